@@ -1,0 +1,32 @@
+# Two entry points, each doing its own set-up from a fresh clone with only Python 3.11 and pip:
+#   make reproduce   full reproduction (config/config.yaml) + HTML report
+#   make test        the whole test suite (units, solver oracles, lint, dry runs, small-data run)
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+CORES  ?= all
+
+.PHONY: reproduce test install clean-venv
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+# Re-install whenever the declared dependencies change.
+$(STAMP): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $(STAMP)
+
+install: $(STAMP)
+
+reproduce: $(STAMP)
+	$(BIN)/snakemake --profile profiles/default --cores $(CORES) --configfile config/config.yaml
+	$(BIN)/snakemake --profile profiles/default --cores $(CORES) --configfile config/config.yaml \
+		--report results/report.html
+
+test: $(STAMP)
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest
+
+clean-venv:
+	rm -rf $(VENV)
