@@ -1,0 +1,121 @@
+"""Reading and writing microscope images (TIFF) with their pixel size.
+
+The pixel size comes from the TIFF resolution tags when they carry a physical unit, otherwise
+from the value the caller supplies (the sample sheet). Writes are atomic: a file is either
+complete or absent.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import tifffile
+
+log = logging.getLogger(__name__)
+
+_METRES_PER_UNIT = {2: 0.0254, 3: 0.01}  # TIFF ResolutionUnit: 2 = inch, 3 = centimetre
+
+
+class ImageError(ValueError):
+    """An image file is not a usable single-channel 2-D microscope image."""
+
+
+@dataclass(frozen=True)
+class Image:
+    """A 2-D image and its square pixel size in metres."""
+
+    data: np.ndarray
+    pixel_m: float
+    path: Path
+
+
+@contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; move it into place only if the block succeeds."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    os.close(handle)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def _pixel_from_tags(page: tifffile.TiffPage) -> float | None:
+    tags = page.tags
+    if "XResolution" not in tags or "ResolutionUnit" not in tags:
+        return None
+    unit = int(tags["ResolutionUnit"].value)
+    if unit not in _METRES_PER_UNIT:
+        return None
+    numerator, denominator = tags["XResolution"].value
+    if numerator <= 0:
+        return None
+    return _METRES_PER_UNIT[unit] * denominator / numerator
+
+
+def read_image(path: str | Path, fallback_pixel_m: float | None = None) -> Image:
+    """Read a single-channel 2-D TIFF of unsigned integer or float pixels.
+
+    Raises ImageError naming the file when the image is not 2-D, has a signed-integer, boolean
+    or complex dtype, contains NaN or infinite pixels, or has no pixel size from either its tags
+    or ``fallback_pixel_m``.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ImageError(f"{path}: no such image")
+    with tifffile.TiffFile(path) as tif:
+        data = tif.asarray()
+        tag_pixel = _pixel_from_tags(tif.pages[0])
+    data = np.squeeze(data)
+    if data.ndim != 2:
+        raise ImageError(
+            f"{path}: image has shape {data.shape}; expected one 2-D single-channel frame"
+        )
+    if not (
+        np.issubdtype(data.dtype, np.unsignedinteger) or np.issubdtype(data.dtype, np.floating)
+    ):
+        raise ImageError(
+            f"{path}: pixel dtype {data.dtype}; expected unsigned integer (uint8/uint16/uint32) "
+            "photon counts or floating point"
+        )
+    if np.issubdtype(data.dtype, np.floating) and not np.all(np.isfinite(data)):
+        bad = int(np.count_nonzero(~np.isfinite(data)))
+        raise ImageError(f"{path}: {bad} NaN or infinite pixels; expected finite intensities")
+    pixel_m = tag_pixel if tag_pixel is not None else fallback_pixel_m
+    if pixel_m is None:
+        raise ImageError(
+            f"{path}: no pixel size in the TIFF resolution tags and none given in the sheet"
+        )
+    disagree = (
+        tag_pixel is not None
+        and fallback_pixel_m is not None
+        and abs(tag_pixel - fallback_pixel_m) > 0.01 * fallback_pixel_m
+    )
+    if disagree:
+        log.warning(
+            "%s: TIFF pixel %.4g nm differs from the sheet's %.4g nm; using the TIFF's",
+            path,
+            tag_pixel * 1e9,
+            fallback_pixel_m * 1e9,
+        )
+    return Image(data=data, pixel_m=float(pixel_m), path=path)
+
+
+def write_image(path: str | Path, data: np.ndarray, pixel_m: float) -> None:
+    """Write a 2-D image as TIFF with its pixel size in the resolution tags (pixels per cm)."""
+    pixels_per_cm = 0.01 / pixel_m
+    with atomic_path(path) as tmp:
+        tifffile.imwrite(
+            tmp, data, resolution=(pixels_per_cm, pixels_per_cm), resolutionunit="CENTIMETER"
+        )

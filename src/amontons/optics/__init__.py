@@ -1,0 +1,1 @@
+"""Measurements from optical images: contact area, and later PSF, Newton rings, absorbance."""
