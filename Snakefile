@@ -1,0 +1,43 @@
+# amontons: multi-asperity contact experiments, from raw images to deviations from Amontons' law.
+# Entry point; README.md says how to run it, config/README.md what every key means.
+from snakemake.utils import min_version
+
+min_version("9.0")
+
+
+configfile: "config/config.yaml"
+
+
+report: "workflow/report/workflow.rst"
+
+
+include: "workflow/rules/common.smk"
+
+
+wildcard_constraints:
+    sphere="|".join(map(re.escape, SPHERES.index)),
+    material="|".join(map(re.escape, MATERIALS)),
+
+
+include: "workflow/rules/virtual_experiment.smk"
+include: "workflow/rules/optics.smk"
+include: "workflow/rules/load_area.smk"
+
+
+# Default target: every output of every selected material.
+rule all:
+    default_target: True
+    input:
+        material_outputs(MATERIALS),
+    localrule: True
+
+
+# One wildcard-free target per material: `snakemake PS` builds only PS's jobs.
+for _material in MATERIALS:
+
+    rule:
+        name:
+            _material
+        input:
+            material_outputs([_material]),
+        localrule: True

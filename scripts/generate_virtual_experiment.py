@@ -1,0 +1,47 @@
+"""Rule generate_virtual_experiment: one sphere's raw data with known truth."""
+
+from pathlib import Path
+
+from amontons.runlog import run_logged
+from amontons.virtual.experiment import generate_sphere
+
+
+def main(
+    truth_path: str,
+    sphere: str,
+    diameter_mm: float,
+    e_star_gpa: float,
+    loads_mn: list[float],
+    pixel_nm: float,
+    settings: dict,
+    seed: int,
+) -> None:
+    generate_sphere(
+        Path(truth_path).parent,
+        sphere=sphere,
+        diameter_m=diameter_mm * 1e-3,
+        e_star_pa=e_star_gpa * 1e9,
+        loads_n=[load * 1e-3 for load in loads_mn],
+        pixel_m=pixel_nm * 1e-9,
+        psf_fwhm_m=settings["psf_fwhm_nm"] * 1e-9,
+        background_counts=settings["background_counts"],
+        contact_counts=settings["contact_counts"],
+        field_of_view_factor=settings["field_of_view_factor"],
+        seed=seed,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        truth_path=sm.output.truth,
+        sphere=sm.params.sphere,
+        diameter_mm=sm.params.diameter_mm,
+        e_star_gpa=sm.params.e_star_gpa,
+        loads_mn=sm.params.loads_mn,
+        pixel_nm=sm.params.pixel_nm,
+        settings=sm.params.settings,
+        seed=sm.params.seed,
+    )

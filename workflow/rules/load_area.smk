@@ -1,0 +1,67 @@
+# Load-area power laws and the deviation from Amontons' law.
+
+
+rule fit_load_area:
+    input:
+        table="results/{material}/{sphere}/contact_area.csv",
+    output:
+        fit="results/{material}/{sphere}/load_area_fit.json",
+    log:
+        "logs/{material}/{sphere}/fit_load_area.log",
+    benchmark:
+        "logs/{material}/{sphere}/fit_load_area.benchmark.tsv"
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        load_area=config["load_area"],
+    script:
+        "../../scripts/fit_load_area.py"
+
+
+rule plot_load_area:
+    input:
+        tables=lambda wc: material_results(wc.material, "contact_area.csv"),
+        fits=lambda wc: material_results(wc.material, "load_area_fit.json"),
+    output:
+        table="results/{material}/load_area.csv",
+        png=report(
+            "results/{material}/load_area.png",
+            caption="../report/load_area.rst",
+            category="Load-area",
+            subcategory="{material}",
+        ),
+        pdf="results/{material}/load_area.pdf",
+    log:
+        "logs/{material}/plot_load_area.log",
+    benchmark:
+        "logs/{material}/plot_load_area.benchmark.tsv"
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        spheres=lambda wc: spheres_of(wc.material),
+        data_label=lambda wc: data_label(spheres_of(wc.material)),
+        reference_load_mn=config["load_area"]["reference_load_mn"],
+    script:
+        "../../scripts/plot_load_area.py"
+
+
+rule fits:
+    """Target: load-area fits of every sphere."""
+    input:
+        [material_results(m, "load_area_fit.json") for m in MATERIALS],
+    localrule: True
+
+
+rule figures:
+    """Target: load-area figures and tables of every material."""
+    input:
+        material_outputs(MATERIALS),
+    localrule: True
