@@ -64,12 +64,14 @@ def _pixel_from_tags(page: tifffile.TiffPage) -> float | None:
     return _METRES_PER_UNIT[unit] * denominator / numerator
 
 
-def read_image(path: str | Path, fallback_pixel_m: float | None = None) -> Image:
+def read_image(
+    path: str | Path, fallback_pixel_m: float | None = None, *, allow_nan: bool = False
+) -> Image:
     """Read a single-channel 2-D TIFF of unsigned integer or float pixels.
 
     Raises ImageError naming the file when the image is not 2-D, has a signed-integer, boolean
     or complex dtype, contains NaN or infinite pixels, or has no pixel size from either its tags
-    or ``fallback_pixel_m``.
+    or ``fallback_pixel_m``. ``allow_nan`` leaves NaN pixels to the caller (height maps).
     """
     path = Path(path)
     if not path.is_file():
@@ -82,14 +84,13 @@ def read_image(path: str | Path, fallback_pixel_m: float | None = None) -> Image
         raise ImageError(
             f"{path}: image has shape {data.shape}; expected one 2-D single-channel frame"
         )
-    if not (
-        np.issubdtype(data.dtype, np.unsignedinteger) or np.issubdtype(data.dtype, np.floating)
-    ):
+    kind = data.dtype.kind  # 'u' unsigned integer, 'f' floating point
+    if kind not in ("u", "f"):
         raise ImageError(
             f"{path}: pixel dtype {data.dtype}; expected unsigned integer (uint8/uint16/uint32) "
             "photon counts or floating point"
         )
-    if np.issubdtype(data.dtype, np.floating) and not np.all(np.isfinite(data)):
+    if not allow_nan and kind == "f" and not np.all(np.isfinite(data)):
         bad = int(np.count_nonzero(~np.isfinite(data)))
         raise ImageError(f"{path}: {bad} NaN or infinite pixels; expected finite intensities")
     pixel_m = tag_pixel if tag_pixel is not None else fallback_pixel_m
