@@ -22,6 +22,7 @@ wildcard_constraints:
 include: "workflow/rules/virtual_experiment.smk"
 include: "workflow/rules/optics.smk"
 include: "workflow/rules/load_area.smk"
+include: "workflow/rules/friction.smk"
 
 
 # Default target: every output of every selected material.

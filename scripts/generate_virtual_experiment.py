@@ -1,9 +1,9 @@
-"""Rule generate_virtual_experiment: one sphere's raw data with known truth."""
+"""Rule generate_virtual_experiment: one sphere's raw data (every instrument) with known truth."""
 
 from pathlib import Path
 
 from amontons.runlog import run_logged
-from amontons.virtual.experiment import generate_sphere
+from amontons.virtual.experiment import InstrumentSettings, generate_sphere
 
 
 def main(
@@ -12,6 +12,9 @@ def main(
     diameter_mm: float,
     e_star_gpa: float,
     loads_mn: list[float],
+    reflection_load_mn: float,
+    flim_load_mn: float | None,
+    shear_strength_mpa: float,
     pixel_nm: float,
     settings: dict,
     seed: int,
@@ -23,10 +26,10 @@ def main(
         e_star_pa=e_star_gpa * 1e9,
         loads_n=[load * 1e-3 for load in loads_mn],
         pixel_m=pixel_nm * 1e-9,
-        psf_fwhm_m=settings["psf_fwhm_nm"] * 1e-9,
-        background_counts=settings["background_counts"],
-        contact_counts=settings["contact_counts"],
-        field_of_view_factor=settings["field_of_view_factor"],
+        reflection_load_n=reflection_load_mn * 1e-3,
+        flim_load_n=None if flim_load_mn is None else flim_load_mn * 1e-3,
+        shear_strength_pa=shear_strength_mpa * 1e6,
+        settings=InstrumentSettings.from_config(settings),
         seed=seed,
     )
 
@@ -41,6 +44,9 @@ if __name__ == "__main__":
         diameter_mm=sm.params.diameter_mm,
         e_star_gpa=sm.params.e_star_gpa,
         loads_mn=sm.params.loads_mn,
+        reflection_load_mn=sm.params.reflection_load_mn,
+        flim_load_mn=sm.params.flim_load_mn,
+        shear_strength_mpa=sm.params.shear_strength_mpa,
         pixel_nm=sm.params.pixel_nm,
         settings=sm.params.settings,
         seed=sm.params.seed,

@@ -59,6 +59,6 @@ if __name__ == "__main__":
         table_path=sm.output.table,
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
-        otsu_bins=sm.params.optics["otsu_bins"],
-        min_separation=sm.params.optics["min_separation"],
+        otsu_bins=sm.params.otsu_bins,
+        min_separation=sm.params.min_separation,
     )

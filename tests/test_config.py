@@ -48,13 +48,16 @@ def test_misspelled_key_is_named_with_the_allowed_keys(repo, config_schema):
     message = str(info.value)
     assert "my.yaml" in message
     assert "'otsu_bin'" in message and "optics" in message
-    assert "allowed keys: min_separation, otsu_bins" in message
+    assert (
+        "allowed keys: absorbance, intensity, lifetime, min_separation, newton_rings, otsu_bins"
+        in message
+    )
 
 
 def test_unknown_top_level_key(repo, config_schema):
     config = _config(repo)
     config["virtual_experment"] = {}
-    with pytest.raises(ConfigError, match="'virtual_experment'.*allowed keys: load_area"):
+    with pytest.raises(ConfigError, match="'virtual_experment'.*allowed keys: friction, load_area"):
         validate(config, config_schema, "my.yaml")
 
 
@@ -87,10 +90,13 @@ def test_loads_parse():
 
 
 def _write_sheet(path, rows):
+    """Sheet with the given rows; every row gets reflection load 25 mN and shear strength
+    20 MPa (required columns that these tests do not vary)."""
     header = (
         "sphere\tmaterial\tdiameter_mm\te_star_gpa\troughened\tloads_mn\t"
-        "fluorescence_pixel_nm\tdata_source\n"
+        "reflection_load_mn\tshear_strength_mpa\tfluorescence_pixel_nm\tdata_source\n"
     )
+    rows = [[*row[:6], "25", "20", *row[6:]] for row in rows]
     path.write_text(header + "".join("\t".join(row) + "\n" for row in rows))
 
 

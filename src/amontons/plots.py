@@ -39,3 +39,127 @@ def plot_normalised_load_area(
         with atomic_path(path) as tmp:
             fig.savefig(tmp, dpi=150, format=str(path).rsplit(".", 1)[-1])
     plt.close(fig)
+
+
+def _save(fig, paths: list[str]) -> None:
+    """Write ``fig`` to each path (format from the extension), atomically, and close it."""
+    for path in paths:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=150, format=str(path).rsplit(".", 1)[-1])
+    plt.close(fig)
+
+
+def plot_psf_profile(
+    r_nm: np.ndarray,
+    counts: np.ndarray,
+    fwhm_nm: float,
+    fwhm_se_nm: float,
+    peak_counts: float,
+    background_counts: float,
+    title: str,
+    paths: list[str],
+) -> None:
+    """Radially averaged bead profile (counts vs distance from the centroid, nm) with the
+    fitted Gaussian (appendix Fig. B.2). The curve shown uses the pixel-corrected FWHM."""
+    sigma = fwhm_nm / (2 * np.sqrt(2 * np.log(2)))
+    fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
+    ax.plot(r_nm, counts, "o", ms=3, label="radial average")
+    span = np.linspace(0, r_nm.max(), 200)
+    ax.plot(
+        span,
+        peak_counts * np.exp(-0.5 * (span / sigma) ** 2) + background_counts,
+        "-",
+        label=f"Gaussian, FWHM {fwhm_nm:.0f} ± {fwhm_se_nm:.0f} nm",
+    )
+    ax.set_xlabel("distance from centre of intensity (nm)")
+    ax.set_ylabel("intensity (counts)")
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7)
+    _save(fig, paths)
+
+
+def plot_absorbance(
+    wavelength_nm: np.ndarray,
+    absorbance: np.ndarray,
+    smoothed: np.ndarray,
+    peak_nm: float,
+    peak_absorbance: float,
+    density_per_um2: float,
+    title: str,
+    paths: list[str],
+) -> None:
+    """Absorbance spectrum with its LOWESS smoothing and maximum (appendix Fig. B.1)."""
+    fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
+    ax.plot(wavelength_nm, absorbance, ".", ms=2, color="0.6", label="measured")
+    ax.plot(wavelength_nm, smoothed, "r-", label="LOWESS")
+    ax.plot(
+        [peak_nm],
+        [peak_absorbance],
+        "kx",
+        label=f"max {peak_absorbance:.2g} at {peak_nm:.0f} nm → {density_per_um2:.3g} µm⁻²",
+    )
+    ax.set_xlabel("wavelength (nm)")
+    ax.set_ylabel("absorbance")
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7)
+    _save(fig, paths)
+
+
+def plot_edge_gap(
+    ring_r_um: list[np.ndarray],
+    ring_gap_nm: list[np.ndarray],
+    edge_radius_um: float,
+    edge_gaps_nm: np.ndarray,
+    title: str,
+    paths: list[str],
+) -> None:
+    """Gap of each Newton ring versus distance from the contact centre, every half-profile,
+    and the extrapolated gaps at the fluorescent edge (appendix Fig. B.7b)."""
+    fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
+    for r, gap in zip(ring_r_um, ring_gap_nm, strict=True):
+        ax.plot(r, gap, "o-", ms=2, lw=0.4, color="tab:blue", alpha=0.4)
+    ax.plot(
+        np.full(edge_gaps_nm.shape, edge_radius_um),
+        edge_gaps_nm,
+        "s",
+        ms=3,
+        color="tab:green",
+        label=f"edge: {edge_gaps_nm.mean():.1f} ± {edge_gaps_nm.std(ddof=1):.1f} nm",
+    )
+    ax.axvline(edge_radius_um, color="tab:green", lw=0.8, ls="--")
+    ax.set_xlabel("distance from contact centre (µm)")
+    ax.set_ylabel("gap (nm)")
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7)
+    _save(fig, paths)
+
+
+def plot_amontons_deviation(
+    table: pd.DataFrame, title: str, paths: list[str], reference_load_mn: float
+) -> None:
+    """Appendix Fig. B.13: (a) A/A_ref and (b) F_s/F_s,ref versus F/F_ref per sphere, log–log,
+    with Amontons' law (slope 1). ``table`` has columns sphere, normal_force_mN,
+    area_over_area_ref, friction_over_friction_ref."""
+    fig, axes = plt.subplots(1, 2, figsize=(8.0, 3.8), constrained_layout=True)
+    ratio = table["normal_force_mN"] / reference_load_mn
+    span = np.geomspace(ratio.min(), ratio.max(), 50)
+    panels = (
+        ("area_over_area_ref", f"A / A({reference_load_mn:g} mN)", "a) contact area"),
+        (
+            "friction_over_friction_ref",
+            f"F_s / F_s({reference_load_mn:g} mN)",
+            "b) static friction",
+        ),
+    )
+    for ax, (column, label, name) in zip(axes, panels, strict=True):
+        for sphere, rows in table.groupby("sphere", sort=False):
+            ax.plot(rows["normal_force_mN"] / reference_load_mn, rows[column], "o-", label=sphere)
+        ax.plot(span, span, "k--", lw=0.8, label="Amontons (∝ F)")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(f"F / {reference_load_mn:g} mN")
+        ax.set_ylabel(label)
+        ax.set_title(name, fontsize=9)
+        ax.legend(fontsize=7)
+    fig.suptitle(title, fontsize=9)
+    _save(fig, paths)

@@ -1,6 +1,8 @@
 # Helpers shared by the workflow files: validated config, the sample sheet and path lookups.
 import os
 
+import pandas as pd
+
 from amontons.config import load_schema, load_workflow_config
 
 SCHEMAS = os.path.join(workflow.basedir, "workflow", "schemas")
@@ -14,6 +16,23 @@ SPHERES = load_workflow_config(
     CONFIG_SOURCE,
 )
 MATERIALS = list(config["materials"])
+
+
+def check_sheet_loads(spheres):
+    """The reflection and FLIM loads of each sphere must be among its loads_mn."""
+    for sphere, row in spheres.iterrows():
+        for column in ("reflection_load_mn", "flim_load_mn"):
+            value = row.get(column)
+            if value is None or pd.isna(value):
+                continue
+            if not any(abs(float(value) - load) < 1e-9 for load in row["loads"]):
+                raise ValueError(
+                    f"{config['materials_sheet']}, sphere {sphere}: {column} = {value:g} is not "
+                    f"one of loads_mn {row['loads']}; expected the load of an existing image"
+                )
+
+
+check_sheet_loads(SPHERES)
 
 
 def sphere_row(sphere):
@@ -39,6 +58,41 @@ def loads_mn(sphere):
     return list(sphere_row(sphere)["loads"])
 
 
+def sheet_value(sphere, column):
+    """A numeric sheet value, or None where the cell is empty."""
+    value = sphere_row(sphere).get(column)
+    return None if value is None or pd.isna(value) else float(value)
+
+
+def pixel_nm(sphere):
+    return float(sphere_row(sphere)["fluorescence_pixel_nm"])
+
+
+def raw_file(sphere, name):
+    """Path of one raw file of a sphere (e.g. 'bead.tif')."""
+    return f"{raw_dir(sphere)}/{name}"
+
+
+def reflection_fluorescence(sphere):
+    """The fluorescence image recorded at the sphere's reflection load."""
+    load = sheet_value(sphere, "reflection_load_mn")
+    return f"{raw_dir(sphere)}/fluorescence/{load:g}.tif"
+
+
+def has_flim(sphere):
+    """Synthetic spheres get a FLIM map where the sheet gives flim_load_mn; measured spheres
+    have one where their folder holds flim.tif."""
+    if is_synthetic(sphere):
+        return sheet_value(sphere, "flim_load_mn") is not None
+    return os.path.isfile(raw_file(sphere, "flim.tif"))
+
+
+def flim_spheres_pattern(with_flim):
+    """Regex matching the synthetic spheres with (or without) a FLIM map; never empty-match."""
+    names = [s for s in SPHERES.index if is_synthetic(s) and has_flim(s) == with_flim]
+    return "|".join(map(re.escape, names)) or "(?!)"
+
+
 def sphere_result(material, sphere, name):
     if sphere_row(sphere)["material"] != material:
         raise ValueError(
@@ -59,10 +113,70 @@ def data_label(spheres):
     )
 
 
-def material_outputs(materials):
-    """The per-material deliverables: load-area table and figure."""
-    return expand(
-        "results/{material}/load_area.{ext}",
+# Per-sphere results of each stage; lifetime only where a FLIM map exists.
+OPTICS_RESULTS = [
+    "contact_area.csv",
+    "psf.json",
+    "psf.png",
+    "psf.pdf",
+    "grafting_density.json",
+    "absorbance.png",
+    "absorbance.pdf",
+    "edge_gap.json",
+    "edge_gap.png",
+    "edge_gap.pdf",
+    "intensity_pressure.csv",
+    "intensity_pressure_fit.json",
+    "hertz_check.csv",
+]
+FRICTION_RESULTS = ["friction.csv"]
+FIT_RESULTS = ["load_area_fit.json"]
+
+
+def sphere_outputs(material, names):
+    return [sphere_result(material, s, n) for s in spheres_of(material) for n in names]
+
+
+def optics_outputs(materials):
+    """Every optical measurement of every sphere of ``materials``."""
+    out = []
+    for material in materials:
+        out += sphere_outputs(material, OPTICS_RESULTS)
+        out += [
+            sphere_result(material, s, "lifetime.json")
+            for s in spheres_of(material)
+            if has_flim(s)
+        ]
+    return out
+
+
+def friction_outputs(materials):
+    """Friction per sphere and the Amontons-deviation figure and table per material."""
+    out = [f for m in materials for f in sphere_outputs(m, FRICTION_RESULTS)]
+    return out + expand(
+        "results/{material}/amontons.{ext}",
         material=materials,
         ext=["png", "pdf", "csv"],
     )
+
+
+def figure_outputs(materials):
+    """The per-material figures and tables: load-area and Amontons deviation."""
+    return expand(
+        "results/{material}/{name}.{ext}",
+        material=materials,
+        name=["load_area", "amontons"],
+        ext=["png", "pdf", "csv"],
+    )
+
+
+def material_outputs(materials):
+    """Everything a material's target builds: every measurement, fit, figure and table."""
+    fits = [f for m in materials for f in sphere_outputs(m, FIT_RESULTS)]
+    everything = (
+        optics_outputs(materials)
+        + friction_outputs(materials)
+        + fits
+        + figure_outputs(materials)
+    )
+    return list(dict.fromkeys(everything))  # once each, in order

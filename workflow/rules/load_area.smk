@@ -56,12 +56,12 @@ rule plot_load_area:
 rule fits:
     """Target: load-area fits of every sphere."""
     input:
-        [material_results(m, "load_area_fit.json") for m in MATERIALS],
+        [f for m in MATERIALS for f in sphere_outputs(m, FIT_RESULTS)],
     localrule: True
 
 
 rule figures:
-    """Target: load-area figures and tables of every material."""
+    """Target: load-area and Amontons-deviation figures and tables of every material."""
     input:
-        material_outputs(MATERIALS),
+        figure_outputs(MATERIALS),
     localrule: True

@@ -1,0 +1,92 @@
+"""Shared helpers for the solver benchmarks (timing, problems, table printing).
+
+Benchmarks print tables; they are not tests. The machine is shared and noisy, so every
+timing is the median of several runs and compared with a floor measured in the same run.
+"""
+
+from __future__ import annotations
+
+import os
+
+# BLAS level-1 calls (dot, axpy) in the CG would otherwise use OpenBLAS's own threads, which
+# spin on a shared 2-core machine: the benchmarks pin them to --threads (default 1) via
+# the environment, before numpy is imported (see README).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse
+import datetime
+import platform
+import statistics
+import time
+
+import numpy as np
+
+from amontons.contact import self_affine, sphere
+
+# The periodic benchmark surface: Hurst 0.8, rms slope 0.1, mean pressure 0.005 E*
+# (about 10 % contact by the κ ≈ 2 law, A/A0 = κ p̄ / (E* h')).
+HURST, RMS_SLOPE, PBAR = 0.8, 0.1, 0.005
+E_STAR = 1.0  # units are arbitrary but consistent; the solver is SI-agnostic in scale
+
+
+def parser(description: str) -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("--quick", action="store_true", help="small grids, a few seconds")
+    ap.add_argument("--repeats", type=int, default=None, help="timing repeats (median)")
+    ap.add_argument("--threads", type=int, default=1, help="FFTW threads")
+    ap.add_argument("--sizes", type=int, nargs="*", default=None, help="grid sizes n (n x n)")
+    return ap
+
+
+def header(title: str, args) -> None:
+    print(f"# {title}")
+    print(
+        f"# {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M UTC}, {platform.node()}, "
+        f"{os.cpu_count()} cores, python {platform.python_version()}, numpy {np.__version__}, "
+        f"threads={args.threads}"
+    )
+
+
+def median_time(fn, repeats: int, warmup: int = 1) -> float:
+    """Median wall time of ``fn()`` over ``repeats`` calls after ``warmup`` calls, s."""
+    for _ in range(warmup):
+        fn()
+    ts = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t0)
+    return statistics.median(ts)
+
+
+def rough_surface(n: int, seed: int = 1) -> np.ndarray:
+    """Periodic self-affine benchmark surface on n², spacing 1."""
+    return self_affine((n, n), 1.0, HURST, rms_slope=RMS_SLOPE, rng=seed)
+
+
+def rough_load(n: int) -> float:
+    return PBAR * E_STAR * n * n
+
+
+def sphere_problem(n: int, seed: int = 1):
+    """Non-periodic rough sphere on n², spacing 1: contact radius ~n/5, edge-free."""
+    radius = 4.0 * n
+    a = n / 5
+    h = sphere((n, n), 1.0, radius) + self_affine((n, n), 1.0, HURST, rms_height=0.5, rng=seed)
+    return h, 4 * E_STAR * a**3 / (3 * radius)
+
+
+def table(rows, columns) -> None:
+    """Print a GitHub-markdown table."""
+    print("| " + " | ".join(columns) + " |")
+    print("|" + "|".join("---" for _ in columns) + "|")
+    for r in rows:
+        print("| " + " | ".join(_fmt(r.get(c, "")) for c in columns) + " |")
+
+
+def _fmt(v):
+    if isinstance(v, float):
+        if v == 0 or 1e-3 <= abs(v) < 1e5:
+            return f"{v:.3g}" if abs(v) < 100 else f"{v:.0f}"
+        return f"{v:.2e}"
+    return str(v)

@@ -1,0 +1,76 @@
+"""Rule measure_grafting_density: probe molecules per µm² from the absorbance spectrum."""
+
+import json
+import logging
+
+from amontons.images import atomic_path
+from amontons.measurements import measure_grafting_density
+from amontons.plots import plot_absorbance
+from amontons.rawdata import read_absorbance
+from amontons.runlog import run_logged
+
+log = logging.getLogger(__name__)
+
+# 1 L/(mol·cm) = 1e-3 m³ / (mol · 1e-2 m) = 0.1 m²/mol
+M2_PER_MOL_PER_L_PER_MOL_CM = 0.1
+
+
+def main(
+    absorbance_path: str,
+    density_path: str,
+    figure_paths: list[str],
+    lowess_frac: float,
+    coated_faces: int,
+    epsilon_l_per_mol_cm: float,
+    data_label: str,
+    sphere: str,
+) -> None:
+    result = measure_grafting_density(
+        absorbance_path,
+        frac=lowess_frac,
+        n_faces=coated_faces,
+        epsilon_m2_per_mol=epsilon_l_per_mol_cm * M2_PER_MOL_PER_L_PER_MOL_CM,
+    )
+    summary = {
+        "quantity": "grafting density of the rigidochromic monolayer, molecules per µm² of one "
+        "face: LOWESS maximum of the absorbance / (ε · coated faces) · N_A",
+        "density_per_um2": result.density_per_um2,
+        "peak_absorbance": result.peak_absorbance,
+        "peak_wavelength_nm": result.peak_wavelength_nm,
+        "noise_sd": result.noise_sd,
+        "coated_faces": result.n_faces,
+        "epsilon_l_per_mol_cm": epsilon_l_per_mol_cm,
+        "lowess_frac": result.frac,
+        "n": int(result.wavelength_nm.size),
+        "spectrum": absorbance_path,
+    }
+    log.info("%s: %.4g molecules/µm²", absorbance_path, result.density_per_um2)
+    with atomic_path(density_path) as tmp:
+        tmp.write_text(json.dumps(summary, indent=2))
+    _, absorbance = read_absorbance(absorbance_path)
+    plot_absorbance(
+        result.wavelength_nm,
+        absorbance,
+        result.smoothed,
+        result.peak_wavelength_nm,
+        result.peak_absorbance,
+        result.density_per_um2,
+        f"{sphere}: absorbance of the probe cover slip ({data_label})",
+        figure_paths,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        absorbance_path=sm.input.absorbance,
+        density_path=sm.output.density,
+        figure_paths=[sm.output.png, sm.output.pdf],
+        lowess_frac=sm.params.absorbance["lowess_frac"],
+        coated_faces=sm.params.absorbance["coated_faces"],
+        epsilon_l_per_mol_cm=sm.params.absorbance["epsilon_l_per_mol_cm"],
+        data_label=sm.params.data_label,
+        sphere=sm.wildcards.sphere,
+    )

@@ -1,0 +1,70 @@
+"""Rule measure_psf: PSF FWHM from the bead image of one sphere, and its radial profile."""
+
+import json
+import logging
+
+from amontons.images import atomic_path
+from amontons.measurements import measure_bead
+from amontons.plots import plot_psf_profile
+from amontons.runlog import run_logged
+
+log = logging.getLogger(__name__)
+
+
+def main(
+    bead_path: str,
+    psf_path: str,
+    figure_paths: list[str],
+    pixel_nm: float,
+    profile_radius_nm: float,
+    centroid_radius_nm: float,
+    data_label: str,
+    sphere: str,
+) -> None:
+    psf = measure_bead(
+        bead_path,
+        pixel_nm * 1e-9,
+        profile_radius_m=profile_radius_nm * 1e-9,
+        centroid_radius_m=centroid_radius_nm * 1e-9,
+    )
+    result = {
+        "quantity": "PSF FWHM from a 100 nm bead (Gaussian fit of the radial profile, "
+        "pixel-corrected)",
+        "fwhm_nm": {"estimate": psf.fwhm_m * 1e9, "standard_error": psf.fwhm_se_m * 1e9},
+        "fitted_fwhm_nm": psf.fitted_fwhm_m * 1e9,
+        "n": psf.n_pixels_fitted,
+        "peak_counts": psf.peak_counts,
+        "background_counts": psf.background_counts,
+        "noise_sd_counts": psf.noise_sd_counts,
+        "centroid_nm": [c * 1e9 for c in psf.centroid_m],
+        "image": bead_path,
+    }
+    log.info("%s: FWHM %.1f ± %.1f nm", bead_path, psf.fwhm_m * 1e9, psf.fwhm_se_m * 1e9)
+    with atomic_path(psf_path) as tmp:
+        tmp.write_text(json.dumps(result, indent=2))
+    plot_psf_profile(
+        psf.profile_r_m * 1e9,
+        psf.profile_counts,
+        psf.fwhm_m * 1e9,
+        psf.fwhm_se_m * 1e9,
+        psf.peak_counts,
+        psf.background_counts,
+        f"{sphere}: bead radial profile ({data_label})",
+        figure_paths,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        bead_path=sm.input.bead,
+        psf_path=sm.output.psf,
+        figure_paths=[sm.output.png, sm.output.pdf],
+        pixel_nm=sm.params.pixel_nm,
+        profile_radius_nm=sm.params.psf["profile_radius_nm"],
+        centroid_radius_nm=sm.params.psf["centroid_radius_nm"],
+        data_label=sm.params.data_label,
+        sphere=sm.wildcards.sphere,
+    )

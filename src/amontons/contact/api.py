@@ -1,0 +1,385 @@
+"""Public solve calls: :func:`solve` and :func:`solve_load_series`."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+
+import numpy as np
+
+from .cg import polonsky_keer
+from .convolution import get_operator
+from .result import ContactInputError, ContactResult, ConvergenceError, FreeBoundaryError
+
+# Coarse levels stop at this many pixels along the shorter side: below it a solve costs
+# nothing and the coarse surface no longer resembles the fine one.
+COARSE_MIN_SIZE = 32
+# Coarse levels only provide a starting guess, so they are solved loosely.
+COARSE_TOL = 1e-4
+
+
+def _check_positive(name, value, unit):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ContactInputError(f"{name} must be a number in {unit}, got {value!r}") from None
+    if not math.isfinite(v) or v <= 0:
+        raise ContactInputError(f"{name} must be a finite positive number in {unit}, got {v!r}")
+    return v
+
+
+def _check_heights(heights):
+    h = np.asarray(heights)
+    if h.ndim != 2:
+        raise ContactInputError(f"heights must be a 2-D array (m), got an array of shape {h.shape}")
+    if min(h.shape) < 2:
+        raise ContactInputError(f"heights must be at least 2x2 pixels, got shape {h.shape}")
+    if not np.issubdtype(h.dtype, np.number) or np.iscomplexobj(h):
+        raise ContactInputError(f"heights must be real numbers (m), got dtype {h.dtype}")
+    h = np.ascontiguousarray(h, dtype=np.float64)
+    bad = ~np.isfinite(h)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise ContactInputError(
+            f"heights contain {int(bad.sum())} non-finite value(s) (NaN or inf), first at "
+            f"pixel ({i}, {j}); expected finite heights in m"
+        )
+    return h
+
+
+def _check_warm_start(warm_start, shape):
+    w = np.asarray(warm_start, dtype=np.float64)
+    if w.shape != shape:
+        raise ContactInputError(f"warm_start must have the shape of heights {shape}, got {w.shape}")
+    if not np.isfinite(w).all():
+        raise ContactInputError("warm_start contains NaN or inf; expected a pressure in Pa")
+    if (w < 0).any():
+        raise ContactInputError(f"warm_start must be a pressure >= 0 (Pa), min is {w.min():.3e}")
+    return w
+
+
+def _default_max_iter(shape):
+    # PK needs O(n) iterations on an n x n grid for rough surfaces (~1200 at 2048²);
+    # generous, so hitting the cap means something is wrong, not just slow.
+    return 1000 + 4 * (shape[0] + shape[1])
+
+
+def _initial_pressure(h, spacing, e_star, displacement):
+    """Starting pressure (Pa) for displacement control: a local-stiffness overlap guess."""
+    overlap = np.maximum(h + displacement, 0.0)
+    n = np.count_nonzero(overlap)
+    if n == 0:
+        return np.zeros_like(h)
+    # a patch of size L has stiffness ~E*/L, so p ~ E* overlap / L
+    return overlap * (e_star / (math.sqrt(n) * spacing))
+
+
+def _coarsen(h):
+    n0, n1 = h.shape
+    return h.reshape(n0 // 2, 2, n1 // 2, 2).mean(axis=(1, 3))
+
+
+def _coarse_start(
+    h, spacing, e_star, load, displacement, periodic, backend, threads, min_size, levels
+):
+    """Pressure (Pa) on the grid of ``h`` from a solve on a 2x coarser grid, or None.
+
+    Heights are block-averaged 2x2 (spacing doubles); the coarse pressure is prolonged by
+    pixel replication, which keeps the total force. Recurses down to ``min_size``.
+    """
+    n0, n1 = h.shape
+    if n0 % 2 or n1 % 2 or min(n0, n1) < 2 * min_size:
+        return None, levels
+    hc = _coarsen(h)
+    start, levels = _coarse_start(
+        hc, 2 * spacing, e_star, load, displacement, periodic, backend, threads, min_size, levels
+    )
+    try:
+        res = _solve(
+            hc,
+            2 * spacing,
+            e_star,
+            load=load,
+            displacement=displacement,
+            periodic=periodic,
+            tol=COARSE_TOL,
+            max_iter=_default_max_iter(hc.shape),
+            backend=backend,
+            threads=threads,
+            warm_start=start,
+            check_boundary=False,
+            raise_on_failure=False,
+        )
+    except ConvergenceError:  # pragma: no cover - raise_on_failure=False
+        return None, levels
+    p = res.pressure
+    if not np.isfinite(p).all() or not p.any():
+        return None, levels
+    levels.append(
+        {"shape": hc.shape, "iterations": res.iterations, "convolutions": res.info["convolutions"]}
+    )
+    return _prolong(p), levels
+
+
+def _prolong(p):
+    """Pixel replication 2x2: keeps the total force and the support of the pressure."""
+    return np.repeat(np.repeat(p, 2, axis=0), 2, axis=1)
+
+
+def solve(
+    heights,
+    spacing,
+    e_star,
+    *,
+    load=None,
+    displacement=None,
+    periodic=False,
+    tol=1e-8,
+    max_iter=None,
+    threads=1,
+    warm_start=None,
+    coarse_to_fine=False,
+    backend=None,
+) -> ContactResult:
+    """Solve the frictionless contact of a rigid rough indenter on an elastic half-space.
+
+    Parameters
+    ----------
+    heights : (n0, n1) array_like
+        Indenter heights, m. Larger = closer to the elastic flat (a sphere of radius R is
+        ``-r²/(2R)``).
+    spacing : float
+        Grid spacing (square pixels), m.
+    e_star : float
+        Contact modulus E*, Pa.
+    load : float, optional
+        Total normal force, N (> 0). Exactly one of ``load`` and ``displacement``.
+    displacement : float, optional
+        Rigid-body approach d, m (gap ``g = u - h - d``).
+    periodic : bool
+        Periodic boundary conditions (nominally flat surfaces) or a free half-space with
+        Hockney padding (spheres; contact must stay off the window edge).
+    tol : float
+        Convergence tolerance on the residual (see :mod:`amontons.contact.cg`).
+    max_iter : int, optional
+        Iteration cap on the finest grid (default ``1000 + 4(n0 + n1)``).
+    threads : int
+        FFTW threads.
+    warm_start : array_like, optional
+        Initial pressure, Pa (e.g. the pressure of a previous, nearby solve).
+    coarse_to_fine : bool
+        Start from the prolonged solution of the same problem on 2x, 4x, ... coarser grids
+        (ignored when ``warm_start`` is given or the shape is odd).
+    backend : {"pyfftw", "numpy", None}
+        FFT backend; None picks pyfftw when importable.
+
+    Returns
+    -------
+    ContactResult
+
+    Raises
+    ------
+    ContactInputError
+        Invalid input (names the value and what was expected).
+    ConvergenceError
+        No convergence within ``max_iter`` (carries the residual history).
+    FreeBoundaryError
+        Non-periodic solve with pressure on the outermost ring of the window.
+    """
+    h = _check_heights(heights)
+    spacing = _check_positive("spacing", spacing, "m")
+    e_star = _check_positive("e_star", e_star, "Pa")
+    if (load is None) == (displacement is None):
+        raise ContactInputError(
+            "give exactly one of load (N) and displacement (m); got "
+            f"load={load!r}, displacement={displacement!r}"
+        )
+    if load is not None:
+        load = _check_positive("load", load, "N")
+    else:
+        try:
+            displacement = float(displacement)
+        except (TypeError, ValueError):
+            raise ContactInputError(
+                f"displacement must be a number in m, got {displacement!r}"
+            ) from None
+        if not math.isfinite(displacement):
+            raise ContactInputError(f"displacement must be finite (m), got {displacement!r}")
+    tol = _check_positive("tol", tol, "(dimensionless)")
+    if max_iter is not None and (int(max_iter) != max_iter or max_iter < 1):
+        raise ContactInputError(f"max_iter must be a positive integer, got {max_iter!r}")
+    threads = int(threads)
+    if threads < 1:
+        raise ContactInputError(f"threads must be >= 1, got {threads}")
+    if warm_start is not None:
+        warm_start = _check_warm_start(warm_start, h.shape)
+    return _solve(
+        h,
+        spacing,
+        e_star,
+        load=load,
+        displacement=displacement,
+        periodic=bool(periodic),
+        tol=tol,
+        max_iter=_default_max_iter(h.shape) if max_iter is None else int(max_iter),
+        backend=backend,
+        threads=threads,
+        warm_start=warm_start,
+        coarse_to_fine=coarse_to_fine,
+    )
+
+
+def _solve(
+    h,
+    spacing,
+    e_star,
+    *,
+    load,
+    displacement,
+    periodic,
+    tol,
+    max_iter,
+    backend,
+    threads,
+    warm_start,
+    coarse_to_fine=False,
+    check_boundary=True,
+    raise_on_failure=True,
+):
+    t0 = time.perf_counter()
+    op = get_operator(h.shape, spacing, e_star, periodic=periodic, backend=backend, threads=threads)
+    levels = []
+    p_init = warm_start
+    if p_init is None and coarse_to_fine:
+        p_init, levels = _coarse_start(
+            h, spacing, e_star, load, displacement, periodic, backend, threads, COARSE_MIN_SIZE, []
+        )
+    if p_init is None:
+        if load is not None:
+            p_init = np.ones_like(h)
+        else:
+            p_init = _initial_pressure(h, spacing, e_star, displacement)
+    h_scale = float(np.std(h))
+    if not h_scale > 0:
+        h_scale = spacing  # a flat indenter: any length works, the gap is exactly 0
+    out = polonsky_keer(
+        op,
+        h,
+        pixel_area=spacing**2,
+        h_scale=h_scale,
+        p_init=p_init,
+        load=load,
+        displacement=displacement,
+        tol=tol,
+        max_iter=max_iter,
+        raise_on_failure=raise_on_failure,
+    )
+    p = out.pressure
+    if not (np.isfinite(p).all() and np.isfinite(out.gap).all()):
+        raise ConvergenceError(
+            "solver produced non-finite pressure or gap (NaN/inf)",
+            iterations=out.iterations,
+            residual=out.residual,
+            tol=tol,
+            residual_history=out.history,
+        )
+    contact = p > 0
+    total = float(p.sum()) * spacing**2
+    if check_boundary and not periodic:
+        edge = np.zeros_like(contact)
+        edge[0, :] = edge[-1, :] = edge[:, 0] = edge[:, -1] = True
+        on_edge = contact & edge
+        n_edge = int(on_edge.sum())
+        if n_edge:
+            f_edge = float(p[on_edge].sum()) * spacing**2
+            raise FreeBoundaryError(
+                f"contact reaches the window edge: {n_edge} edge pixel(s) carry "
+                f"{f_edge:.3e} N of {total:.3e} N; the non-periodic solution is only valid "
+                "if the pressure vanishes at the edge - enlarge the window or lower the load",
+                edge_pixels=n_edge,
+                edge_force=f_edge,
+            )
+    info = {
+        "convolutions": out.convolutions,
+        "steepest_descent_resets": out.info["steepest_descent_resets"],
+        "coarse_levels": levels,
+        "backend": op.backend,
+        "threads": threads,
+        "tol": tol,
+        "wall_time_s": time.perf_counter() - t0,
+    }
+    return ContactResult(
+        pressure=p,
+        gap=out.gap,
+        elastic_displacement=out.displacement_field,
+        plastic_displacement=np.zeros_like(p),
+        contact=contact,
+        load=total,
+        displacement=out.rigid_displacement,
+        spacing=spacing,
+        iterations=out.iterations,
+        residual=out.residual,
+        residual_history=out.history,
+        converged=out.converged,
+        periodic=periodic,
+        info=info,
+    )
+
+
+def solve_load_series(
+    heights,
+    spacing,
+    e_star,
+    loads: Sequence[float],
+    *,
+    periodic=False,
+    tol=1e-8,
+    max_iter=None,
+    threads=1,
+    coarse_to_fine=False,
+    backend=None,
+) -> list[ContactResult]:
+    """Solve for increasing loads, each step warm-started from the previous pressure.
+
+    Parameters
+    ----------
+    heights, spacing, e_star, periodic, tol, max_iter, threads, backend
+        As in :func:`solve`.
+    loads : sequence of float
+        Total forces, N; strictly increasing and positive.
+    coarse_to_fine : bool
+        Coarse-to-fine start for the first load only (later loads are warm-started).
+
+    Returns
+    -------
+    list of ContactResult, one per load.
+    """
+    arr = np.asarray(loads, dtype=float)
+    if arr.ndim != 1 or arr.size == 0:
+        raise ContactInputError(f"loads must be a non-empty 1-D sequence (N), got {loads!r}")
+    if not np.isfinite(arr).all() or (arr <= 0).any():
+        raise ContactInputError(f"loads must be finite and positive (N), got {arr.tolist()}")
+    if arr.size > 1 and (np.diff(arr) <= 0).any():
+        raise ContactInputError(f"loads must be strictly increasing (N), got {arr.tolist()}")
+    results = []
+    prev = None
+    for i, w in enumerate(arr):
+        # scale the previous field to the new load: right total, right shape to first order
+        start = None if prev is None else prev.pressure * (w / prev.load)
+        res = solve(
+            heights,
+            spacing,
+            e_star,
+            load=float(w),
+            periodic=periodic,
+            tol=tol,
+            max_iter=max_iter,
+            threads=threads,
+            warm_start=start,
+            coarse_to_fine=coarse_to_fine and i == 0,
+            backend=backend,
+        )
+        results.append(res)
+        prev = res
+    return results

@@ -1,0 +1,313 @@
+"""One sphere's measurements from its raw-data folder, one function per workflow rule.
+
+Each function reads its files through amontons.rawdata, runs the measurement from
+amontons.optics / amontons.friction / amontons.hertz_check and returns plain results; the
+workflow scripts only write them. A measurement that cannot be made raises RawDataError naming
+the file it came from and why.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.ndimage import binary_dilation
+
+from amontons.friction import RheometerError, amontons_deviation, static_friction
+from amontons.hertz_check import hertz_check
+from amontons.images import read_image
+from amontons.optics.absorbance import AbsorbanceError, GraftingDensity, grafting_density
+from amontons.optics.area import otsu_contact_area
+from amontons.optics.intensity import IntensityPressure, intensity_pressure
+from amontons.optics.lifetime import LifetimeStatistics, lifetime_statistics
+from amontons.optics.newton_rings import NewtonRingError, NewtonRingGap, newton_ring_gap
+from amontons.optics.psf import PsfError, PsfMeasurement, measure_psf
+from amontons.rawdata import (
+    RawDataError,
+    fluorescence_images,
+    read_absorbance,
+    read_bead,
+    read_flim,
+    read_reflection,
+    read_rheometer_traces,
+)
+
+
+def contact_geometry(mask: np.ndarray, pixel_m: float) -> tuple[tuple[float, float], float]:
+    """Centre (row, col) px of a contact mask and the radius (m) of the circle of its area."""
+    rows, cols = np.nonzero(mask)
+    if rows.size == 0:
+        raise ValueError("the contact mask is empty; expected a contact")
+    radius_m = float(np.sqrt(rows.size / np.pi) * pixel_m)
+    return (float(rows.mean()), float(cols.mean())), radius_m
+
+
+# --- optics ------------------------------------------------------------------------------------
+
+
+def measure_bead(
+    path: str | Path,
+    fallback_pixel_m: float | None,
+    *,
+    profile_radius_m: float,
+    centroid_radius_m: float,
+) -> PsfMeasurement:
+    """PSF FWHM from the bead image ``path`` (amontons.optics.psf.measure_psf)."""
+    image = read_bead(path, fallback_pixel_m)
+    try:
+        return measure_psf(
+            image.data,
+            image.pixel_m,
+            profile_radius_m=profile_radius_m,
+            centroid_radius_m=centroid_radius_m,
+        )
+    except PsfError as error:
+        raise RawDataError(f"{image.path}: {error}") from error
+
+
+def measure_grafting_density(
+    path: str | Path, *, frac: float, n_faces: int, epsilon_m2_per_mol: float
+) -> GraftingDensity:
+    """Grafting density from the spectrum ``path`` (LOWESS maximum over ε·faces)."""
+    wavelength_nm, absorbance = read_absorbance(path)
+    try:
+        return grafting_density(
+            wavelength_nm,
+            absorbance,
+            frac=frac,
+            n_faces=n_faces,
+            epsilon_m2_per_mol=epsilon_m2_per_mol,
+        )
+    except AbsorbanceError as error:
+        raise RawDataError(f"{path}: {error}") from error
+
+
+@dataclass(frozen=True)
+class EdgeGap:
+    """Newton-ring gap at the fluorescent contact edge, with where the edge was found."""
+
+    rings: NewtonRingGap
+    centre_px: tuple[float, float]  # (row, col), from the fluorescence Otsu mask
+    contact_radius_m: float
+    fluorescence_path: Path
+    reflection_path: Path
+
+
+def measure_edge_gap(
+    reflection_path: str | Path,
+    fluorescence_path: str | Path,
+    fallback_pixel_m: float | None,
+    *,
+    otsu_bins: int,
+    n_profiles: int,
+    edge_model: str,
+    max_rings: int | None = None,
+) -> EdgeGap:
+    """Gap at the contact edge from the reflection image (appendix Figs. B.6, B.7).
+
+    The contact centre and edge radius come from the Otsu mask of ``fluorescence_path`` (the
+    image at the reflection load), on the same pixel grid as the reflection image.
+    """
+    fluorescence = read_image(fluorescence_path, fallback_pixel_m)
+    area = otsu_contact_area(fluorescence.data, fluorescence.pixel_m, bins=otsu_bins)
+    try:
+        centre, radius = contact_geometry(area.mask, fluorescence.pixel_m)
+    except ValueError as error:
+        raise RawDataError(f"{fluorescence.path}: {error}") from error
+    reflection = read_reflection(reflection_path, fallback_pixel_m, like=fluorescence)
+    try:
+        rings = newton_ring_gap(
+            reflection.data,
+            reflection.pixel_m,
+            centre,
+            radius,
+            n_profiles,
+            edge_model=edge_model,
+            max_rings=max_rings,
+        )
+    except NewtonRingError as error:
+        raise RawDataError(f"{reflection.path}: {error}") from error
+    return EdgeGap(rings, centre, radius, fluorescence.path, reflection.path)
+
+
+def background_level(image: np.ndarray, mask: np.ndarray, margin_px: int) -> float:
+    """Median counts of the pixels more than ``margin_px`` from the contact mask.
+
+    The margin keeps the PSF's tail around the contact out of the background estimate.
+    """
+    far = ~binary_dilation(mask, iterations=margin_px) if margin_px > 0 else ~mask
+    if far.sum() < 10:
+        raise ValueError(
+            f"only {int(far.sum())} pixels lie more than {margin_px} px from the contact; "
+            "expected a background region around it"
+        )
+    return float(np.median(np.asarray(image, dtype=float)[far]))
+
+
+def measure_intensity_pressure(
+    fluorescence_dir: str | Path,
+    loads_mn: Sequence[float],
+    fallback_pixel_m: float | None,
+    *,
+    otsu_bins: int,
+    background_margin_px: int,
+    pressure_ref_pa: float,
+) -> tuple[IntensityPressure, list[float]]:
+    """Mean contact intensity versus mean contact pressure F/A (appendix Fig. B.4).
+
+    Returns the fit and each image's background (counts, from the pixels far from the mask).
+    """
+    images, masks, backgrounds, pixel = [], [], [], None
+    for path in fluorescence_images(fluorescence_dir, list(loads_mn)):
+        image = read_image(path, fallback_pixel_m)
+        if pixel is not None and abs(image.pixel_m - pixel) > 1e-6 * pixel:
+            raise RawDataError(
+                f"{path}: pixel {image.pixel_m * 1e9:.4g} nm differs from the other images' "
+                f"{pixel * 1e9:.4g} nm; expected one pixel size per sphere"
+            )
+        pixel = image.pixel_m
+        mask = otsu_contact_area(image.data, image.pixel_m, bins=otsu_bins).mask
+        images.append(image.data)
+        masks.append(mask)
+        try:
+            backgrounds.append(background_level(image.data, mask, background_margin_px))
+        except ValueError as error:
+            raise RawDataError(f"{path}: {error}") from error
+    loads_n = [load * 1e-3 for load in loads_mn]
+    result = intensity_pressure(
+        images, masks, loads_n, backgrounds, pixel_m=pixel, pressure_ref_pa=pressure_ref_pa
+    )
+    return result, backgrounds
+
+
+def measure_lifetime(
+    path: str | Path,
+    fallback_pixel_m: float | None,
+    *,
+    otsu_bins: int,
+    exclude_edge_px: int,
+) -> LifetimeStatistics:
+    """Arrival-time statistics inside and outside the contact of the FLIM map ``path``.
+
+    The FLIM map comes from another microscope (appendix Fig. B.3), so its contact mask is
+    found in the map itself: confined molecules emit later, so the contact is the Otsu class of
+    long arrival times.
+    """
+    image = read_flim(path, fallback_pixel_m)
+    try:
+        mask = otsu_contact_area(image.data, image.pixel_m, bins=otsu_bins).mask
+        return lifetime_statistics(image.data, mask, exclude_edge_px=exclude_edge_px)
+    except ValueError as error:
+        raise RawDataError(f"{image.path}: {error}") from error
+
+
+# --- friction ----------------------------------------------------------------------------------
+
+
+def measure_friction(
+    rheometer_dir: str | Path,
+    loads_mn: Sequence[float],
+    *,
+    median_window_s: float,
+    plateau_fraction: float,
+) -> pd.DataFrame:
+    """Friction per load from ``<folder>/rheometer/<load>.csv``; units in the column names."""
+    rows = []
+    for load, trace in zip(
+        loads_mn, read_rheometer_traces(rheometer_dir, list(loads_mn)), strict=True
+    ):
+        try:
+            result = static_friction(
+                trace, median_window_s=median_window_s, plateau_fraction=plateau_fraction
+            )
+        except RheometerError as error:
+            raise RawDataError(str(error)) from error
+        rows.append(
+            {
+                "load_mN": load,
+                "normal_force_mN": result.normal_force_n * 1e3,
+                "static_friction_mN": result.static_friction_n * 1e3,
+                "dynamic_friction_mN": result.dynamic_friction_n * 1e3,
+                "dynamic_friction_se_mN": result.dynamic_friction_se_n * 1e3,
+                "static_coefficient": result.static_coefficient,
+                "dynamic_coefficient": result.dynamic_coefficient,
+                "sliding_speed_um_s": result.sliding_speed_m_s * 1e6,
+                "sliding_distance_um": result.sliding_distance_m * 1e6,
+                "peak_time_s": result.peak_time_s,
+                "rotation_radius_mm": result.rotation_radius_m * 1e3,
+                "file": trace.source,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+# --- per-sphere and per-material tables from measured tables -----------------------------------
+
+
+def hertz_check_table(area_table: pd.DataFrame, radius_m: float, e_star_pa: float) -> pd.DataFrame:
+    """Measured (Otsu) contact radius against Hertz per load, units in the column names.
+
+    Loads with an ill-determined threshold are kept but flagged (column well_separated).
+    """
+    table = hertz_check(
+        area_table["load_mN"].to_numpy() * 1e-3,
+        area_table["area_um2"].to_numpy() * 1e-12,
+        radius_m,
+        e_star_pa,
+    )
+    return pd.DataFrame(
+        {
+            "load_mN": table["load_N"] * 1e3,
+            "area_um2": table["area_m2"] * 1e12,
+            "measured_radius_um": table["measured_radius_m"] * 1e6,
+            "hertz_radius_um": table["hertz_radius_m"] * 1e6,
+            "radius_ratio": table["radius_ratio"],
+            "well_separated": area_table["well_separated"].to_numpy(),
+        }
+    )
+
+
+def amontons_table(
+    spheres: Sequence[str],
+    area_tables: Sequence[pd.DataFrame],
+    friction_tables: Sequence[pd.DataFrame],
+    reference_load_mn: float,
+) -> pd.DataFrame:
+    """Area and static friction per load and sphere, normalised at ``reference_load_mn``
+    (appendix Fig. B.13), from each sphere's contact_area.csv and friction.csv tables.
+
+    Loads whose area is ill-determined (Otsu) are left out. The normal force is the
+    rheometer's measured one.
+    """
+    frames = []
+    for sphere, areas, friction in zip(spheres, area_tables, friction_tables, strict=True):
+        merged = areas[areas["well_separated"]].merge(friction, on="load_mN", how="inner")
+        deviation = amontons_deviation(
+            merged["normal_force_mN"].to_numpy() * 1e-3,
+            merged["area_um2"].to_numpy() * 1e-12,
+            merged["static_friction_mN"].to_numpy() * 1e-3,
+            reference_load_n=reference_load_mn * 1e-3,
+        )
+        # The same reference row as amontons_deviation: the load nearest the reference.
+        reference = int(np.argmin(np.abs(deviation["normal_force_N"] - reference_load_mn * 1e-3)))
+        frames.append(
+            pd.DataFrame(
+                {
+                    "sphere": sphere,
+                    "load_mN": merged.sort_values("normal_force_mN")["load_mN"].to_numpy(),
+                    "normal_force_mN": deviation["normal_force_N"] * 1e3,
+                    "area_um2": deviation["area_m2"] * 1e12,
+                    "static_friction_mN": deviation["static_friction_N"] * 1e3,
+                    "friction_coefficient": deviation["friction_coefficient"],
+                    "shear_strength_MPa": deviation["shear_strength_Pa"] * 1e-6,
+                    "area_over_area_ref": deviation["area_over_area_ref"],
+                    "friction_over_friction_ref": deviation["static_friction_N"]
+                    / deviation["static_friction_N"].iloc[reference],
+                    "mu_over_mu_ref": deviation["mu_over_mu_ref"],
+                }
+            )
+        )
+    return pd.concat(frames, ignore_index=True)

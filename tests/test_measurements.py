@@ -1,0 +1,91 @@
+"""Per-sphere and per-material tables built from measured tables (amontons.measurements)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from amontons.measurements import (
+    amontons_table,
+    background_level,
+    contact_geometry,
+    hertz_check_table,
+)
+
+LOADS_MN = [25.0, 50.0, 100.0, 200.0]
+
+
+def _tables(tau_mpa=20.0, alpha=2 / 3, separated=(True, True, True, True)):
+    """Area ∝ F^alpha and F_s = τ·A exactly, as contact_area.csv and friction.csv hold them."""
+    loads = np.array(LOADS_MN)
+    area_um2 = 400.0 * (loads / 25.0) ** alpha
+    areas = pd.DataFrame(
+        {"load_mN": loads, "area_um2": area_um2, "well_separated": list(separated)}
+    )
+    friction = pd.DataFrame(
+        {
+            "load_mN": loads,
+            "normal_force_mN": loads * 1.001,  # the rheometer's measured force, 0.1 % off
+            "static_friction_mN": tau_mpa * area_um2 * 1e-3,  # MPa·µm² = 1e-6 N = 1e-3 mN
+        }
+    )
+    return areas, friction
+
+
+def test_amontons_table_normalises_at_the_reference_load():
+    areas, friction = _tables()
+    table = amontons_table(["A"], [areas], [friction], 25.0)
+    # F_s = τ·A exactly, so both normalised columns agree to round-off and equal (F/25)^(2/3).
+    np.testing.assert_allclose(table["friction_over_friction_ref"], table["area_over_area_ref"])
+    np.testing.assert_allclose(table["area_over_area_ref"], (np.array(LOADS_MN) / 25) ** (2 / 3))
+    np.testing.assert_allclose(table["shear_strength_MPa"], 20.0)
+    # μ/μ_ref = (F/25)^(−1/3) · (1.001/1.001): the deviation from Amontons' law.
+    np.testing.assert_allclose(table["mu_over_mu_ref"], (np.array(LOADS_MN) / 25) ** (-1 / 3))
+
+
+def test_amontons_table_leaves_out_ill_determined_areas_and_keeps_spheres_apart():
+    areas, friction = _tables(separated=(True, True, False, True))
+    other_areas, other_friction = _tables(tau_mpa=5.0, alpha=0.9)
+    table = amontons_table(["A", "B"], [areas, other_areas], [friction, other_friction], 25.0)
+    assert table.loc[table["sphere"] == "A", "load_mN"].tolist() == [25.0, 50.0, 200.0]
+    assert len(table[table["sphere"] == "B"]) == 4
+
+
+def test_amontons_table_needs_the_reference_load():
+    areas, friction = _tables(separated=(False, True, True, True))
+    with pytest.raises(ValueError, match="no load within 10% of the reference 0.025 N"):
+        amontons_table(["A"], [areas], [friction], 25.0)
+
+
+def test_hertz_check_table_units():
+    # Areas of the Hertz radius itself: ratio 1 to round-off; 4 mm glass at 25 mN, a = 10.456 µm.
+    radius, e_star = 2e-3, 32.8e9
+    a = np.array([(3 * f * 1e-3 * radius / (4 * e_star)) ** (1 / 3) for f in LOADS_MN])
+    areas = pd.DataFrame(
+        {"load_mN": LOADS_MN, "area_um2": np.pi * a**2 * 1e12, "well_separated": True}
+    )
+    table = hertz_check_table(areas, radius, e_star)
+    np.testing.assert_allclose(table["radius_ratio"], 1.0, rtol=1e-12)
+    assert table["hertz_radius_um"].iloc[0] == pytest.approx(10.456, abs=0.001)
+
+
+def test_contact_geometry_of_a_disc():
+    # A disc of radius 20 px centred at (40.0, 50.0): centroid exact by symmetry, equal-area
+    # radius within 1 % of 20 px (pixelation).
+    rows, cols = np.indices((100, 100))
+    mask = np.hypot(rows - 40, cols - 50) <= 20
+    centre, radius = contact_geometry(mask, 200e-9)
+    assert centre == pytest.approx((40.0, 50.0), abs=1e-9)
+    assert radius == pytest.approx(20 * 200e-9, rel=0.01)
+    with pytest.raises(ValueError, match="contact mask is empty"):
+        contact_geometry(np.zeros((4, 4), bool), 200e-9)
+
+
+def test_background_level_ignores_the_contact_and_its_halo():
+    rows, cols = np.indices((100, 100))
+    mask = np.hypot(rows - 50, cols - 50) <= 20
+    image = np.full((100, 100), 120.0)
+    image[mask] = 1500.0
+    image[np.hypot(rows - 50, cols - 50) <= 23] += 300.0  # PSF halo just outside the mask
+    assert background_level(image, mask, margin_px=5) == 120.0
+    with pytest.raises(ValueError, match="expected a background region"):
+        background_level(image, np.ones((100, 100), bool), margin_px=5)
