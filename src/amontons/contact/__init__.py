@@ -17,12 +17,15 @@ Sign convention
 
 Public API
 ----------
-``solve``, ``solve_load_series``, ``ContactResult`` and the exceptions
+``solve``, ``solve_load_series``, ``ContactResult``, the plasticity laws
+``PenetrationHardness`` and ``ContactHardening`` (:mod:`amontons.contact.plasticity`)
+and the exceptions
 ``ContactInputError``, ``ConvergenceError``, ``FreeBoundaryError``; surface synthesis in
 :mod:`amontons.contact.surfaces`.
 """
 
 from .api import solve, solve_load_series
+from .plasticity import ContactHardening, PenetrationHardness
 from .result import (
     ContactError,
     ContactInputError,
@@ -34,10 +37,12 @@ from .surfaces import self_affine, sphere
 
 __all__ = [
     "ContactError",
+    "ContactHardening",
     "ContactInputError",
     "ContactResult",
     "ConvergenceError",
     "FreeBoundaryError",
+    "PenetrationHardness",
     "self_affine",
     "solve",
     "solve_load_series",

@@ -10,6 +10,7 @@ import numpy as np
 
 from .cg import polonsky_keer
 from .convolution import get_operator
+from .plasticity import ContactHardening, PenetrationHardness, solve_plastic
 from .result import ContactInputError, ContactResult, ConvergenceError, FreeBoundaryError
 
 # Coarse levels stop at this many pixels along the shorter side: below it a solve costs
@@ -141,6 +142,10 @@ def solve(
     warm_start=None,
     coarse_to_fine=False,
     backend=None,
+    plasticity=None,
+    plastic_displacement=None,
+    iterative=False,
+    max_outer=200,
 ) -> ContactResult:
     """Solve the frictionless contact of a rigid rough indenter on an elastic half-space.
 
@@ -173,6 +178,17 @@ def solve(
         (ignored when ``warm_start`` is given or the shape is odd).
     backend : {"pyfftw", "numpy", None}
         FFT backend; None picks pyfftw when importable.
+    plasticity : PenetrationHardness or ContactHardening, optional
+        Plasticity law of appendix B.2.3 (None: purely elastic). The result's
+        ``plastic_displacement`` is then the plastic displacement of the indenter (m, <= 0
+        where material flowed) and ``deformed_heights`` is h + h_pl.
+    plastic_displacement : array_like, optional
+        Plastic displacement left by earlier loading, m (the history of a load series).
+    iterative : bool
+        Contact hardening with local increments: force the appendix's iterative scheme
+        instead of the exact elastic-plus-Winkler route (used as the test oracle).
+    max_outer : int
+        Cap on the outer (plastic-update or active-set) iterations of a plastic solve.
 
     Returns
     -------
@@ -214,6 +230,29 @@ def solve(
         raise ContactInputError(f"threads must be >= 1, got {threads}")
     if warm_start is not None:
         warm_start = _check_warm_start(warm_start, h.shape)
+    if plasticity is not None:
+        return _solve_plastic(
+            h,
+            spacing,
+            e_star,
+            _check_law(plasticity),
+            load=load,
+            displacement=displacement,
+            plastic_prev=_check_plastic_history(plastic_displacement, h.shape),
+            periodic=bool(periodic),
+            tol=tol,
+            max_iter=_default_max_iter(h.shape) if max_iter is None else int(max_iter),
+            backend=backend,
+            threads=threads,
+            warm_start=warm_start,
+            iterative=bool(iterative),
+            max_outer=_check_count("max_outer", max_outer),
+        )
+    if plastic_displacement is not None:
+        raise ContactInputError(
+            "plastic_displacement was given without a plasticity law; pass plasticity="
+            "PenetrationHardness(...) or ContactHardening(...)"
+        )
     return _solve(
         h,
         spacing,
@@ -287,19 +326,7 @@ def _solve(
     contact = p > 0
     total = float(p.sum()) * spacing**2
     if check_boundary and not periodic:
-        edge = np.zeros_like(contact)
-        edge[0, :] = edge[-1, :] = edge[:, 0] = edge[:, -1] = True
-        on_edge = contact & edge
-        n_edge = int(on_edge.sum())
-        if n_edge:
-            f_edge = float(p[on_edge].sum()) * spacing**2
-            raise FreeBoundaryError(
-                f"contact reaches the window edge: {n_edge} edge pixel(s) carry "
-                f"{f_edge:.3e} N of {total:.3e} N; the non-periodic solution is only valid "
-                "if the pressure vanishes at the edge - enlarge the window or lower the load",
-                edge_pixels=n_edge,
-                edge_force=f_edge,
-            )
+        _check_free_boundary(p, contact, spacing)
     info = {
         "convolutions": out.convolutions,
         "steepest_descent_resets": out.info["steepest_descent_resets"],
@@ -323,6 +350,133 @@ def _solve(
         residual_history=out.history,
         converged=out.converged,
         periodic=periodic,
+        heights=h,
+        info=info,
+    )
+
+
+def _check_free_boundary(p, contact, spacing):
+    """Raise FreeBoundaryError when pressure reaches the outermost ring of the window."""
+    edge = np.zeros_like(contact)
+    edge[0, :] = edge[-1, :] = edge[:, 0] = edge[:, -1] = True
+    on_edge = contact & edge
+    n_edge = int(on_edge.sum())
+    if n_edge:
+        total = float(p.sum()) * spacing**2
+        f_edge = float(p[on_edge].sum()) * spacing**2
+        raise FreeBoundaryError(
+            f"contact reaches the window edge: {n_edge} edge pixel(s) carry "
+            f"{f_edge:.3e} N of {total:.3e} N; the non-periodic solution is only valid "
+            "if the pressure vanishes at the edge - enlarge the window or lower the load",
+            edge_pixels=n_edge,
+            edge_force=f_edge,
+        )
+
+
+def _check_law(law):
+    if not isinstance(law, PenetrationHardness | ContactHardening):
+        raise ContactInputError(
+            f"plasticity must be PenetrationHardness(p_y) or ContactHardening(k), got {law!r}"
+        )
+    return law
+
+
+def _check_plastic_history(plastic, shape):
+    if plastic is None:
+        return np.zeros(shape)
+    h_pl = np.asarray(plastic, dtype=np.float64)
+    if h_pl.shape != shape:
+        raise ContactInputError(
+            f"plastic_displacement must have the shape of heights {shape}, got {h_pl.shape}"
+        )
+    if not np.isfinite(h_pl).all():
+        raise ContactInputError("plastic_displacement contains NaN or inf; expected metres")
+    return h_pl
+
+
+def _check_count(name, value):
+    if int(value) != value or value < 1:
+        raise ContactInputError(f"{name} must be a positive integer, got {value!r}")
+    return int(value)
+
+
+def _solve_plastic(
+    h,
+    spacing,
+    e_star,
+    law,
+    *,
+    load,
+    displacement,
+    plastic_prev,
+    periodic,
+    tol,
+    max_iter,
+    backend,
+    threads,
+    warm_start,
+    iterative,
+    max_outer,
+):
+    t0 = time.perf_counter()
+    op = get_operator(h.shape, spacing, e_star, periodic=periodic, backend=backend, threads=threads)
+    p_init = warm_start
+    if p_init is None:
+        if load is not None:
+            p_init = np.ones_like(h)
+        else:
+            p_init = _initial_pressure(h + plastic_prev, spacing, e_star, displacement)
+    state = solve_plastic(
+        op,
+        h,
+        spacing,
+        law,
+        load=load,
+        displacement=displacement,
+        plastic_prev=plastic_prev,
+        p_init=p_init,
+        periodic=periodic,
+        tol=tol,
+        max_iter=max_iter,
+        max_outer=max_outer,
+        iterative=iterative,
+    )
+    p = state.pressure
+    if not (np.isfinite(p).all() and np.isfinite(state.gap).all()):
+        raise ConvergenceError(
+            "plastic solve produced non-finite pressure or gap (NaN/inf)",
+            iterations=state.iterations,
+            residual=state.residual,
+            tol=tol,
+            residual_history=state.history,
+        )
+    contact = p > 0
+    if not periodic:
+        _check_free_boundary(p, contact, spacing)
+    info = {
+        "convolutions": state.convolutions,
+        "outer_iterations": state.outer_iterations,
+        "plasticity": law,
+        "backend": op.backend,
+        "threads": threads,
+        "tol": tol,
+        "wall_time_s": time.perf_counter() - t0,
+    }
+    return ContactResult(
+        pressure=p,
+        gap=state.gap,
+        elastic_displacement=state.elastic_displacement,
+        plastic_displacement=state.plastic_displacement,
+        contact=contact,
+        load=float(p.sum()) * spacing**2,
+        displacement=state.displacement,
+        spacing=spacing,
+        iterations=state.iterations,
+        residual=state.residual,
+        residual_history=state.history,
+        converged=state.converged,
+        periodic=periodic,
+        heights=h,
         info=info,
     )
 
@@ -339,6 +493,8 @@ def solve_load_series(
     threads=1,
     coarse_to_fine=False,
     backend=None,
+    plasticity=None,
+    max_outer=200,
 ) -> list[ContactResult]:
     """Solve for increasing loads, each step warm-started from the previous pressure.
 
@@ -349,7 +505,13 @@ def solve_load_series(
     loads : sequence of float
         Total forces, N; strictly increasing and positive.
     coarse_to_fine : bool
-        Coarse-to-fine start for the first load only (later loads are warm-started).
+        Coarse-to-fine start for the first load only (later loads are warm-started;
+        ignored with plasticity).
+    plasticity : PenetrationHardness or ContactHardening, optional
+        Plasticity law; each load step starts from the plastic displacement and the
+        pressure of the previous one, so the series carries the plastic history.
+    max_outer : int
+        As in :func:`solve`.
 
     Returns
     -------
@@ -377,8 +539,13 @@ def solve_load_series(
             max_iter=max_iter,
             threads=threads,
             warm_start=start,
-            coarse_to_fine=coarse_to_fine and i == 0,
+            coarse_to_fine=coarse_to_fine and i == 0 and plasticity is None,
             backend=backend,
+            plasticity=plasticity,
+            plastic_displacement=None
+            if prev is None or plasticity is None
+            else prev.plastic_displacement,
+            max_outer=max_outer,
         )
         results.append(res)
         prev = res

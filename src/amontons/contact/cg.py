@@ -143,7 +143,11 @@ class BoundedWall(HardWall):
         cand = np.flatnonzero(m == 0.0)
         gc, pc = g[cand], p[cand]
         upper = self.p_max if np.isscalar(self.p_max) else self.p_max[cand]
-        return cand[((pc <= 0.0) & (gc < 0.0)) | ((pc >= upper) & (gc > 0.0))]
+        # unloaded and penetrating, with room to rise (p_max = 0 pins the point at 0), or
+        # at the bound, open, with room to fall
+        rise = (pc <= 0.0) & (gc < 0.0) & (pc < upper)
+        fall = (pc >= upper) & (gc > 0.0) & (pc > 0.0)
+        return cand[rise | fall]
 
 
 _EMPTY = np.empty(0, dtype=np.intp)
@@ -286,18 +290,21 @@ def polonsky_keer(
         np.subtract(u, h, out=g)
         if nc == 0:
             # only possible in displacement control (load control keeps Σp = W > 0):
-            # start the free set from the penetrating points
+            # start the free set from the points the constraint says should be free
+            # (penetrating and unloaded; with a bound, also open points at the bound -
+            # those at the bound that penetrate are where they belong)
             g -= d
-            np.less(g, 0.0, out=bwork)
-            nc = int(np.count_nonzero(bwork))
+            m[:] = 0.0
+            start = constraint.violators(p, g, m)
+            nc = int(start.size)
             if nc == 0:
-                p[:] = 0.0
+                # every point is at a bound or open and unloaded: already the solution
                 residual = 0.0
                 history.append(0.0)
                 converged = True
                 since_fresh = 1  # recompute u below
                 break
-            np.copyto(m, bwork)
+            m[start] = 1.0
         elif load_control:
             # rigid-body approach = mean of (u - h) over the contact set (Lagrange mult.)
             d = float(np.dot(g, m)) / nc

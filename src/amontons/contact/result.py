@@ -107,6 +107,8 @@ class ContactResult:
         True when ``residual < tol``.
     periodic : bool
         Whether the problem was solved with periodic boundary conditions.
+    heights : ndarray, optional
+        The undeformed indenter heights h that were solved for, m.
     info : dict
         Further diagnostics (convolutions performed, coarse levels, ...).
     """
@@ -124,7 +126,16 @@ class ContactResult:
     residual_history: np.ndarray
     converged: bool
     periodic: bool
+    heights: np.ndarray | None = field(default=None, compare=False)
     info: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def deformed_heights(self) -> np.ndarray:
+        """Indenter topography after plastic flow, h + h_pl, m (what an AFM scan after
+        unloading sees, up to the sign convention of the heights)."""
+        if self.heights is None:
+            raise AttributeError("this result does not carry the heights it was solved for")
+        return self.heights + self.plastic_displacement
 
     @property
     def area(self) -> float:

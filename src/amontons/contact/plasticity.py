@@ -1,0 +1,450 @@
+"""Plasticity laws of appendix B.2.3 on top of the Polonsky–Keer solver.
+
+Two laws, each with local (eq. B.2) or volume-conserving (eq. B.3) plastic increments:
+
+* :class:`PenetrationHardness`: the pressure is bounded by p_Y (scalar or per pixel). A bounded
+  CG (0 ≤ p ≤ p_Y) gives the elastic field; where p = p_Y the gap is negative and the indenter
+  is lowered by α·Δh_pl; repeat until the gap is non-negative everywhere.
+* :class:`ContactHardening`: p_Y = k·|h_pl| per pixel, so an untouched point yields at once.
+
+Routes (science.md §2.3). Under monotonic loading every contact point of the hardening law sits
+on its yield surface, p = k·|h_pl|, so the converged state is an elastic half-space plus a
+Winkler layer of stiffness k: (K + I/k) p = h + d on the contact set. That linear
+complementarity problem is solved directly, with one extension that keeps it exact when a
+point unloads under a later load: the plastic displacement of earlier steps is a floor, so each
+point either flows (Winkler, on the undeformed heights) or stays elastic on its earlier
+deformation; an active-set loop picks which (it is the convex problem with dissipation
+potential φ'(p) = max(|h_pl,prev|, p/k)). This is the product route for local increments; the
+appendix's iterative scheme (bounded CG, gap, increment, repeat) is kept for volume-conserving
+increments — where pile-up breaks the Winkler picture — and as the test oracle.
+
+Load control of the iterative schemes is a root find on the rigid-body approach (the load is a
+continuous, non-decreasing function of it), each trial starting from the previous step's
+plastic state.
+
+SI units: heights, gaps, plastic displacement in m; pressures and p_Y in Pa; k in Pa/m.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from scipy import optimize
+
+from .cg import BoundedWall, polonsky_keer
+from .plastic_increments import local_increment, volume_conserving_increment
+from .result import ContactInputError, ConvergenceError
+
+Increment = Literal["local", "volume"]
+
+
+def _check_increment(increment: str, alpha: float) -> None:
+    if increment not in ("local", "volume"):
+        raise ContactInputError(
+            f"increment must be 'local' (eq. B.2) or 'volume' (eq. B.3), got {increment!r}"
+        )
+    if not 0 < alpha <= 1:
+        raise ContactInputError(f"over-relaxation alpha must be in (0, 1], got {alpha!r}")
+    if increment == "volume" and alpha == 1:
+        raise ContactInputError(
+            "volume-conserving increments (eq. B.3) need over-relaxation alpha < 1; got 1"
+        )
+
+
+@dataclass(frozen=True)
+class PenetrationHardness:
+    """Pressure bounded by the penetration hardness ``p_y`` (Pa; scalar or per-pixel array)."""
+
+    p_y: float | np.ndarray
+    increment: Increment = "local"
+    alpha: float = 1.0
+
+    def __post_init__(self):
+        p_y = np.asarray(self.p_y, dtype=float)
+        if not np.all(np.isfinite(p_y)) or np.any(p_y <= 0):
+            raise ContactInputError(f"p_y must be finite and > 0 (Pa), got min {p_y.min():.3e}")
+        _check_increment(self.increment, self.alpha)
+
+
+@dataclass(frozen=True)
+class ContactHardening:
+    """Local hardening p_Y = k·|h_pl| with hardening coefficient ``k`` in Pa/m.
+
+    (The appendix's k ≈ 7 MPa/nm for PMMA is 7e15 Pa/m.)
+    """
+
+    k: float
+    increment: Increment = "local"
+    alpha: float = 1.0
+
+    def __post_init__(self):
+        if not (np.isfinite(self.k) and self.k > 0):
+            raise ContactInputError(f"k must be finite and > 0 (Pa/m), got {self.k!r}")
+        _check_increment(self.increment, self.alpha)
+
+
+@dataclass
+class PlasticState:
+    """Converged state of one load step (arrays on the solver grid)."""
+
+    pressure: np.ndarray
+    gap: np.ndarray
+    elastic_displacement: np.ndarray
+    plastic_displacement: np.ndarray
+    displacement: float
+    iterations: int
+    residual: float
+    history: np.ndarray
+    converged: bool
+    convolutions: int
+    outer_iterations: int
+
+
+def _increment(gap, increment: Increment, periodic: bool):
+    if increment == "local":
+        return local_increment(gap)
+    return volume_conserving_increment(gap, periodic)
+
+
+def _plastic_iteration(
+    operator,
+    heights,
+    pixel_area,
+    h_scale,
+    bound,
+    plastic_prev,
+    displacement,
+    *,
+    increment,
+    alpha,
+    periodic,
+    p_init,
+    tol,
+    max_iter,
+    max_outer,
+):
+    """Appendix scheme at a fixed approach: bounded CG on h + h_pl, then h_pl += α·Δh_pl,
+    until no yielding point penetrates by more than tol·h_scale. ``bound(h_pl)`` gives
+    p_max per pixel (Pa)."""
+    h_pl = plastic_prev.copy()
+    p = p_init
+    iterations = convolutions = 0
+    history = []
+    for outer in range(1, max_outer + 1):
+        p_max = bound(h_pl)
+        out = polonsky_keer(
+            operator,
+            heights + h_pl,
+            pixel_area=pixel_area,
+            h_scale=h_scale,
+            p_init=p,
+            displacement=displacement,
+            tol=tol,
+            max_iter=max_iter,
+            constraint=BoundedWall(p_max),
+        )
+        p = out.pressure
+        iterations += out.iterations
+        convolutions += out.convolutions
+        history.extend(out.history)
+        # Only points at the bound yield (appendix: "where p = p_Y the material deforms
+        # plastically"); a free point's gap is the elastic solver's residual, not flow.
+        yielding = np.where((p >= p_max) & (out.gap < 0.0), out.gap, 0.0)
+        worst = float(-yielding.min())
+        if worst <= tol * h_scale:
+            return PlasticState(
+                pressure=p,
+                gap=out.gap,
+                elastic_displacement=out.displacement_field,
+                plastic_displacement=h_pl,
+                displacement=displacement,
+                iterations=iterations,
+                residual=max(out.residual, worst / h_scale),
+                history=np.asarray(history),
+                converged=True,
+                convolutions=convolutions,
+                outer_iterations=outer,
+            )
+        h_pl = h_pl + alpha * _increment(yielding, increment, periodic)
+    raise ConvergenceError(
+        f"plastic iteration did not make the gap non-negative in {max_outer} updates: worst "
+        f"penetration {worst:.3e} m > {tol * h_scale:.3e} m (alpha={alpha}, {increment} "
+        "increments); lower alpha or raise max_outer",
+        iterations=iterations,
+        residual=worst / h_scale,
+        tol=tol,
+        residual_history=np.asarray(history),
+    )
+
+
+class _Found(Exception):
+    def __init__(self, state):
+        self.state = state
+
+
+def _find_approach(evaluate, load, d_guess, d_step, load_tol):
+    """The state at the root of load(d) = ``load``, for a continuous non-decreasing load(d).
+
+    ``evaluate(d)`` returns (load, state). Brackets by doubling steps from ``d_guess``, then
+    Brent's method (scipy), stopping early once the load is within ``load_tol`` (relative).
+    Where load(d) is nearly a staircase (a fully plastic contact: one more pixel, p_Y·Δx² more
+    load), the closest state found is returned and its load differs from ``load`` by less
+    than one pixel's worth.
+    """
+    best = {"err": np.inf, "state": None}
+
+    def residual(d):
+        f, state = evaluate(d)
+        err = abs(f - load)
+        if err < best["err"]:
+            best.update(err=err, state=state)
+        if err <= load_tol * load:
+            raise _Found(state)
+        return f - load
+
+    try:
+        d_lo = d_hi = d_guess
+        f0 = residual(d_guess)
+        step = d_step
+        if f0 < 0:
+            d_hi = d_guess + step
+            while residual(d_hi) < 0:
+                d_lo, step = d_hi, 2 * step
+                d_hi = d_hi + step
+        else:
+            d_lo = d_guess - step
+            while residual(d_lo) >= 0:
+                d_hi, step = d_lo, 2 * step
+                d_lo = d_lo - step
+        optimize.brentq(residual, d_lo, d_hi, xtol=1e-13 * d_step, rtol=1e-15, maxiter=200)
+    except _Found as found:
+        return found.state
+    return best["state"]
+
+
+class _WinklerOperator:
+    """K·x + x/k on the flowing set: the elastic half-space plus a Winkler layer."""
+
+    def __init__(self, operator, compliance: np.ndarray):
+        self.operator = operator
+        self.compliance = compliance
+
+    def __call__(self, x, out):
+        self.operator(x, out=out)
+        out += self.compliance * x
+        return out
+
+
+def _hardening_winkler(
+    operator,
+    heights,
+    pixel_area,
+    h_scale,
+    k,
+    plastic_prev,
+    *,
+    load,
+    displacement,
+    p_init,
+    tol,
+    max_iter,
+    max_rounds=50,
+):
+    """Contact hardening with local increments, exact for any load history (module doc)."""
+    floor = np.maximum(-plastic_prev, 0.0)  # plastic depth already reached, m
+    flowing = np.ones(heights.shape, dtype=bool)
+    p = p_init
+    iterations = convolutions = 0
+    history = []
+    for rounds in range(1, max_rounds + 1):  # noqa: B007 (reported after the loop)
+        compliance = np.where(flowing, 1.0 / k, 0.0)
+        effective = np.where(flowing, heights, heights - floor)
+        out = polonsky_keer(
+            _WinklerOperator(operator, compliance),
+            effective,
+            pixel_area=pixel_area,
+            h_scale=h_scale,
+            p_init=p,
+            load=load,
+            displacement=displacement,
+            tol=tol,
+            max_iter=max_iter,
+        )
+        p = out.pressure
+        iterations += out.iterations
+        convolutions += out.convolutions
+        history.extend(out.history)
+        now_flowing = (p > k * floor) | (floor == 0)
+        if np.array_equal(now_flowing, flowing):
+            break
+        flowing = now_flowing
+    else:
+        raise ConvergenceError(
+            f"hardening active set did not settle in {max_rounds} rounds "
+            f"({int(np.count_nonzero(now_flowing != flowing))} pixels still switching)",
+            iterations=iterations,
+            residual=out.residual,
+            tol=tol,
+            residual_history=np.asarray(history),
+        )
+    depth = np.where(flowing & (p > 0), np.maximum(p / k, floor), floor)
+    plastic = -depth
+    elastic = out.displacement_field - compliance * p
+    gap = elastic - (heights + plastic) - out.rigid_displacement
+    return PlasticState(
+        pressure=p,
+        gap=gap,
+        elastic_displacement=elastic,
+        plastic_displacement=plastic,
+        displacement=out.rigid_displacement,
+        iterations=iterations,
+        residual=out.residual,
+        history=np.asarray(history),
+        converged=out.converged,
+        convolutions=convolutions,
+        outer_iterations=rounds,
+    )
+
+
+def solve_plastic(
+    operator,
+    heights,
+    spacing,
+    law,
+    *,
+    load=None,
+    displacement=None,
+    plastic_prev,
+    p_init,
+    periodic,
+    tol,
+    max_iter,
+    max_outer=200,
+    iterative=False,
+):
+    """One load step of a plasticity law, starting from the plastic state ``plastic_prev``.
+
+    ``iterative=True`` forces the appendix scheme for contact hardening with local increments
+    (the oracle); otherwise that case takes the exact Winkler route.
+    """
+    pixel_area = spacing**2
+    h_scale = float(np.std(heights)) or spacing
+    if (
+        isinstance(law, ContactHardening)
+        and law.alpha == 1
+        and (iterative or law.increment != "local")
+    ):
+        # with p_Y = k|h_pl| and α = 1 the first update closes every gap at zero pressure,
+        # a fixed point of the scheme that is not the hardening state
+        raise ContactInputError(
+            "the iterative contact-hardening scheme needs over-relaxation alpha < 1; got 1"
+        )
+    if isinstance(law, ContactHardening) and law.increment == "local" and not iterative:
+        return _hardening_winkler(
+            operator,
+            heights,
+            pixel_area,
+            h_scale,
+            law.k,
+            plastic_prev,
+            load=load,
+            displacement=displacement,
+            p_init=p_init,
+            tol=tol,
+            max_iter=max_iter,
+        )
+    if isinstance(law, PenetrationHardness):
+        p_y = np.broadcast_to(np.asarray(law.p_y, dtype=float), heights.shape)
+
+        def bound(h_pl):
+            return p_y
+    else:
+
+        def bound(h_pl):
+            # pile-up (h_pl > 0) has not yielded in compression: no hardness there
+            return law.k * np.maximum(-h_pl, 0.0)
+
+    def at(d, p_start):
+        return _plastic_iteration(
+            operator,
+            heights,
+            pixel_area,
+            h_scale,
+            bound,
+            plastic_prev,
+            d,
+            increment=law.increment,
+            alpha=law.alpha,
+            periodic=periodic,
+            p_init=p_start,
+            tol=tol,
+            max_iter=max_iter,
+            max_outer=max_outer,
+        )
+
+    if displacement is not None:
+        return at(float(displacement), p_init)
+    last = {"p": p_init}
+
+    def evaluate(d):
+        state = at(d, last["p"])
+        last["p"] = state.pressure
+        return float(state.pressure.sum()) * pixel_area, state
+
+    span = float(np.ptp(heights)) or spacing
+    if isinstance(law, ContactHardening):
+        # the Winkler state is exact for local increments and close for volume-conserving ones
+        d_guess = _hardening_winkler(
+            operator,
+            heights,
+            pixel_area,
+            h_scale,
+            law.k,
+            plastic_prev,
+            load=load,
+            displacement=None,
+            p_init=p_init,
+            tol=tol,
+            max_iter=max_iter,
+        ).displacement
+    else:
+        elastic = polonsky_keer(
+            operator,
+            heights + plastic_prev,
+            pixel_area=pixel_area,
+            h_scale=h_scale,
+            p_init=p_init,
+            load=load,
+            tol=tol,
+            max_iter=max_iter,
+        )
+        if np.all(elastic.pressure <= bound(plastic_prev)):
+            # the bound is never reached: the elastic solution is the answer
+            return _elastic_state(elastic, plastic_prev)
+        last["p"] = np.minimum(elastic.pressure, bound(plastic_prev))
+        # plasticity softens the contact, so the approach is at least the elastic one; when
+        # fully plastic it is about the rigid overlap that carries the load at the hardness
+        p_mean = float(np.mean(bound(plastic_prev)))
+        target_pixels = min(heights.size, max(1, int(load / (pixel_area * p_mean))))
+        d_bearing = -float(np.sort((heights + plastic_prev).ravel())[::-1][target_pixels - 1])
+        d_guess = max(elastic.rigid_displacement, d_bearing)
+    return _find_approach(evaluate, load, d_guess, 1e-3 * span, load_tol=tol)
+
+
+def _elastic_state(out, plastic_prev):
+    """A PK outcome that never reached the bound, as the state of a plastic step."""
+    return PlasticState(
+        pressure=out.pressure,
+        gap=out.gap,
+        elastic_displacement=out.displacement_field,
+        plastic_displacement=plastic_prev.copy(),
+        displacement=out.rigid_displacement,
+        iterations=out.iterations,
+        residual=out.residual,
+        history=out.history,
+        converged=out.converged,
+        convolutions=out.convolutions,
+        outer_iterations=0,
+    )
