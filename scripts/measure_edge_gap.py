@@ -4,8 +4,8 @@ import json
 import logging
 
 from amontons.images import atomic_path
-from amontons.measurements import measure_edge_gap
-from amontons.plots import plot_edge_gap
+from amontons.measurements import RingsUnreadable, measure_edge_gap
+from amontons.plots import plot_edge_gap, plot_unmeasured
 from amontons.rawdata import fluorescence_image
 from amontons.runlog import run_logged
 
@@ -26,15 +26,30 @@ def main(
     data_label: str,
     sphere: str,
 ) -> None:
-    result = measure_edge_gap(
-        reflection_path,
-        fluorescence_image(fluorescence_dir, reflection_load_mn),
-        pixel_nm * 1e-9,
-        otsu_bins=otsu_bins,
-        n_profiles=n_profiles,
-        edge_model=edge_model,
-        max_rings=max_rings,
-    )
+    title = f"{sphere}: Newton-ring gap at {reflection_load_mn:g} mN ({data_label})"
+    try:
+        result = measure_edge_gap(
+            reflection_path,
+            fluorescence_image(fluorescence_dir, reflection_load_mn),
+            pixel_nm * 1e-9,
+            otsu_bins=otsu_bins,
+            n_profiles=n_profiles,
+            edge_model=edge_model,
+            max_rings=max_rings,
+        )
+    except RingsUnreadable as error:
+        # A rough sphere scatters its rings: the gap is not measurable, and the result says
+        # so (a flagged null, never a number), so the other spheres' analysis goes on.
+        log.warning("edge gap not measurable: %s", error)
+        with atomic_path(gap_path) as tmp:
+            tmp.write_text(
+                json.dumps(
+                    {"edge_gap_nm": None, "flag": str(error), "load_mN": reflection_load_mn},
+                    indent=2,
+                )
+            )
+        plot_unmeasured(str(error), title, figure_paths)
+        return
     rings = result.rings
     summary = {
         "quantity": "gap at the fluorescent contact edge from Newton rings, d = (m + 1/2) λ/2n, "
@@ -48,6 +63,14 @@ def main(
         "profile_angles_deg": [float(a) for a in rings.angles_rad * 180 / 3.141592653589793],
         "first_ring_gap_nm": rings.first_ring_gap_m * 1e9,
         "rings_per_half_profile": [int(p.ring_r_m.size) for p in rings.half_profiles],
+        # profiles without usable rings (roughness scatters them) are left out, not hidden
+        "rejected_half_profiles": list(rings.rejected),
+        "flag": (
+            f"{len(rings.rejected)} of {len(rings.rejected) + rings.edge_gaps_m.size} "
+            "half-profiles refused; see rejected_half_profiles"
+            if rings.rejected
+            else None
+        ),
         "contact_radius_um": result.contact_radius_m * 1e6,
         "contact_centre_px": list(result.centre_px),
         "load_mN": reflection_load_mn,
@@ -68,7 +91,7 @@ def main(
         [p.ring_gap_m * 1e9 for p in rings.half_profiles],
         result.contact_radius_m * 1e6,
         rings.edge_gaps_m * 1e9,
-        f"{sphere}: Newton-ring gap at {reflection_load_mn:g} mN ({data_label})",
+        title,
         figure_paths,
     )
 

@@ -104,7 +104,7 @@ def test_reflection_without_rings_names_the_file(tmp_path):
         tmp_path / "25.tif", rng.poisson(np.where(contact, 1500, 120)).astype(np.uint16), PIXEL
     )
     write_image(tmp_path / "reflection.tif", rng.poisson(400, (128, 128)).astype(np.uint16), PIXEL)
-    with pytest.raises(RawDataError, match=r"reflection\.tif: profile at .*ring maxima"):
+    with pytest.raises(RawDataError, match=r"reflection\.tif: .*profile at .*ring maxima"):
         measure_edge_gap(
             tmp_path / "reflection.tif",
             tmp_path / "25.tif",

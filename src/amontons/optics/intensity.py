@@ -1,9 +1,13 @@
 """Mean contact intensity versus mean contact pressure (appendix Fig. B.4).
 
 Per load: the mean contact pressure is F/A with A the area of the contact mask (Otsu), and
-the mean contact intensity is the background-subtracted intensity summed over the mask,
-divided by its pixel count. The appendix finds intensity ∝ √pressure; the exponent comes
-from a log–log OLS fit (amontons.powerlaw.fit_power_law).
+the mean contact intensity is, as the appendix defines it (Fig. B.4), the total
+background-subtracted intensity divided by the same area. "Total" is summed over the mask
+dilated by ``margin_px``: the PSF spreads a patchy contact's light beyond its Otsu mask (a
+share that shrinks as the contact grows, which biased a mask-only mean by +0.1 in the
+exponent on the rough virtual spheres), while the pixels beyond the margin are background.
+The appendix finds intensity ∝ √pressure; the exponent comes from a log–log OLS fit
+(amontons.powerlaw.fit_power_law).
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from scipy.ndimage import binary_dilation
 
 from amontons.powerlaw import PowerLawFit, fit_power_law
 
@@ -25,9 +30,13 @@ class IntensityPressure:
     fit: PowerLawFit
 
 
-def mean_contact_intensity(image: np.ndarray, mask: np.ndarray, background: float) -> float:
-    """Mean background-subtracted counts over the mask's pixels."""
-    return float(np.asarray(image, dtype=float)[mask].mean() - background)
+def mean_contact_intensity(
+    image: np.ndarray, mask: np.ndarray, background: float, margin_px: int
+) -> float:
+    """Background-subtracted counts summed over the mask dilated by ``margin_px``, per mask
+    pixel (counts)."""
+    region = binary_dilation(mask, iterations=margin_px) if margin_px > 0 else mask
+    return float((np.asarray(image, dtype=float)[region] - background).sum() / mask.sum())
 
 
 def intensity_pressure(
@@ -37,6 +46,7 @@ def intensity_pressure(
     background: float | Sequence[float],
     *,
     pixel_m: float,
+    margin_px: int = 5,
     pressure_ref_pa: float = 1e8,
 ) -> IntensityPressure:
     """Mean contact intensity (counts) vs mean contact pressure (Pa) and its exponent.
@@ -60,7 +70,7 @@ def intensity_pressure(
         n_pixels = int(mask.sum())
         if n_pixels == 0:
             raise ValueError(f"load {load:g} N: the contact mask is empty; expected a contact")
-        intensity = mean_contact_intensity(image, mask, level)
+        intensity = mean_contact_intensity(image, mask, level, margin_px)
         if not intensity > 0:
             raise ValueError(
                 f"load {load:g} N: mean contact intensity {intensity:.3g} counts is not above "

@@ -39,6 +39,15 @@ class NewtonRingError(ValueError):
     """A reflection image from which no gap profile can be read."""
 
 
+# A missed ring on a few half-profiles is local (roughness scatters a ring); on more than
+# this fraction of them it is the image's ring sequence that cannot be numbered.
+MAX_MISSED_FRACTION = 0.25
+
+
+class MissedRingError(NewtonRingError):
+    """A half-profile whose ring spacing says a ring was not detected."""
+
+
 @dataclass(frozen=True)
 class HalfProfile:
     """Rings along one ray from the contact centre."""
@@ -61,6 +70,8 @@ class NewtonRingGap:
     contact_radius_m: float
     edge_model: str
     half_profiles: tuple[HalfProfile, ...]
+    # half-profiles left out, each with its reason (a rough sphere scatters its rings)
+    rejected: tuple[str, ...] = ()
 
 
 def hertz_exterior_shape(r_m: np.ndarray, edge_radius_m: float) -> np.ndarray:
@@ -142,7 +153,7 @@ def _check_spacing(ring_r_m: np.ndarray, degrees: float, max_ratio: float) -> No
     ratios = spacing[:-1] / spacing[1:]
     worst = int(np.argmax(ratios))
     if ratios[worst] > max_ratio:
-        raise NewtonRingError(
+        raise MissedRingError(
             f"profile at {degrees:.1f}°: rings at {ring_r_m[worst]:.3g} and "
             f"{ring_r_m[worst + 1]:.3g} m are {ratios[worst]:.2f} × further apart than the next "
             f"pair (expected ≤ {max_ratio:g}); a ring in between was probably missed, which "
@@ -210,6 +221,7 @@ def newton_ring_gap(
     smooth_px: float = 1.0,
     step_px: float = 0.5,
     max_spacing_ratio: float = 1.8,
+    min_accepted_fraction: float = 0.5,
 ) -> NewtonRingGap:
     """Gap (m) at the contact edge from ``n_profiles`` lines through ``centre_px`` (row, col).
 
@@ -219,10 +231,13 @@ def newton_ring_gap(
     of the image's 2–98 % intensity range and ``min_prominence_sd`` pixel-noise standard
     deviations (so pure noise never makes rings). ``max_rings`` keeps only the innermost rings.
     A half-profile whose ring spacing jumps by more than ``max_spacing_ratio`` is refused
-    (a missed ring).
+    (a missed ring). Refused half-profiles are left out and listed in ``rejected`` with their
+    reason, as long as at least ``min_accepted_fraction`` of them remain (roughness on the
+    sphere scatters single rings; the rest still measure the average gap).
 
-    Raises NewtonRingError for a centre outside the image, a half-profile with too few rings,
-    a ring inside the contact edge or a missed ring, or an unknown edge model.
+    Raises NewtonRingError for a centre outside the image, an unknown edge model, or when
+    fewer than ``min_accepted_fraction`` of the half-profiles have enough, correctly ordered
+    rings outside the contact edge (the message names the first refused profile's reason).
     """
     image = np.asarray(reflection, dtype=float)
     if image.ndim != 2:
@@ -258,18 +273,47 @@ def newton_ring_gap(
             np.arange(n_profiles) * np.pi / n_profiles + np.pi,
         ]
     )
-    profiles = tuple(
-        _half_profile(smoothed, (row, col), angle, pixel_m, contact_radius_m, settings)
-        for angle in angles
-    )
+    profiles, rejected, missed = [], [], []
+    for angle in angles:
+        try:
+            profiles.append(
+                _half_profile(smoothed, (row, col), angle, pixel_m, contact_radius_m, settings)
+            )
+        except MissedRingError as error:
+            missed.append(str(error))
+        except NewtonRingError as error:
+            rejected.append(str(error))
+    if len(missed) > MAX_MISSED_FRACTION * angles.size:
+        raise NewtonRingError(
+            f"{len(missed)} of {angles.size} half-profiles missed a ring (more than "
+            f"{MAX_MISSED_FRACTION:.0%}): the ring orders of this image are not safe; first: "
+            f"{missed[0]}"
+        )
+    rejected += missed
+    if missed:
+        # The spacing test needs three rings; once it has caught a missed ring elsewhere,
+        # a two-ring profile may be misnumbered in the same way without showing it.
+        unchecked = [p for p in profiles if p.ring_r_m.size < 3]
+        profiles = [p for p in profiles if p.ring_r_m.size >= 3]
+        rejected += [
+            f"profile at {np.degrees(p.angle_rad):.1f}°: {p.ring_r_m.size} rings cannot show a "
+            "missed ring, and other profiles missed one"
+            for p in unchecked
+        ]
+    if len(profiles) < max(2, min_accepted_fraction * angles.size):
+        raise NewtonRingError(
+            f"{len(rejected)} of {angles.size} half-profiles refused (at least "
+            f"{min_accepted_fraction:.0%} must have usable rings); first: {rejected[0]}"
+        )
     edges = np.array([p.edge_gap_m for p in profiles])
     return NewtonRingGap(
         edge_gap_mean_m=float(edges.mean()),
         edge_gap_sd_m=float(edges.std(ddof=1)),
         edge_gaps_m=edges,
-        angles_rad=angles,
+        angles_rad=np.array([p.angle_rad for p in profiles]),
         first_ring_gap_m=float(ring_gap(0, wavelength_m, n_medium)),
         contact_radius_m=float(contact_radius_m),
         edge_model=edge_model,
-        half_profiles=profiles,
+        half_profiles=tuple(profiles),
+        rejected=tuple(rejected),
     )
