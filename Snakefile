@@ -23,6 +23,7 @@ include: "workflow/rules/virtual_experiment.smk"
 include: "workflow/rules/optics.smk"
 include: "workflow/rules/load_area.smk"
 include: "workflow/rules/friction.smk"
+include: "workflow/rules/surface.smk"
 
 
 # Default target: every output of every selected material.

@@ -1,9 +1,14 @@
 """Rule generate_virtual_experiment: one sphere's raw data (every instrument) with known truth."""
 
+import os
 from pathlib import Path
 
+if "snakemake" in globals():
+    # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
+
 from amontons.runlog import run_logged
-from amontons.virtual.experiment import InstrumentSettings, generate_sphere
+from amontons.virtual.experiment import InstrumentSettings, SurfaceSettings, generate_sphere
 
 
 def main(
@@ -11,6 +16,8 @@ def main(
     sphere: str,
     diameter_mm: float,
     e_star_gpa: float,
+    roughness_rms_nm: float,
+    hardening_k_mpa_per_nm: float,
     loads_mn: list[float],
     reflection_load_mn: float,
     flim_load_mn: float | None,
@@ -18,19 +25,24 @@ def main(
     pixel_nm: float,
     settings: dict,
     seed: int,
+    threads: int,
 ) -> None:
     generate_sphere(
         Path(truth_path).parent,
         sphere=sphere,
         diameter_m=diameter_mm * 1e-3,
         e_star_pa=e_star_gpa * 1e9,
+        roughness_rms_m=roughness_rms_nm * 1e-9,
+        hardening_k_pa_per_m=hardening_k_mpa_per_nm * 1e15,
         loads_n=[load * 1e-3 for load in loads_mn],
         pixel_m=pixel_nm * 1e-9,
         reflection_load_n=reflection_load_mn * 1e-3,
         flim_load_n=None if flim_load_mn is None else flim_load_mn * 1e-3,
         shear_strength_pa=shear_strength_mpa * 1e6,
         settings=InstrumentSettings.from_config(settings),
+        surface=SurfaceSettings.from_config(settings),
         seed=seed,
+        threads=threads,
     )
 
 
@@ -43,6 +55,8 @@ if __name__ == "__main__":
         sphere=sm.params.sphere,
         diameter_mm=sm.params.diameter_mm,
         e_star_gpa=sm.params.e_star_gpa,
+        roughness_rms_nm=sm.params.roughness_rms_nm,
+        hardening_k_mpa_per_nm=sm.params.hardening_k_mpa_per_nm,
         loads_mn=sm.params.loads_mn,
         reflection_load_mn=sm.params.reflection_load_mn,
         flim_load_mn=sm.params.flim_load_mn,
@@ -50,4 +64,5 @@ if __name__ == "__main__":
         pixel_nm=sm.params.pixel_nm,
         settings=sm.params.settings,
         seed=sm.params.seed,
+        threads=sm.threads,
     )

@@ -90,13 +90,14 @@ def test_loads_parse():
 
 
 def _write_sheet(path, rows):
-    """Sheet with the given rows; every row gets reflection load 25 mN and shear strength
-    20 MPa (required columns that these tests do not vary)."""
+    """Sheet with the given rows; every row gets reflection load 25 mN, shear strength 20 MPa,
+    roughness 80 nm and k 5 MPa/nm (required columns that these tests do not vary)."""
     header = (
         "sphere\tmaterial\tdiameter_mm\te_star_gpa\troughened\tloads_mn\t"
-        "reflection_load_mn\tshear_strength_mpa\tfluorescence_pixel_nm\tdata_source\n"
+        "reflection_load_mn\tshear_strength_mpa\troughness_rms_nm\thardening_k_mpa_per_nm\t"
+        "fluorescence_pixel_nm\tdata_source\n"
     )
-    rows = [[*row[:6], "25", "20", *row[6:]] for row in rows]
+    rows = [[*row[:6], "25", "20", "80", "5", *row[6:]] for row in rows]
     path.write_text(header + "".join("\t".join(row) + "\n" for row in rows))
 
 

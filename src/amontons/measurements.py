@@ -26,6 +26,7 @@ from amontons.optics.lifetime import LifetimeStatistics, lifetime_statistics
 from amontons.optics.newton_rings import NewtonRingError, NewtonRingGap, newton_ring_gap
 from amontons.optics.psf import PsfError, PsfMeasurement, measure_psf
 from amontons.rawdata import (
+    AFM_SUFFIXES,
     RawDataError,
     fluorescence_images,
     read_absorbance,
@@ -33,6 +34,14 @@ from amontons.rawdata import (
     read_flim,
     read_reflection,
     read_rheometer_traces,
+)
+from amontons.surface import (
+    RoughnessStatistics,
+    SphereFit,
+    TopographyError,
+    level_sphere,
+    read_height_map,
+    roughness_statistics,
 )
 
 
@@ -96,6 +105,10 @@ class EdgeGap:
     reflection_path: Path
 
 
+class RingsUnreadable(RawDataError):
+    """A reflection image whose Newton rings cannot be numbered (e.g. a rough sphere's)."""
+
+
 def measure_edge_gap(
     reflection_path: str | Path,
     fluorescence_path: str | Path,
@@ -129,7 +142,7 @@ def measure_edge_gap(
             max_rings=max_rings,
         )
     except NewtonRingError as error:
-        raise RawDataError(f"{reflection.path}: {error}") from error
+        raise RingsUnreadable(f"{reflection.path}: {error}") from error
     return EdgeGap(rings, centre, radius, fluorescence.path, reflection.path)
 
 
@@ -178,7 +191,13 @@ def measure_intensity_pressure(
             raise RawDataError(f"{path}: {error}") from error
     loads_n = [load * 1e-3 for load in loads_mn]
     result = intensity_pressure(
-        images, masks, loads_n, backgrounds, pixel_m=pixel, pressure_ref_pa=pressure_ref_pa
+        images,
+        masks,
+        loads_n,
+        backgrounds,
+        pixel_m=pixel,
+        margin_px=background_margin_px,
+        pressure_ref_pa=pressure_ref_pa,
     )
     return result, backgrounds
 
@@ -311,3 +330,90 @@ def amontons_table(
             )
         )
     return pd.concat(frames, ignore_index=True)
+
+
+# --- AFM topography -----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Topography:
+    """The sphere's AFM scans before and after the load series, levelled (lengths in m)."""
+
+    before: SphereFit
+    after: SphereFit
+    before_statistics: RoughnessStatistics
+    after_statistics: RoughnessStatistics
+    change_m: np.ndarray  # after − before, the unchanged points at 0, m
+    pixel_m: float
+    filled_pixels: int
+
+
+def afm_file(folder: str | Path, stem: str) -> Path:
+    """The AFM height map ``stem`` (afm_before / afm_after) in ``folder``, in whichever of the
+    readable formats it is; RawDataError naming the folder if none or several."""
+    folder = Path(folder)
+    found = [folder / f"{stem}{ext}" for ext in AFM_SUFFIXES if (folder / f"{stem}{ext}").is_file()]
+    if len(found) != 1:
+        raise RawDataError(
+            f"{folder}: expected exactly one {stem} height map "
+            f"({', '.join(stem + s for s in AFM_SUFFIXES)}), found {len(found)}"
+        )
+    return found[0]
+
+
+def unchanged_level(change_m: np.ndarray, bin_m: float = 0.25e-9) -> float:
+    """The height change (m) of the points that did not flow: the mode of after − before.
+
+    Two AFM scans share no absolute height, and flattened points are not a minority near a
+    large contact, so neither 0 nor the median is the reference; the points that never
+    touched (most of a rough sphere, even inside the contact) form a peak as narrow as the
+    scan noise.
+    """
+    low, high = np.percentile(change_m, [0.5, 99.5])
+    bins = max(8, int(np.ceil((high - low) / bin_m)))
+    counts, edges = np.histogram(change_m, bins=bins, range=(low, high))
+    peak = int(np.argmax(counts))
+    return float(0.5 * (edges[peak] + edges[peak + 1]))
+
+
+def measure_topography(
+    before_path: str | Path,
+    after_path: str | Path,
+    fallback_pixel_m: float | None,
+    *,
+    nan_policy: str,
+) -> Topography:
+    """Level both scans (sphere fit, scan-line offsets) and take their roughness statistics and
+    their difference, the plastic flattening (appendix Fig. B.9). Both scans must cover the
+    same field on the same grid (a repeated scan of the same area)."""
+    maps = []
+    for path in (before_path, after_path):
+        try:
+            maps.append(
+                read_height_map(path, fallback_pixel_m=fallback_pixel_m, nan_policy=nan_policy)
+            )
+        except TopographyError as error:
+            raise RawDataError(str(error)) from error
+    before, after = maps
+    if before.heights.shape != after.heights.shape or not np.isclose(
+        before.pixel_m, after.pixel_m, rtol=1e-6
+    ):
+        raise RawDataError(
+            f"{after.path}: {after.heights.shape} px of {after.pixel_m * 1e9:.4g} nm; expected "
+            f"the field of {before.path} ({before.heights.shape} px of "
+            f"{before.pixel_m * 1e9:.4g} nm)"
+        )
+    fits = [level_sphere(m.heights, m.pixel_m) for m in maps]
+    # No row alignment of the difference: near a large contact most of a row may have flowed,
+    # so row statistics would eat the flattening; the scan-line offsets (a few nm on a few
+    # rows) stay in it, which the report's tolerance allows for.
+    change = after.heights - before.heights
+    return Topography(
+        before=fits[0],
+        after=fits[1],
+        before_statistics=roughness_statistics(fits[0].roughness, before.pixel_m),
+        after_statistics=roughness_statistics(fits[1].roughness, after.pixel_m),
+        change_m=change - unchanged_level(change),
+        pixel_m=before.pixel_m,
+        filled_pixels=before.filled + after.filled,
+    )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import textwrap
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -131,6 +133,54 @@ def plot_edge_gap(
     ax.set_ylabel("gap (nm)")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7)
+    _save(fig, paths)
+
+
+def plot_unmeasured(reason: str, title: str, paths: list[str]) -> None:
+    """A figure that says why a quantity could not be measured (no silent empty plot)."""
+    fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
+    ax.axis("off")
+    ax.text(
+        0.5,
+        0.5,
+        "not measurable:\n" + textwrap.fill(reason, 60),
+        ha="center",
+        va="center",
+        fontsize=7,
+        wrap=True,
+        transform=ax.transAxes,
+    )
+    ax.set_title(title, fontsize=9)
+    _save(fig, paths)
+
+
+def plot_topography(
+    before_nm: np.ndarray,
+    after_nm: np.ndarray,
+    change_nm: np.ndarray,
+    pixel_um: float,
+    title: str,
+    paths: list[str],
+) -> None:
+    """Levelled AFM roughness before and after contact and their difference (appendix
+    Fig. B.9), on one colour scale for the two scans."""
+    fig, axes = plt.subplots(1, 3, figsize=(9, 3.2), constrained_layout=True)
+    extent = [0, before_nm.shape[1] * pixel_um, 0, before_nm.shape[0] * pixel_um]
+    low, high = np.percentile(before_nm, [1, 99])
+    for ax, data, label in ((axes[0], before_nm, "before"), (axes[1], after_nm, "after")):
+        image = ax.imshow(data, extent=extent, origin="lower", vmin=low, vmax=high, cmap="viridis")
+        ax.set_title(f"{label} contact", fontsize=8)
+    fig.colorbar(image, ax=axes[:2], label="height (nm)", shrink=0.8)
+    span = max(float(np.percentile(np.abs(change_nm), 99.9)), 1e-3)
+    diff = axes[2].imshow(
+        change_nm, extent=extent, origin="lower", vmin=-span, vmax=span, cmap="RdBu"
+    )
+    axes[2].set_title("after − before", fontsize=8)
+    fig.colorbar(diff, ax=axes[2], label="height change (nm)", shrink=0.8)
+    for ax in axes:
+        ax.set_xlabel("x (µm)")
+    axes[0].set_ylabel("y (µm)")
+    fig.suptitle(title, fontsize=9)
     _save(fig, paths)
 
 

@@ -7,6 +7,8 @@
 <folder>/bead.tif                        a 100 nm fluorescent bead, imaged like the contacts
 <folder>/absorbance.csv                  wavelength_nm, absorbance of the probe cover slip
 <folder>/flim.tif                        optional: mean photon arrival time map, ns (float)
+<folder>/afm_before.<tif|npy|txt>        AFM height map of the sphere before contact (m)
+<folder>/afm_after.<tif|npy|txt>         the same after the load series (m)
 <folder>/truth.json                      virtual experiment only; the analysis never reads it
 
 Every reader raises RawDataError naming the file and what was expected.
@@ -26,6 +28,10 @@ REFLECTION_NAME = "reflection.tif"
 BEAD_NAME = "bead.tif"
 ABSORBANCE_NAME = "absorbance.csv"
 FLIM_NAME = "flim.tif"
+AFM_BEFORE_NAME = "afm_before.tif"
+AFM_AFTER_NAME = "afm_after.tif"
+# Height-map formats amontons.surface reads (TIFF, numpy, Gwyddion text export).
+AFM_SUFFIXES = (".tif", ".tiff", ".npy", ".txt", ".asc")
 # A rheometer's set-point and its measured normal force differ by its force noise and drift;
 # more than this relative difference means the file belongs to another load.
 NORMAL_FORCE_TOLERANCE = 0.1

@@ -4,6 +4,8 @@ import os
 import pandas as pd
 
 from amontons.config import load_schema, load_workflow_config
+from amontons.measurements import afm_file
+from amontons.rawdata import AFM_SUFFIXES
 
 SCHEMAS = os.path.join(workflow.basedir, "workflow", "schemas")
 CONFIG_SOURCE = ", ".join(
@@ -73,6 +75,18 @@ def raw_file(sphere, name):
     return f"{raw_dir(sphere)}/{name}"
 
 
+def afm_path(sphere, stem):
+    """A sphere's AFM height map ``stem`` (afm_before / afm_after): the virtual experiment
+    writes TIFF; measured data may be TIFF, .npy or a Gwyddion text export (two formats of
+    one map stop the run, naming both). With none present the TIFF is named, so the missing
+    input is reported by that name."""
+    folder = raw_dir(sphere)
+    present = [ext for ext in AFM_SUFFIXES if os.path.isfile(f"{folder}/{stem}{ext}")]
+    if is_synthetic(sphere) or not present:
+        return raw_file(sphere, f"{stem}.tif")
+    return str(afm_file(folder, stem))
+
+
 def reflection_fluorescence(sphere):
     """The fluorescence image recorded at the sphere's reflection load."""
     load = sheet_value(sphere, "reflection_load_mn")
@@ -130,6 +144,7 @@ OPTICS_RESULTS = [
     "hertz_check.csv",
 ]
 FRICTION_RESULTS = ["friction.csv"]
+SURFACE_RESULTS = ["topography.json", "topography.png", "topography.pdf"]
 FIT_RESULTS = ["load_area_fit.json"]
 
 
@@ -173,8 +188,10 @@ def figure_outputs(materials):
 def material_outputs(materials):
     """Everything a material's target builds: every measurement, fit, figure and table."""
     fits = [f for m in materials for f in sphere_outputs(m, FIT_RESULTS)]
+    surface = [f for m in materials for f in sphere_outputs(m, SURFACE_RESULTS)]
     everything = (
         optics_outputs(materials)
+        + surface
         + friction_outputs(materials)
         + fits
         + figure_outputs(materials)

@@ -10,6 +10,8 @@ rule generate_virtual_experiment:
         reflection="resources/synthetic/{sphere}/reflection.tif",
         bead="resources/synthetic/{sphere}/bead.tif",
         absorbance="resources/synthetic/{sphere}/absorbance.csv",
+        afm_before="resources/synthetic/{sphere}/afm_before.tif",
+        afm_after="resources/synthetic/{sphere}/afm_after.tif",
         truth="resources/synthetic/{sphere}/truth.json",
     log:
         "logs/virtual_experiment/{sphere}.log",
@@ -21,12 +23,16 @@ rule generate_virtual_experiment:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=4000,
+        runtime=20,
     params:
         sphere=lambda wc: wc.sphere,
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
         e_star_gpa=lambda wc: float(sphere_row(wc.sphere)["e_star_gpa"]),
+        roughness_rms_nm=lambda wc: sheet_value(wc.sphere, "roughness_rms_nm"),
+        hardening_k_mpa_per_nm=lambda wc: sheet_value(
+            wc.sphere, "hardening_k_mpa_per_nm"
+        ),
         loads_mn=lambda wc: loads_mn(wc.sphere),
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         flim_load_mn=lambda wc: sheet_value(wc.sphere, "flim_load_mn"),
@@ -45,6 +51,8 @@ use rule generate_virtual_experiment as generate_virtual_experiment_with_flim wi
         reflection="resources/synthetic/{sphere}/reflection.tif",
         bead="resources/synthetic/{sphere}/bead.tif",
         absorbance="resources/synthetic/{sphere}/absorbance.csv",
+        afm_before="resources/synthetic/{sphere}/afm_before.tif",
+        afm_after="resources/synthetic/{sphere}/afm_after.tif",
         flim="resources/synthetic/{sphere}/flim.tif",
         truth="resources/synthetic/{sphere}/truth.json",
     wildcard_constraints:

@@ -28,15 +28,20 @@ import numpy as np
 from amontons import hertz
 from amontons.images import atomic_path, write_image
 from amontons.optics.absorbance import AVOGADRO_PER_MOL, EPSILON_M2_PER_MOL
+from amontons.powerlaw import fit_power_law
 from amontons.rawdata import (
     ABSORBANCE_NAME,
+    AFM_AFTER_NAME,
+    AFM_BEFORE_NAME,
     BEAD_NAME,
     FLIM_NAME,
     REFLECTION_NAME,
     fluorescence_name,
     rheometer_name,
 )
+from amontons.surface import roughness_statistics
 from amontons.virtual.absorbance import absorbance_spectrum, write_absorbance_csv
+from amontons.virtual.afm import AfmSettings, resample, scan_artefacts, write_afm
 from amontons.virtual.bead import render_bead
 from amontons.virtual.flim import render_flim
 from amontons.virtual.fluorescence import pixel_averaged, render_fluorescence
@@ -49,6 +54,17 @@ from amontons.virtual.reflection import (
     ring_gap,
 )
 from amontons.virtual.rheometer import rheometer_trace, write_rheometer_trace
+from amontons.virtual.rough_contact import (
+    RoughSphereSolution,
+    SolverSettings,
+    contact_radius_m,
+    edge_radius_m,
+    image_contact_state,
+    reach_radius_m,
+    ring_reach_gap,
+    simulate_rough_sphere,
+)
+from amontons.virtual.roughness import Roughness, synthesize
 
 log = logging.getLogger(__name__)
 
@@ -75,7 +91,6 @@ class InstrumentSettings:
     reflection_counts: float
     reflection_contrast: float
     reflection_rings: int
-    edge_gap_m: float
     bead_field_m: float
     bead_peak_counts: float
     absorbance_peak: float
@@ -100,7 +115,6 @@ class InstrumentSettings:
             reflection_counts=settings["reflection_counts"],
             reflection_contrast=settings["reflection_contrast"],
             reflection_rings=settings["reflection_rings"],
-            edge_gap_m=settings["edge_gap_nm"] * 1e-9,
             bead_field_m=settings["bead_field_um"] * 1e-6,
             bead_peak_counts=settings["bead_peak_counts"],
             absorbance_peak=settings["absorbance_peak"],
@@ -117,21 +131,54 @@ class InstrumentSettings:
 
 
 @dataclass(frozen=True)
+class SurfaceSettings:
+    """The rough sphere and the grids it is seen on (SI units; config/README.md)."""
+
+    hurst: float
+    rolloff_m: float
+    solver: SolverSettings
+    afm: AfmSettings
+
+    @classmethod
+    def from_config(cls, settings: Mapping) -> SurfaceSettings:
+        """Convert the ``virtual_experiment`` config slice (units in key names) to SI."""
+        return cls(
+            hurst=settings["roughness_hurst"],
+            rolloff_m=settings["roughness_rolloff_um"] * 1e-6,
+            solver=SolverSettings(
+                pixel_m=settings["solver_pixel_nm"] * 1e-9,
+                max_grid_px=settings["solver_max_grid_px"],
+                window_factor=settings["solver_window_factor"],
+            ),
+            afm=AfmSettings(
+                pixel_m=settings["afm_pixel_nm"] * 1e-9,
+                side_px=settings["afm_side_px"],
+                noise_m=settings["afm_noise_nm"] * 1e-9,
+                line_offsets=settings["afm_line_offsets"],
+                line_offset_m=settings["afm_line_offset_nm"] * 1e-9,
+            ),
+        )
+
+
+@dataclass(frozen=True)
 class ContactState:
     """One load's contact on the image grid (origin at the image centre, square pixels).
 
-    ``pressure_pa``: pressure averaged over each pixel (Pa); ``gap_m``: gap at pixel centres
-    (m, 0 in contact); ``contact``: pixels whose centre is in contact; ``area_m2``: the true
-    contact area; ``edge_gap_m``: the gap just outside the contact edge (m), what the Newton
-    rings extrapolate to.
+    ``pressure_pa``: pressure averaged over each pixel (Pa); ``sqrt_pressure``: √p averaged
+    over each pixel (√Pa; what the fluorescence sums, since each molecule responds to its
+    local pressure); ``gap_m``: gap at pixel centres
+    (m, 0 in contact; None where no instrument needs it); ``contact``: pixels in contact;
+    ``area_m2``: the true contact area; ``edge_gap_m``: the average gap at the contact edge
+    (m), what the Newton rings extrapolate to (None with ``gap_m``).
     """
 
     load_n: float
     pressure_pa: np.ndarray
-    gap_m: np.ndarray
+    sqrt_pressure: np.ndarray
+    gap_m: np.ndarray | None
     contact: np.ndarray
     area_m2: float
-    edge_gap_m: float
+    edge_gap_m: float | None
     centre_px: tuple[float, float]
 
 
@@ -147,33 +194,6 @@ def field_of_view_px(largest_radius_m: float, pixel_m: float, factor: float) -> 
     """Image side in pixels: ``factor`` × the largest contact diameter, rounded up to 32."""
     side = int(np.ceil(factor * 2 * largest_radius_m / pixel_m))
     return int(32 * np.ceil(side / 32))
-
-
-def hertz_ring_radius(gap_m: float, load_n: float, radius_m: float, e_star_pa: float) -> float:
-    """Distance from the centre (m) at which the Hertz gap reaches ``gap_m`` (bisection; the
-    exterior gap rises monotonically from 0 at the edge)."""
-    lo = hertz.contact_radius(load_n, radius_m, e_star_pa)
-    hi = 2 * lo
-    while hertz_gap(np.array([hi]), load_n, radius_m, e_star_pa)[0] < gap_m:
-        hi *= 2
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if hertz_gap(np.array([mid]), load_n, radius_m, e_star_pa)[0] < gap_m:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
-
-
-def reflection_field_px(
-    rings: int, load_n: float, radius_m: float, e_star_pa: float, pixel_m: float
-) -> int:
-    """Image side (px, a multiple of 32) whose half-width holds ``rings`` bright rings plus half
-    a ring spacing, so that every half-profile through the centre crosses that many rings."""
-    gaps = ring_gap(np.arange(rings + 1), WAVELENGTH_M, N_FORMAMIDE)
-    outer = 0.5 * (gaps[-2] + gaps[-1])  # half-way to the next ring
-    reach_m = hertz_ring_radius(float(outer), load_n, radius_m, e_star_pa)
-    return int(32 * np.ceil(2 * reach_m / pixel_m / 32))
 
 
 def hertz_contact_state(
@@ -204,6 +224,7 @@ def hertz_contact_state(
     return ContactState(
         load_n=load_n,
         pressure_pa=pixel_averaged(pressure, shape, pixel_m),
+        sqrt_pressure=pixel_averaged(lambda x, y: np.sqrt(pressure(x, y)), shape, pixel_m),
         gap_m=radial_gap_map(shape, pixel_m, centre, gap),
         contact=contact,
         area_m2=float(np.pi * a**2),
@@ -224,7 +245,7 @@ def write_fluorescence(
     rng: np.random.Generator,
 ) -> None:
     """Confocal image: local intensity ∝ √pressure (appendix Fig. B.4), PSF, background, noise."""
-    signal = counts_per_sqrt_pa * np.sqrt(state.pressure_pa)
+    signal = counts_per_sqrt_pa * state.sqrt_pressure
     image = render_fluorescence(
         signal,
         pixel_m,
@@ -348,48 +369,126 @@ def write_flim(
 # --- one sphere ---------------------------------------------------------------------------------
 
 
+def _check_load_listed(sphere: str, what: str, load_n: float | None, loads_n: list[float]):
+    if load_n is not None and not any(np.isclose(load_n, f, rtol=1e-9) for f in loads_n):
+        raise ValueError(
+            f"{sphere}: {what} load {load_n * 1e3:g} mN is not one of the loads "
+            f"{[f * 1e3 for f in loads_n]} mN"
+        )
+
+
+def write_afm_scans(
+    out_dir: Path,
+    solution: RoughSphereSolution,
+    radius_m: float,
+    roughness: Roughness,
+    afm: AfmSettings,
+    rng: np.random.Generator,
+) -> dict:
+    """Write ``afm_before.tif`` and ``afm_after.tif`` (the sphere near its apex before the
+    load series and after it); return their truth. The scan centre is off the apex by up to
+    a tenth of the window, as a real scan is.
+
+    After: where the solve made the surface flow (h_pl < 0 on the solver grid, nearest
+    pixel), the scan sees the deformed surface h + h_pl of the solver where it lies below the
+    scan's own surface: asperity tops cut flat (appendix Fig. B.9), the finer roughness the
+    solver grid does not carry kept below the cut.
+    """
+    side = afm.side_px
+    offset = rng.uniform(-0.1, 0.1, size=2) * side * afm.pixel_m
+    axis = (np.arange(side) - (side - 1) / 2) * afm.pixel_m
+    rows_m, cols_m = axis + offset[0], axis + offset[1]
+    dx = solution.spacing_m
+    fine = synthesize((side, side), afm.pixel_m, roughness, rng, above_m=dx)
+    coarse = resample(solution.roughness, dx, rows_m, cols_m, order=3)
+    cap = -(rows_m[:, None] ** 2 + cols_m[None, :] ** 2) / (2 * radius_m)
+    before = cap + coarse + fine
+    plastic = solution.results[-1].plastic_displacement
+    deformed = cap + resample(solution.roughness + plastic, dx, rows_m, cols_m, order=3)
+    flowed = resample((plastic < 0).astype(float), dx, rows_m, cols_m, order=0) > 0.5
+    after = np.where(flowed, np.minimum(before, deformed), before)
+    before_scan = before + scan_artefacts(before.shape, afm, rng)
+    after_scan = after + scan_artefacts(before.shape, afm, rng)
+    write_afm(out_dir / AFM_BEFORE_NAME, before_scan, afm.pixel_m)
+    write_afm(out_dir / AFM_AFTER_NAME, after_scan, afm.pixel_m)
+    rough = coarse + fine
+    stats = roughness_statistics(rough - rough.mean(), afm.pixel_m)
+    return {
+        "pixel_nm": afm.pixel_m * 1e9,
+        "side_px": side,
+        "apex_offset_um": [float(-o * 1e6) for o in offset],
+        "noise_nm": afm.noise_m * 1e9,
+        "line_offsets": afm.line_offsets,
+        "line_offset_nm": afm.line_offset_m * 1e9,
+        "roughness_rms_nm": stats.h_rms_m * 1e9,
+        "slope_rms": stats.slope_rms,
+        "curvature_rms_per_um": stats.curvature_rms_per_m * 1e-6,
+        "max_plastic_depth_nm": float((before - after).max() * 1e9),
+        "flattened_fraction": float(np.mean(after < before)),
+    }
+
+
 def generate_sphere(
     out_dir: str | Path,
     *,
     sphere: str,
     diameter_m: float,
     e_star_pa: float,
+    roughness_rms_m: float,
+    hardening_k_pa_per_m: float,
     loads_n: list[float],
     pixel_m: float,
     reflection_load_n: float,
     flim_load_n: float | None,
     shear_strength_pa: float,
     settings: InstrumentSettings,
+    surface: SurfaceSettings,
     seed: int,
+    threads: int = 1,
 ) -> dict:
     """Write every raw file of one sphere into ``out_dir`` and ``truth.json``; return the truth.
 
+    The contact is a rough sphere under contact hardening (amontons.virtual.rough_contact),
+    solved once per load on the solver grid and seen by each instrument on its own grid.
     ``contact_counts`` (settings) is the expected signal at the mean contact pressure of the
     smallest load; the signal scales as √p. Static friction is ``shear_strength_pa`` × the true
     contact area at each load (F_f = τ·A); dynamic friction is ``dynamic_fraction`` of it.
     """
     out_dir = Path(out_dir)
     radius_m = diameter_m / 2
-    if not any(np.isclose(reflection_load_n, f, rtol=1e-9) for f in loads_n):
-        raise ValueError(
-            f"{sphere}: reflection load {reflection_load_n * 1e3:g} mN is not one of the loads "
-            f"{[f * 1e3 for f in loads_n]} mN"
-        )
-    if flim_load_n is not None and not any(np.isclose(flim_load_n, f) for f in loads_n):
-        raise ValueError(
-            f"{sphere}: FLIM load {flim_load_n * 1e3:g} mN is not one of the loads "
-            f"{[f * 1e3 for f in loads_n]} mN"
-        )
-    radii = [hertz.contact_radius(f, radius_m, e_star_pa) for f in loads_n]
-    side = max(
-        field_of_view_px(max(radii), pixel_m, settings.field_of_view_factor),
-        reflection_field_px(
-            settings.reflection_rings, reflection_load_n, radius_m, e_star_pa, pixel_m
-        ),
+    _check_load_listed(sphere, "reflection", reflection_load_n, loads_n)
+    _check_load_listed(sphere, "FLIM", flim_load_n, loads_n)
+    roughness = Roughness(roughness_rms_m, surface.hurst, surface.rolloff_m, surface.afm.pixel_m)
+    solution = simulate_rough_sphere(
+        radius_m=radius_m,
+        e_star_pa=e_star_pa,
+        k_pa_per_m=hardening_k_pa_per_m,
+        loads_n=loads_n,
+        reflection_load_n=reflection_load_n,
+        rings=settings.reflection_rings,
+        roughness=roughness,
+        settings=surface.solver,
+        rng_seed=[seed, zlib.crc32(sphere.encode()), zlib.crc32(b"roughness")],
+        threads=threads,
     )
+    dx = solution.spacing_m
+    largest = contact_radius_m(solution.results[-1].contact, dx)
+    reflection_index = next(i for i, f in enumerate(loads_n) if f == reflection_load_n)
+    reach = reach_radius_m(
+        solution.results[reflection_index], ring_reach_gap(settings.reflection_rings)
+    )
+    side = max(
+        field_of_view_px(largest, pixel_m, settings.field_of_view_factor),
+        int(32 * np.ceil(2 * reach / pixel_m / 32)),
+    )
+    # the solver window holds both with a margin (simulate_rough_sphere); never look past it
+    side = min(side, int(solution.window_m / pixel_m) // 32 * 32)
+    closing = settings.psf_fwhm_m / 2
     states = [
-        hertz_contact_state(f, radius_m, e_star_pa, (side, side), pixel_m, settings.edge_gap_m)
-        for f in loads_n
+        image_contact_state(
+            solution, i, (side, side), pixel_m, with_gap=i == reflection_index, closing_m=closing
+        )
+        for i in range(len(loads_n))
     ]
     truth = write_instruments(
         out_dir,
@@ -402,18 +501,59 @@ def generate_sphere(
         settings=settings,
         seed=seed,
     )
+    afm_truth = write_afm_scans(
+        out_dir, solution, radius_m, roughness, surface.afm, instrument_rng(seed, sphere, "afm")
+    )
+    areas = np.array([r.area for r in solution.results])
+    fit = fit_power_law(np.array(loads_n), areas, x_ref=loads_n[0])
     truth.update(
         {
-            "forward_model": "hertz (smooth sphere)",
-            "contact_radius_um": [a * 1e6 for a in radii],
-            "area_exponent": 2 / 3,
+            "forward_model": "rough sphere, contact hardening (elastic half-space + Winkler layer)",
             "diameter_mm": diameter_m * 1e3,
             "e_star_gpa": e_star_pa * 1e-9,
+            "hardening_k_mpa_per_nm": hardening_k_pa_per_m * 1e-15,
+            "roughness": {
+                "rms_nm_at_afm_pixel": roughness_rms_m * 1e9,
+                "hurst": surface.hurst,
+                "rolloff_um": surface.rolloff_m * 1e6,
+                "solver_grid_rms_nm": float(solution.roughness.std() * 1e9),
+            },
+            "solver": {
+                "pixel_nm": dx * 1e9,
+                "grid_px": int(solution.heights.shape[0]),
+                "window_um": solution.window_m * 1e6,
+                "tol": surface.solver.tol,
+                "iterations": [int(r.iterations) for r in solution.results],
+            },
+            "approach_nm": [r.displacement * 1e9 for r in solution.results],
+            "max_plastic_depth_nm": [
+                float(-r.plastic_displacement.min() * 1e9) for r in solution.results
+            ],
+            "contact_radius_um": [contact_radius_m(r.contact, dx) * 1e6 for r in solution.results],
+            "edge_radius_um": [
+                edge_radius_m(r.contact, dx, closing) * 1e6 for r in solution.results
+            ],
+            "hertz_contact_radius_um": [
+                hertz.contact_radius(f, radius_m, e_star_pa) * 1e6 for f in loads_n
+            ],
+            "area_exponent": fit.exponent.estimate,
+            "afm": afm_truth,
         }
     )
     with atomic_path(out_dir / "truth.json") as tmp:
         tmp.write_text(json.dumps(truth, indent=2))
     return truth
+
+
+def mean_intensity_exponent(states: list[ContactState], pixel_m: float) -> float:
+    """Power-law exponent of the true mean contact intensity (Σ√p·Δx²/A, √Pa) versus the
+    true mean pressure F/A over the load series: the quantity the intensity-pressure
+    measurement estimates from the images."""
+    intensity = [s.sqrt_pressure.sum() * pixel_m**2 / s.area_m2 for s in states]
+    pressure = [s.load_n / s.area_m2 for s in states]
+    return fit_power_law(
+        np.array(pressure), np.array(intensity), x_ref=pressure[0]
+    ).exponent.estimate
 
 
 def _matching(states: list[ContactState], load_n: float) -> ContactState:
@@ -501,7 +641,11 @@ def write_instruments(
         "image_side_px": int(smallest.contact.shape[0]),
         "psf_fwhm_nm": settings.psf_fwhm_m * 1e9,
         "background_counts": settings.background_counts,
-        "intensity_pressure_exponent": 0.5,
+        "local_intensity_pressure_exponent": 0.5,
+        "intensity_pressure_exponent": mean_intensity_exponent(states, pixel_m),
+        "intensity_pressure_definition": "exponent of the true mean contact intensity "
+        "(sum of the pixel-averaged sqrt(p) over the true area) versus the true mean pressure "
+        "F/A; the local law is I ~ p^0.5, a rough contact's mean follows its own exponent",
         "bead_centre_nm": [c * 1e9 for c in bead_centre],
         "grafting_density_per_um2": density_per_um2,
         "absorbance_peak": peak,

@@ -1,0 +1,86 @@
+"""Rule measure_topography: the sphere's AFM scans levelled, their roughness and the flattening."""
+
+import json
+import logging
+
+from amontons.images import atomic_path
+from amontons.measurements import measure_topography
+from amontons.plots import plot_topography
+from amontons.runlog import run_logged
+
+log = logging.getLogger(__name__)
+
+
+def main(
+    before_path: str,
+    after_path: str,
+    topography_path: str,
+    figure_paths: list[str],
+    afm_pixel_nm: float | None,
+    nan_policy: str,
+    data_label: str,
+    sphere: str,
+) -> None:
+    topo = measure_topography(
+        before_path,
+        after_path,
+        None if afm_pixel_nm is None else afm_pixel_nm * 1e-9,
+        nan_policy=nan_policy,
+    )
+
+    def statistics(fit, stats):
+        return {
+            "sphere_radius_mm": fit.radius_m * 1e3,
+            "roughness_rms_nm": stats.h_rms_m * 1e9,
+            "slope_rms": stats.slope_rms,
+            "curvature_rms_per_um": stats.curvature_rms_per_m * 1e-6,
+        }
+
+    result = {
+        "quantity": "AFM topography levelled by a sphere fit and scan-line alignment; "
+        "statistics at the AFM pixel",
+        "pixel_nm": topo.pixel_m * 1e9,
+        "shape_px": list(topo.change_m.shape),
+        "before": statistics(topo.before, topo.before_statistics),
+        "after": statistics(topo.after, topo.after_statistics),
+        # the deepest flattening, robust to single noisy pixels
+        "max_flattening_nm": float(-(topo.change_m.min()) * 1e9),
+        "filled_nan_pixels": topo.filled_pixels,
+        "nan_policy": nan_policy,
+        "before_file": str(before_path),
+        "after_file": str(after_path),
+    }
+    log.info(
+        "%s: R = %.3f mm, h_rms %.1f nm, h' %.3f, flattening %.1f nm",
+        sphere,
+        topo.before.radius_m * 1e3,
+        topo.before_statistics.h_rms_m * 1e9,
+        topo.before_statistics.slope_rms,
+        result["max_flattening_nm"],
+    )
+    with atomic_path(topography_path) as tmp:
+        tmp.write_text(json.dumps(result, indent=2))
+    plot_topography(
+        topo.before.roughness * 1e9,
+        topo.after.roughness * 1e9,
+        topo.change_m * 1e9,
+        topo.pixel_m * 1e6,
+        f"{sphere}: AFM before and after the load series ({data_label})",
+        figure_paths,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        before_path=sm.input.before,
+        after_path=sm.input.after,
+        topography_path=sm.output.topography,
+        figure_paths=[sm.output.png, sm.output.pdf],
+        afm_pixel_nm=sm.params.afm_pixel_nm,
+        nan_policy=sm.params.nan_policy,
+        data_label=sm.params.data_label,
+        sphere=sm.wildcards.sphere,
+    )

@@ -1,0 +1,55 @@
+"""Forward model of an AFM height map of the sphere near its apex (heights in m, TIFF).
+
+The scan sees the true surface at its own pixel - the paraboloid, the roughness the contact
+solve resolves (interpolated from the solver grid, bicubic) plus the finer band the solver
+grid cannot carry (:func:`amontons.virtual.roughness.synthesize` with ``above_m``) - and
+adds what an AFM adds: white height noise and a few scan lines shifted by a constant offset
+(the raw data keeps the sphere curvature; levelling is the analysis' job).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from amontons.images import write_image
+
+
+@dataclass(frozen=True)
+class AfmSettings:
+    """Pixel (m), side (px), height noise (m rms), number and size (m) of line offsets."""
+
+    pixel_m: float
+    side_px: int
+    noise_m: float
+    line_offsets: int
+    line_offset_m: float
+
+
+def resample(field: np.ndarray, spacing_m: float, rows_m: np.ndarray, cols_m: np.ndarray, order):
+    """``field`` (on a grid of ``spacing_m`` about its centre) at the positions (m) given by
+    the outer product of ``rows_m`` and ``cols_m``; cubic (order 3) or bilinear (order 1)."""
+    n0, n1 = field.shape
+    r = (n0 - 1) / 2 + rows_m / spacing_m
+    c = (n1 - 1) / 2 + cols_m / spacing_m
+    rr, cc = np.meshgrid(r, c, indexing="ij")
+    return ndimage.map_coordinates(field, [rr, cc], order=order, mode="nearest")
+
+
+def scan_artefacts(shape, settings: AfmSettings, rng: np.random.Generator) -> np.ndarray:
+    """White noise plus ``line_offsets`` scan lines shifted by ±``line_offset_m``, m."""
+    artefacts = rng.normal(0.0, settings.noise_m, shape)
+    lines = rng.choice(shape[0], size=min(settings.line_offsets, shape[0]), replace=False)
+    signs = rng.choice([-1.0, 1.0], size=lines.size)
+    artefacts[lines] += signs[:, None] * settings.line_offset_m
+    return artefacts
+
+
+def write_afm(path, heights_m: np.ndarray, pixel_m: float) -> None:
+    """Write a height map (m) as a float32 TIFF with its pixel size in the resolution tags."""
+    heights = np.asarray(heights_m)
+    if not np.all(np.isfinite(heights)):
+        raise ValueError(f"{path}: refusing to write a height map with NaN or inf")
+    write_image(path, heights.astype(np.float32), pixel_m)

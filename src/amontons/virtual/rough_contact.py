@@ -1,0 +1,277 @@
+"""The virtual experiment's contact: a rough sphere with contact hardening, solved per load.
+
+Forward model (DESIGN.md, "The virtual experiment"): the sphere is a paraboloid of radius R
+plus self-affine roughness (:mod:`amontons.virtual.roughness`) on the solver grid; it is
+pressed onto the glass (elastic half-space of contact modulus E*) with the contact-hardening
+law p = k·|h_pl| (appendix B.2.3), the loads stepping upward and each step carrying the
+plastic displacement of the previous one (:func:`amontons.contact.solve_load_series`).
+
+The solver grid is a setting (``solver_pixel_nm``, capped at ``solver_max_grid_px`` per
+side), separate from the AFM pixel and from the image pixel. Its window holds the largest
+contact and the Newton rings of the reflection load with a margin; a solve whose contact
+reaches the window edge, or whose rings fall outside it, is repeated on a larger window.
+
+:func:`image_contact_state` maps one load's solution onto an instrument's pixel grid (the
+ContactState every instrument of :mod:`amontons.virtual.experiment` reads).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.fft
+from scipy import ndimage
+
+from amontons import hertz
+from amontons.contact import ContactHardening, ContactResult, FreeBoundaryError, solve_load_series
+from amontons.contact.surfaces import sphere as sphere_cap
+from amontons.virtual.fluorescence import pixel_averaged
+from amontons.virtual.reflection import N_FORMAMIDE, WAVELENGTH_M, ring_gap
+from amontons.virtual.roughness import Roughness, synthesize
+
+log = logging.getLogger(__name__)
+
+# Hardening enlarges the contact over Hertz (PMMA, 512² benchmark: area ×1.45 at 10 mN, so
+# radius ×1.2); the first window assumes ×1.3 and grows by WINDOW_GROWTH when too small.
+HARDENING_RADIUS_GUESS = 1.3
+WINDOW_GROWTH = 1.5
+MAX_WINDOW_ATTEMPTS = 4
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Grid of the forward contact solve: pixel (m), largest side (px), window margin (×)."""
+
+    pixel_m: float
+    max_grid_px: int
+    window_factor: float
+    tol: float = 1e-8
+
+
+@dataclass(frozen=True)
+class RoughSphereSolution:
+    """The rough sphere's load series on the solver grid (apex at the window centre).
+
+    ``heights``: indenter heights (m, larger = closer to the glass); ``roughness``: the
+    roughness part of them (m); ``results``: one ContactResult per load (SI units).
+    """
+
+    heights: np.ndarray
+    roughness: np.ndarray
+    spacing_m: float
+    results: list[ContactResult]
+
+    @property
+    def centre_px(self) -> tuple[float, float]:
+        n0, n1 = self.heights.shape
+        return ((n0 - 1) / 2, (n1 - 1) / 2)
+
+    @property
+    def window_m(self) -> float:
+        return self.heights.shape[0] * self.spacing_m
+
+
+def ring_reach_gap(rings: int) -> float:
+    """Gap (m) half-way between the last bright ring an image must hold and the next one."""
+    gaps = ring_gap(np.arange(rings + 1), WAVELENGTH_M, N_FORMAMIDE)
+    return float(0.5 * (gaps[-2] + gaps[-1]))
+
+
+def hertz_reach_radius(gap_m: float, load_n: float, radius_m: float, e_star_pa: float) -> float:
+    """Distance (m) at which a Hertz sphere's gap reaches ``gap_m``: the far field is
+    r²/2R − d + u with u ≤ the Hertz displacement, so r² ≤ 2R(g + d) bounds it from above."""
+    d = hertz.contact_radius(load_n, radius_m, e_star_pa) ** 2 / radius_m
+    return float(np.sqrt(2 * radius_m * (gap_m + d)))
+
+
+def initial_window_m(
+    loads_n, radius_m, e_star_pa, reflection_load_n, rings, settings: SolverSettings
+) -> float:
+    """First solver window (m): the larger of the hardened contact diameter and the Newton
+    rings' reach at the reflection load, times ``window_factor``."""
+    a_max = hertz.contact_radius(max(loads_n), radius_m, e_star_pa) * HARDENING_RADIUS_GUESS
+    reach = hertz_reach_radius(ring_reach_gap(rings), reflection_load_n, radius_m, e_star_pa)
+    return settings.window_factor * 2 * max(a_max, reach)
+
+
+def solver_grid(window_m: float, settings: SolverSettings) -> tuple[int, float]:
+    """Side (px, even) and pixel (m) of the solver grid: ``settings.pixel_m`` unless the
+    window would then exceed ``max_grid_px``, in which case the pixel grows."""
+    n = _fast_even(int(np.ceil(window_m / settings.pixel_m)))
+    if n <= settings.max_grid_px:
+        return n, settings.pixel_m
+    n = settings.max_grid_px - settings.max_grid_px % 2
+    return n, window_m / n
+
+
+def _fast_even(n: int) -> int:
+    """Smallest even n' >= n whose FFT is fast (a product of 2, 3, 5, 7): a 962² window pads
+    to 1924 = 4·13·37, whose transforms are ~4x slower than those of 1000 (measured)."""
+    m = scipy.fft.next_fast_len(n, real=True)
+    while m % 2:
+        m = scipy.fft.next_fast_len(m + 1, real=True)
+    return m
+
+
+def rough_sphere_heights(n: int, spacing_m: float, radius_m: float, roughness: Roughness, rng):
+    """(heights, roughness) on an n² grid, m: the paraboloid plus the solver-band roughness."""
+    rough = synthesize((n, n), spacing_m, roughness, rng)
+    return sphere_cap((n, n), spacing_m, radius_m) + rough, rough
+
+
+def azimuthal_mean(field: np.ndarray, spacing_m: float, radii_m: np.ndarray) -> np.ndarray:
+    """Mean of ``field`` over circles of the given radii (m) about the window centre, sampled
+    at 720 angles with bilinear interpolation."""
+    n0, n1 = field.shape
+    theta = np.linspace(0, 2 * np.pi, 720, endpoint=False)
+    r = np.asarray(radii_m, dtype=float)[:, None] / spacing_m
+    rows = (n0 - 1) / 2 + r * np.sin(theta)
+    cols = (n1 - 1) / 2 + r * np.cos(theta)
+    values = ndimage.map_coordinates(field, [rows.ravel(), cols.ravel()], order=1)
+    return values.reshape(rows.shape).mean(axis=1)
+
+
+def reach_radius_m(result: ContactResult, gap_m: float) -> float:
+    """Smallest radius (m) at which the azimuthally averaged gap exceeds ``gap_m``; inf when
+    it does not within the window."""
+    spacing = result.spacing
+    radii = np.arange(0, result.gap.shape[0] // 2 - 1) * spacing
+    mean_gap = azimuthal_mean(result.gap, spacing, radii)
+    beyond = np.nonzero(mean_gap > gap_m)[0]
+    return float(radii[beyond[0]]) if beyond.size else float("inf")
+
+
+def contact_radius_m(contact: np.ndarray, spacing_m: float) -> float:
+    """Largest distance (m) of a contact pixel's centre from the window centre."""
+    n0, n1 = contact.shape
+    rows, cols = np.nonzero(contact)
+    if rows.size == 0:
+        return 0.0
+    return float(np.hypot(rows - (n0 - 1) / 2, cols - (n1 - 1) / 2).max() * spacing_m)
+
+
+def simulate_rough_sphere(
+    *,
+    radius_m: float,
+    e_star_pa: float,
+    k_pa_per_m: float,
+    loads_n: list[float],
+    reflection_load_n: float,
+    rings: int,
+    roughness: Roughness,
+    settings: SolverSettings,
+    rng_seed,
+    threads: int = 1,
+) -> RoughSphereSolution:
+    """Solve the contact-hardening load series of a rough sphere on a window that holds the
+    largest contact and the reflection load's Newton rings (grown and re-solved if not)."""
+    window = initial_window_m(loads_n, radius_m, e_star_pa, reflection_load_n, rings, settings)
+    reach_gap = ring_reach_gap(rings)
+    law = ContactHardening(k_pa_per_m)
+    for attempt in range(1, MAX_WINDOW_ATTEMPTS + 1):
+        n, dx = solver_grid(window, settings)
+        heights, rough = rough_sphere_heights(
+            n, dx, radius_m, roughness, np.random.default_rng(rng_seed)
+        )
+        log.info(
+            "solver grid %d² at %.1f nm (window %.1f µm, attempt %d)",
+            n,
+            dx * 1e9,
+            n * dx * 1e6,
+            attempt,
+        )
+        try:
+            results = solve_load_series(
+                heights, dx, e_star_pa, loads_n, plasticity=law, tol=settings.tol, threads=threads
+            )
+        except FreeBoundaryError as error:
+            log.info("window too small (%s); growing it", error)
+            window *= WINDOW_GROWTH
+            continue
+        reflected = next(r for r, f in zip(results, loads_n, strict=True) if f == reflection_load_n)
+        reach = reach_radius_m(reflected, reach_gap)
+        largest = contact_radius_m(results[-1].contact, dx)
+        needed = settings.window_factor * 2 * max(reach, largest)
+        if needed <= n * dx:
+            return RoughSphereSolution(heights, rough, dx, results)
+        log.info("rings or contact reach %.1f µm beyond the window; growing it", needed * 1e6)
+        window = max(needed, window * WINDOW_GROWTH)
+    raise RuntimeError(
+        f"no solver window held the contact and the Newton rings after {MAX_WINDOW_ATTEMPTS} "
+        f"attempts (last {window * 1e6:.0f} µm); raise solver_max_grid_px or lower the loads"
+    )
+
+
+def _lookup(field: np.ndarray, spacing_m: float, order: int):
+    """field(x, y) at positions in m about the window centre; 0 outside the window."""
+    n0, n1 = field.shape
+
+    def at(x, y):
+        xx, yy = np.broadcast_arrays(x, y)
+        rows = (n0 - 1) / 2 + yy / spacing_m
+        cols = (n1 - 1) / 2 + xx / spacing_m
+        return ndimage.map_coordinates(
+            field, [rows.ravel(), cols.ravel()], order=order, mode="constant", cval=0.0
+        ).reshape(xx.shape)
+
+    return at
+
+
+def edge_radius_m(contact: np.ndarray, spacing_m: float, closing_m: float) -> float:
+    """Radius (m) of the disc with the area of the contact's envelope: the contact mask closed
+    with a disc of radius ``closing_m`` (the gaps between patches that the microscope cannot
+    resolve) and its holes filled - the edge a thresholded fluorescence image shows."""
+    r = max(1, int(round(closing_m / spacing_m)))
+    yy, xx = np.mgrid[-r : r + 1, -r : r + 1]
+    disc = xx**2 + yy**2 <= r * r
+    padded = np.pad(contact, r + 1)
+    closed = ndimage.binary_closing(padded, structure=disc)
+    envelope = ndimage.binary_fill_holes(closed)
+    return float(np.sqrt(envelope.sum() * spacing_m**2 / np.pi))
+
+
+def image_contact_state(
+    solution: RoughSphereSolution,
+    index: int,
+    shape: tuple[int, int],
+    pixel_m: float,
+    *,
+    with_gap: bool,
+    closing_m: float,
+):
+    """Load ``index`` of the solution on an image grid (image centre = sphere apex).
+
+    Pressure: averaged over each image pixel (4×4 sub-samples of the solver field, nearest
+    solver pixel, so patch edges keep their covered fraction); contact: pixels more than half
+    covered by contact; area: the solver's true contact area. Gap (only when ``with_gap``:
+    the reflection image is the one instrument that needs it): bilinear at pixel centres.
+    The edge gap is the azimuthal mean gap at :func:`edge_radius_m` - the average local gap
+    the Newton rings measure, at the edge a thresholded fluorescence image shows.
+    """
+    from amontons.virtual.experiment import ContactState  # the instruments' view
+
+    result = solution.results[index]
+    dx = solution.spacing_m
+    pressure = pixel_averaged(_lookup(result.pressure, dx, order=0), shape, pixel_m)
+    sqrt_pressure = pixel_averaged(_lookup(np.sqrt(result.pressure), dx, order=0), shape, pixel_m)
+    covered = pixel_averaged(_lookup(result.contact.astype(float), dx, order=0), shape, pixel_m)
+    centre = ((shape[0] - 1) / 2, (shape[1] - 1) / 2)
+    gap = edge_gap = None
+    if with_gap:
+        rows, cols = np.indices(shape)
+        at = _lookup(result.gap, dx, order=1)
+        gap = np.maximum(at((cols - centre[1]) * pixel_m, (rows - centre[0]) * pixel_m), 0.0)
+        r_edge = edge_radius_m(result.contact, dx, closing_m)
+        edge_gap = float(azimuthal_mean(result.gap, dx, np.array([r_edge]))[0])
+    return ContactState(
+        load_n=float(result.load),
+        pressure_pa=pressure,
+        sqrt_pressure=sqrt_pressure,
+        gap_m=gap,
+        contact=covered > 0.5,
+        area_m2=result.area,
+        edge_gap_m=edge_gap,
+        centre_px=centre,
+    )

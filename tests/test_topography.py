@@ -1,0 +1,71 @@
+"""The topography measurement: the NaN policy from the config, mismatched scans, and the
+flattening read from two scans of a sphere with a known cut."""
+
+import numpy as np
+import pytest
+
+from amontons.images import read_image, write_image
+from amontons.measurements import afm_file, measure_topography
+from amontons.rawdata import RawDataError
+from amontons.surface import sphere_cap
+
+PIXEL = 32e-9
+
+
+def _scans(tmp_path, rng, cut_nm=40.0):
+    """A 0.3 mm sphere with 20 nm bumps; after: the bumps near the apex cut at a plane
+    ``cut_nm`` below the highest point."""
+    n = 256
+    bumps = (
+        20e-9
+        * np.sin(np.arange(n) * 2 * np.pi / 16)[:, None]
+        * np.cos(np.arange(n) * 2 * np.pi / 16)[None, :]
+    )
+    before = sphere_cap((n, n), PIXEL, 0.3e-3) + bumps
+    after = np.minimum(before, before.max() - cut_nm * 1e-9)
+    noise = 0.2e-9
+    write_image(tmp_path / "afm_before.tif", before + rng.normal(0, noise, before.shape), PIXEL)
+    write_image(tmp_path / "afm_after.tif", after + rng.normal(0, noise, before.shape), PIXEL)
+    return before, after
+
+
+def test_flattening_is_the_depth_of_the_cut(tmp_path):
+    before, after = _scans(tmp_path, np.random.default_rng(1))
+    topo = measure_topography(
+        tmp_path / "afm_before.tif", tmp_path / "afm_after.tif", None, nan_policy="fail"
+    )
+    # Depth of the cut to the noise of two scans (5 σ of √2 × 0.2 nm = 1.4 nm).
+    assert -topo.change_m.min() == pytest.approx((before - after).max(), abs=1.5e-9)
+    assert topo.before.radius_m == pytest.approx(0.3e-3, rel=0.02)
+
+
+def test_nan_pixels_fail_or_are_filled_as_the_config_says(tmp_path):
+    _scans(tmp_path, np.random.default_rng(2))
+    image = read_image(tmp_path / "afm_after.tif", allow_nan=True).data.astype(np.float32)
+    image[10, 20] = np.nan
+    write_image(tmp_path / "afm_after.tif", image, PIXEL)
+    with pytest.raises(RawDataError, match=r"afm_after\.tif: 1 NaN pixels.*row, column \(10, 20\)"):
+        measure_topography(
+            tmp_path / "afm_before.tif", tmp_path / "afm_after.tif", None, nan_policy="fail"
+        )
+    topo = measure_topography(
+        tmp_path / "afm_before.tif", tmp_path / "afm_after.tif", None, nan_policy="fill"
+    )
+    assert topo.filled_pixels == 1 and np.isfinite(topo.change_m).all()
+
+
+def test_scans_of_different_fields_are_refused(tmp_path):
+    _scans(tmp_path, np.random.default_rng(3))
+    write_image(tmp_path / "afm_after.tif", np.zeros((128, 128), np.float32), PIXEL)
+    with pytest.raises(RawDataError, match=r"afm_after\.tif: \(128, 128\) px.*expected the field"):
+        measure_topography(
+            tmp_path / "afm_before.tif", tmp_path / "afm_after.tif", None, nan_policy="fail"
+        )
+
+
+def test_afm_file_finds_one_format_and_refuses_two(tmp_path):
+    np.save(tmp_path / "afm_before.npy", np.zeros((16, 16)))
+    assert afm_file(tmp_path, "afm_before").name == "afm_before.npy"
+    (tmp_path / "afm_before.txt").write_text("# Width: 1 um\n0 0\n0 0\n")
+    with pytest.raises(RawDataError, match="exactly one afm_before height map"):
+        afm_file(tmp_path, "afm_before")

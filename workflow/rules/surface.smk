@@ -1,0 +1,32 @@
+# The sphere's AFM topography: levelling, roughness statistics, and the plastic flattening.
+
+
+rule measure_topography:
+    input:
+        before=lambda wc: afm_path(wc.sphere, "afm_before"),
+        after=lambda wc: afm_path(wc.sphere, "afm_after"),
+    output:
+        topography="results/{material}/{sphere}/topography.json",
+        png=report(
+            "results/{material}/{sphere}/topography.png",
+            caption="../report/topography.rst",
+            category="Surface",
+            subcategory="{material}",
+        ),
+        pdf="results/{material}/{sphere}/topography.pdf",
+    log:
+        "logs/{material}/{sphere}/measure_topography.log",
+    benchmark:
+        "logs/{material}/{sphere}/measure_topography.benchmark.tsv"
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        afm_pixel_nm=lambda wc: sheet_value(wc.sphere, "afm_pixel_nm"),
+        nan_policy=config["surface"]["afm_nan_policy"],
+        data_label=lambda wc: data_label([wc.sphere]),
+    script:
+        "../../scripts/measure_topography.py"
