@@ -3,6 +3,7 @@
 import json
 import logging
 
+from amontons.hertz import contact_radius
 from amontons.images import atomic_path
 from amontons.measurements import RingsUnreadable, measure_edge_gap
 from amontons.plots import plot_edge_gap, plot_unmeasured
@@ -25,6 +26,8 @@ def main(
     max_rings: int,
     data_label: str,
     sphere: str,
+    diameter_mm: float,
+    e_star_gpa: float,
 ) -> None:
     title = f"{sphere}: Newton-ring gap at {reflection_load_mn:g} mN ({data_label})"
     try:
@@ -36,6 +39,9 @@ def main(
             n_profiles=n_profiles,
             edge_model=edge_model,
             max_rings=max_rings,
+            hertz_radius_m=contact_radius(
+                reflection_load_mn * 1e-3, diameter_mm * 0.5e-3, e_star_gpa * 1e9
+            ),
         )
     except RingsUnreadable as error:
         # A rough sphere scatters its rings: the gap is not measurable, and the result says
@@ -113,4 +119,6 @@ if __name__ == "__main__":
         max_rings=sm.params.newton_rings["max_rings"],
         data_label=sm.params.data_label,
         sphere=sm.wildcards.sphere,
+        diameter_mm=sm.params.diameter_mm,
+        e_star_gpa=sm.params.e_star_gpa,
     )

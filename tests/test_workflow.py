@@ -178,15 +178,11 @@ def test_small_data_run(small_run):
 
 @pytest.mark.xfail(
     strict=True,
-    reason="issue 6 (open): on the rough virtual spheres the glass edge gap is -6.7 nm against "
-    "a true +0.6 nm (the Otsu edge lies 0.8 um inside the contact envelope), and the PS "
-    "intensity-pressure exponent is 0.486 against 0.545",
+    reason="issue 6 (open): on the rough PS sphere the intensity-pressure exponent is 0.486 "
+    "against a true 0.545 (small data); the Otsu share of the true area drifts with load",
 )
-def test_issue_6_targets_on_the_rough_spheres(small_run):
+def test_issue_6_intensity_exponent_on_the_rough_ps_sphere(small_run):
     project = small_run
-    gap = json.loads((project / "results/glass/glass/edge_gap.json").read_text())
-    truth = json.loads((project / "resources/synthetic/glass/truth.json").read_text())
-    assert gap["edge_gap_nm"]["mean"] == pytest.approx(truth["edge_gap_nm"], abs=2.0)
     intensity = json.loads((project / "results/PS/PS/intensity_pressure_fit.json").read_text())
     truth = json.loads((project / "resources/synthetic/PS/truth.json").read_text())
     assert intensity["exponent"]["estimate"] == pytest.approx(
@@ -231,6 +227,11 @@ def check_measurements_against_truth(project, material, sphere):
         assert gap["first_ring_gap_nm"] == pytest.approx(truth["first_ring_gap_nm"], abs=0.1)
         assert gap["first_ring_gap_nm"] == pytest.approx(84.3, abs=0.1)
         assert gap["edge_gap_nm"]["n"] + len(gap["rejected_half_profiles"]) == 40
+    if sphere == "glass":
+        # The glass sphere (the appendix's Newton-ring sphere, Fig. B.6): the average gap at
+        # the edge within 2 nm of the truth (the issue's target); measured at 4 noise seeds
+        # of the full-size sphere: +1.0 to +1.6 nm off.
+        assert gap["edge_gap_nm"]["mean"] == pytest.approx(truth["edge_gap_nm"], abs=2.0)
 
     # Static friction: the torque-peak median scatters by 0.5 % at 1 % torque noise
     # (tests/virtual); 2 % per load. Speed from the angle slope to 2 % as well.

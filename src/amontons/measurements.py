@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.ndimage import binary_dilation
+from scipy.ndimage import binary_dilation, binary_fill_holes
 
 from amontons.friction import RheometerError, amontons_deviation, static_friction
 from amontons.hertz_check import hertz_check
@@ -118,18 +118,24 @@ def measure_edge_gap(
     n_profiles: int,
     edge_model: str,
     max_rings: int | None = None,
+    hertz_radius_m: float | None = None,
 ) -> EdgeGap:
     """Gap at the contact edge from the reflection image (appendix Figs. B.6, B.7).
 
-    The contact centre and edge radius come from the Otsu mask of ``fluorescence_path`` (the
-    image at the reflection load), on the same pixel grid as the reflection image.
+    The contact centre comes from the Otsu mask of ``fluorescence_path`` (the image at the
+    reflection load, on the reflection's pixel grid); the edge is where that image shows it:
+    the radius of the circle with the area of the mask with its holes filled (the outer
+    boundary of a patchy contact). ``hertz_radius_m``, the Hertz radius of the load from
+    the sheet's E* and diameter, is the radius of the exterior shape the rings are fitted
+    with (amontons.optics.newton_rings.newton_ring_gap).
     """
     fluorescence = read_image(fluorescence_path, fallback_pixel_m)
     area = otsu_contact_area(fluorescence.data, fluorescence.pixel_m, bins=otsu_bins)
     try:
-        centre, radius = contact_geometry(area.mask, fluorescence.pixel_m)
+        centre, _ = contact_geometry(area.mask, fluorescence.pixel_m)
     except ValueError as error:
         raise RawDataError(f"{fluorescence.path}: {error}") from error
+    radius = float(np.sqrt(binary_fill_holes(area.mask).sum() / np.pi) * fluorescence.pixel_m)
     reflection = read_reflection(reflection_path, fallback_pixel_m, like=fluorescence)
     try:
         rings = newton_ring_gap(
@@ -140,6 +146,7 @@ def measure_edge_gap(
             n_profiles,
             edge_model=edge_model,
             max_rings=max_rings,
+            shape_radius_m=hertz_radius_m,
         )
     except NewtonRingError as error:
         raise RingsUnreadable(f"{reflection.path}: {error}") from error

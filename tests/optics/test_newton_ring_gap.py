@@ -117,6 +117,19 @@ def test_edge_gap_of_an_offset_contact_is_recovered_within_2_nm():
     assert result.edge_gap_mean_m == pytest.approx(5e-9, abs=2e-9)
 
 
+def test_an_edge_inside_the_hertz_radius_needs_the_hertz_shape_of_the_load():
+    # A patchy contact's fluorescent edge lies inside the radius its far field follows (the
+    # rough glass sphere: ~15 % inside). Truth: 0 nm at and inside the Hertz edge A. Fitting
+    # the Hertz shape of the load's radius recovers it within 2 nm; a shape of the
+    # fluorescent edge's radius misses the rings' curvature and reads several nm too low.
+    edge = 0.85 * A
+    image = hertz_reflection(4)
+    right = newton_ring_gap(image, PIXEL, CENTRE, edge, shape_radius_m=A)
+    wrong = newton_ring_gap(image, PIXEL, CENTRE, edge)
+    assert right.edge_gap_mean_m == pytest.approx(0.0, abs=2e-9)
+    assert wrong.edge_gap_mean_m < -4e-9
+
+
 def test_appendix_quadratic_extrapolation_is_biased_on_hertz():
     # Documents why the default is the Hertz-shape fit: a parabola through the rings misses
     # the (r − a)^{3/2} rise at the edge and reports ≈ −18 nm where the truth is 0.

@@ -114,6 +114,8 @@ rule measure_edge_gap:
         otsu_bins=config["optics"]["otsu_bins"],
         newton_rings=config["optics"]["newton_rings"],
         data_label=lambda wc: data_label([wc.sphere]),
+        diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
+        e_star_gpa=lambda wc: float(sphere_row(wc.sphere)["e_star_gpa"]),
     script:
         "../../scripts/measure_edge_gap.py"
 

@@ -108,17 +108,24 @@ def refine_peak(r: np.ndarray, values: np.ndarray, index: int, half_width: int) 
 
 
 def fit_edge_gap(
-    ring_r_m: np.ndarray, ring_gap_m: np.ndarray, contact_radius_m: float, edge_model: str
+    ring_r_m: np.ndarray,
+    ring_gap_m: np.ndarray,
+    contact_radius_m: float,
+    edge_model: str,
+    shape_radius_m: float | None = None,
 ) -> float:
-    """Gap (m) at ``contact_radius_m`` from a fit to the ring points."""
+    """Gap (m) at ``contact_radius_m`` from a fit to the ring points.
+
+    'hertz': gap = g0 + c·S(r; a) with the Hertz exterior shape S of radius a =
+    ``shape_radius_m`` (default: the contact radius itself), g0 and c fitted.
+    """
     if edge_model == "quadratic":
         coefficients = np.polyfit(ring_r_m, ring_gap_m, 2)
         return float(np.polyval(coefficients, contact_radius_m))
-    design = np.column_stack(
-        [np.ones_like(ring_r_m), hertz_exterior_shape(ring_r_m, contact_radius_m)]
-    )
-    (edge_gap, _), *_ = np.linalg.lstsq(design, ring_gap_m, rcond=None)
-    return float(edge_gap)
+    a = contact_radius_m if shape_radius_m is None else shape_radius_m
+    design = np.column_stack([np.ones_like(ring_r_m), hertz_exterior_shape(ring_r_m, a)])
+    (offset, scale), *_ = np.linalg.lstsq(design, ring_gap_m, rcond=None)
+    return float(offset + scale * hertz_exterior_shape(np.array([contact_radius_m]), a)[0])
 
 
 def _ray(
@@ -201,7 +208,9 @@ def _half_profile(
     )
     _check_spacing(ring_r, degrees, settings["max_spacing_ratio"])
     gaps = ring_gap(np.arange(ring_r.size), settings["wavelength_m"], settings["n_medium"])
-    edge = fit_edge_gap(ring_r, gaps, contact_radius_m, settings["edge_model"])
+    edge = fit_edge_gap(
+        ring_r, gaps, contact_radius_m, settings["edge_model"], settings["shape_radius_m"]
+    )
     return HalfProfile(float(angle), ring_r, gaps, edge)
 
 
@@ -222,6 +231,7 @@ def newton_ring_gap(
     step_px: float = 0.5,
     max_spacing_ratio: float = 1.8,
     min_accepted_fraction: float = 0.5,
+    shape_radius_m: float | None = None,
 ) -> NewtonRingGap:
     """Gap (m) at the contact edge from ``n_profiles`` lines through ``centre_px`` (row, col).
 
@@ -230,6 +240,11 @@ def newton_ring_gap(
     mask). A maximum counts as a ring when its prominence exceeds both ``prominence_fraction``
     of the image's 2–98 % intensity range and ``min_prominence_sd`` pixel-noise standard
     deviations (so pure noise never makes rings). ``max_rings`` keeps only the innermost rings.
+    ``shape_radius_m``: radius of the Hertz exterior shape the 'hertz' model fits (default
+    the fluorescent edge). The far field of a contact is set by its load: a rough or
+    flattened sphere's Otsu edge lies well inside the radius whose Hertz shape its rings
+    follow, and a shape of the edge's radius then biases the extrapolation by −8 nm (rough
+    glass sphere of the virtual experiment); the Hertz radius of the load does not.
     A half-profile whose ring spacing jumps by more than ``max_spacing_ratio`` is refused
     (a missed ring). Refused half-profiles are left out and listed in ``rejected`` with their
     reason, as long as at least ``min_accepted_fraction`` of them remain (roughness on the
@@ -263,6 +278,7 @@ def newton_ring_gap(
         "wavelength_m": wavelength_m,
         "n_medium": n_medium,
         "max_spacing_ratio": max_spacing_ratio,
+        "shape_radius_m": shape_radius_m,
     }
     # Noise is independent per pixel while the rings are tens of pixels wide: smoothing by a
     # pixel removes most of the noise and leaves the ring maxima where they are.
