@@ -4,7 +4,7 @@ import logging
 
 import pandas as pd
 
-from amontons.images import atomic_path, read_image
+from amontons.images import atomic_path, read_image, saturated_pixels
 from amontons.optics.area import otsu_contact_area
 from amontons.rawdata import fluorescence_images
 from amontons.runlog import run_logged
@@ -33,6 +33,11 @@ def main(
                 area.separation,
                 min_separation,
             )
+        saturated = saturated_pixels(image.data)
+        if saturated:
+            # The threshold still separates contact from background, but the brightest
+            # contact is clipped: the area stands, the intensities do not (flagged).
+            log.warning("%s: %d saturated pixels; intensities are clipped", path, saturated)
         rows.append(
             {
                 "load_mN": load,
@@ -42,6 +47,7 @@ def main(
                 "otsu_threshold_counts": area.threshold,
                 "otsu_separation": area.separation,
                 "well_separated": area.well_separated,
+                "saturated_pixels": saturated,
                 "image": str(path),
             }
         )

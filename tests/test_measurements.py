@@ -4,12 +4,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from amontons.images import saturated_pixels, write_image
 from amontons.measurements import (
     amontons_table,
     background_level,
     contact_geometry,
     hertz_check_table,
+    measure_intensity_pressure,
 )
+from amontons.rawdata import RawDataError
 
 LOADS_MN = [25.0, 50.0, 100.0, 200.0]
 
@@ -89,3 +92,19 @@ def test_background_level_ignores_the_contact_and_its_halo():
     assert background_level(image, mask, margin_px=5) == 120.0
     with pytest.raises(ValueError, match="expected a background region"):
         background_level(image, np.ones((100, 100), bool), margin_px=5)
+
+
+def test_saturated_image_is_refused_for_intensity_and_counted(tmp_path):
+    # A contact whose brightest pixels hit the 16-bit ceiling: its mean intensity would be too
+    # low, so the intensity-pressure measurement names the file and the count.
+    rows, cols = np.indices((96, 96))
+    contact = np.hypot(rows - 48, cols - 48) < 15
+    folder = tmp_path / "fluorescence"
+    for load, level in ((25, 1500), (50, 65535)):
+        image = np.where(contact, level, 120).astype(np.uint16)
+        write_image(folder / f"{load}.tif", image, 200e-9)
+        assert saturated_pixels(image) == (contact.sum() if level == 65535 else 0)
+    with pytest.raises(RawDataError, match=r"50\.tif: 697 saturated pixels"):
+        measure_intensity_pressure(
+            folder, [25, 50], None, otsu_bins=256, background_margin_px=5, pressure_ref_pa=1e8
+        )

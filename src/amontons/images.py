@@ -113,6 +113,13 @@ def read_image(
     return Image(data=data, pixel_m=float(pixel_m), path=path)
 
 
+def saturated_pixels(data: np.ndarray) -> int:
+    """Pixels at the ceiling of an unsigned-integer image (detector saturation); 0 for floats."""
+    if data.dtype.kind != "u":
+        return 0
+    return int(np.count_nonzero(data == np.iinfo(data.dtype).max))
+
+
 def write_image(path: str | Path, data: np.ndarray, pixel_m: float) -> None:
     """Write a 2-D image as TIFF with its pixel size in the resolution tags (pixels per cm)."""
     pixels_per_cm = 0.01 / pixel_m

@@ -18,7 +18,7 @@ from scipy.ndimage import binary_dilation, binary_fill_holes
 
 from amontons.friction import RheometerError, amontons_deviation, static_friction
 from amontons.hertz_check import hertz_check
-from amontons.images import read_image
+from amontons.images import read_image, saturated_pixels
 from amontons.optics.absorbance import AbsorbanceError, GraftingDensity, grafting_density
 from amontons.optics.area import otsu_contact_area
 from amontons.optics.intensity import IntensityPressure, intensity_pressure
@@ -189,6 +189,13 @@ def measure_intensity_pressure(
                 f"{pixel * 1e9:.4g} nm; expected one pixel size per sphere"
             )
         pixel = image.pixel_m
+        saturated = saturated_pixels(image.data)
+        if saturated:
+            raise RawDataError(
+                f"{path}: {saturated} saturated pixels (the {image.data.dtype} maximum); the "
+                "mean contact intensity of a clipped image is too low - expected none (lower "
+                "the laser power or the detector gain)"
+            )
         mask = otsu_contact_area(image.data, image.pixel_m, bins=otsu_bins).mask
         images.append(image.data)
         masks.append(mask)

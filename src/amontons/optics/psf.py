@@ -24,6 +24,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter
 from scipy.optimize import curve_fit
 
+from amontons.images import saturated_pixels
 from amontons.virtual.fluorescence import FWHM_PER_SIGMA
 
 _MAD_TO_SD = 1.4826  # σ of a normal population per median absolute deviation
@@ -66,14 +67,12 @@ def border_background(image: np.ndarray, width: int) -> tuple[float, float]:
 
 
 def _check_saturation(image: np.ndarray) -> None:
-    if image.dtype.kind != "u":
-        return
-    ceiling = np.iinfo(image.dtype).max
-    n_saturated = int(np.count_nonzero(image == ceiling))
+    n_saturated = saturated_pixels(image)
     if n_saturated:
         raise PsfError(
-            f"bead image has {n_saturated} saturated pixels (value {ceiling}, the {image.dtype} "
-            "maximum); a clipped peak widens the PSF, expected none — lower the laser or gain"
+            f"bead image has {n_saturated} saturated pixels (value {np.iinfo(image.dtype).max}, "
+            f"the {image.dtype} maximum); a clipped peak widens the PSF, expected none — lower "
+            "the laser or gain"
         )
 
 
