@@ -315,14 +315,7 @@ def _solve(
         raise_on_failure=raise_on_failure,
     )
     p = out.pressure
-    if not (np.isfinite(p).all() and np.isfinite(out.gap).all()):
-        raise ConvergenceError(
-            "solver produced non-finite pressure or gap (NaN/inf)",
-            iterations=out.iterations,
-            residual=out.residual,
-            tol=tol,
-            residual_history=out.history,
-        )
+    _check_finite("solver", out, tol)
     contact = p > 0
     total = float(p.sum()) * spacing**2
     if check_boundary and not periodic:
@@ -353,6 +346,19 @@ def _solve(
         heights=h,
         info=info,
     )
+
+
+def _check_finite(what, outcome, tol):
+    """Raise ConvergenceError when a solve's pressure or gap holds NaN or inf (never return
+    them)."""
+    if not (np.isfinite(outcome.pressure).all() and np.isfinite(outcome.gap).all()):
+        raise ConvergenceError(
+            f"{what} produced non-finite pressure or gap (NaN/inf)",
+            iterations=outcome.iterations,
+            residual=outcome.residual,
+            tol=tol,
+            residual_history=outcome.history,
+        )
 
 
 def _check_free_boundary(p, contact, spacing):
@@ -442,14 +448,7 @@ def _solve_plastic(
         iterative=iterative,
     )
     p = state.pressure
-    if not (np.isfinite(p).all() and np.isfinite(state.gap).all()):
-        raise ConvergenceError(
-            "plastic solve produced non-finite pressure or gap (NaN/inf)",
-            iterations=state.iterations,
-            residual=state.residual,
-            tol=tol,
-            residual_history=state.history,
-        )
+    _check_finite("plastic solve", state, tol)
     contact = p > 0
     if not periodic:
         _check_free_boundary(p, contact, spacing)

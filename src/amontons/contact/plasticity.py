@@ -28,6 +28,7 @@ SI units: heights, gaps, plastic displacement in m; pressures and p_Y in Pa; k i
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import Literal
 
 import numpy as np
@@ -341,20 +342,21 @@ def solve_plastic(
         raise ContactInputError(
             "the iterative contact-hardening scheme needs over-relaxation alpha < 1; got 1"
         )
-    if isinstance(law, ContactHardening) and law.increment == "local" and not iterative:
-        return _hardening_winkler(
+    if isinstance(law, ContactHardening):
+        winkler = partial(
+            _hardening_winkler,
             operator,
             heights,
             pixel_area,
             h_scale,
             law.k,
             plastic_prev,
-            load=load,
-            displacement=displacement,
             p_init=p_init,
             tol=tol,
             max_iter=max_iter,
         )
+        if law.increment == "local" and not iterative:
+            return winkler(load=load, displacement=displacement)
     if isinstance(law, PenetrationHardness):
         p_y = np.broadcast_to(np.asarray(law.p_y, dtype=float), heights.shape)
 
@@ -396,19 +398,7 @@ def solve_plastic(
     span = float(np.ptp(heights)) or spacing
     if isinstance(law, ContactHardening):
         # the Winkler state is exact for local increments and close for volume-conserving ones
-        d_guess = _hardening_winkler(
-            operator,
-            heights,
-            pixel_area,
-            h_scale,
-            law.k,
-            plastic_prev,
-            load=load,
-            displacement=None,
-            p_init=p_init,
-            tol=tol,
-            max_iter=max_iter,
-        ).displacement
+        d_guess = winkler(load=load, displacement=None).displacement
     else:
         elastic = polonsky_keer(
             operator,
