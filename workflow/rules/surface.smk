@@ -30,3 +30,10 @@ rule measure_topography:
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_topography.py"
+
+
+rule surface:
+    """Target: the AFM topography of every sphere."""
+    input:
+        [f for m in MATERIALS for f in sphere_outputs(m, SURFACE_RESULTS)],
+    localrule: True
