@@ -384,10 +384,14 @@ def unchanged_level(change_m: np.ndarray, bin_m: float = 0.25e-9) -> float:
     scan noise.
     """
     low, high = np.percentile(change_m, [0.5, 99.5])
-    bins = max(8, int(np.ceil((high - low) / bin_m)))
+    if high - low < bin_m:
+        return float(np.median(change_m))  # nothing flowed: one narrow population
+    bins = int(np.ceil((high - low) / bin_m))
     counts, edges = np.histogram(change_m, bins=bins, range=(low, high))
     peak = int(np.argmax(counts))
-    return float(0.5 * (edges[peak] + edges[peak + 1]))
+    # the peak bin locates the population; its median places it to better than a bin
+    inside = change_m[(change_m >= edges[peak] - bin_m) & (change_m <= edges[peak + 1] + bin_m)]
+    return float(np.median(inside))
 
 
 def measure_topography(

@@ -7,6 +7,7 @@ import pytest
 
 from amontons.contact import (
     ContactHardening,
+    ContactInputError,
     ConvergenceError,
     FreeBoundaryError,
     PenetrationHardness,
@@ -259,3 +260,35 @@ def test_plastic_iteration_that_cannot_converge_raises():
     law = PenetrationHardness(50e6, increment="volume", alpha=0.5)
     with pytest.raises(ConvergenceError, match="plastic iteration"):
         solve(h, dx, E_STAR, load=1e-3, plasticity=law, max_outer=1)
+
+
+def test_load_beyond_the_window_at_the_hardness_is_an_input_error():
+    """Σ p_Y·Δx² is the most the window can carry; more is not a convergence problem."""
+    h, dx = rough_sphere(n=32)
+    p_y = 1e5
+    with pytest.raises(ContactInputError, match="needs more than the whole window"):
+        solve(h, dx, E_STAR, load=1.5 * p_y * h.size * dx**2, plasticity=PenetrationHardness(p_y))
+
+
+def test_load_controlled_appendix_schemes_reach_their_load():
+    """Warm starts from trial approaches exceed the fresh bound k·|h_pl| = 0; the bounded solve
+    clips them, so the root find on the approach meets the load (tolerance 1e-8 relative).
+    64² sphere, 2 nm noise: the reviewer's case."""
+    n, dx = 64, 1e-6
+    h = sphere((n, n), dx, 5e-3) + 2e-9 * np.random.default_rng(1).standard_normal((n, n))
+    for law, iterative in (
+        (ContactHardening(K_PMMA, alpha=0.5), True),
+        (ContactHardening(K_PMMA, increment="volume", alpha=0.5), False),
+    ):
+        res = solve(h, dx, 3e9, load=2e-3, plasticity=law, iterative=iterative)
+        assert res.load == pytest.approx(2e-3, rel=1e-8)
+
+
+def test_pile_up_history_is_refused_by_the_winkler_route():
+    h, dx = rough_sphere(n=32)
+    bump = np.zeros_like(h)
+    bump[16, 16] = 5e-9
+    with pytest.raises(ContactInputError, match="pile-up"):
+        solve(
+            h, dx, E_STAR, load=1e-5, plasticity=ContactHardening(K_PMMA), plastic_displacement=bump
+        )

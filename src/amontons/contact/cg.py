@@ -240,6 +240,9 @@ def polonsky_keer(
     p[:] = np.ravel(p_init)
     if p.min() < 0:
         raise ValueError("p_init must be >= 0")
+    if constraint.bounded:
+        # a warm start from another problem may exceed this one's bound; start admissible
+        np.minimum(p, constraint.p_max, out=p)
     calls = 0
 
     def conv(x, out):

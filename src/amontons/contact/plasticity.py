@@ -185,14 +185,19 @@ class _Found(Exception):
         self.state = state
 
 
-def _find_approach(evaluate, load, d_guess, d_step, load_tol):
+# Doubling steps allowed while bracketing the approach: 60 doublings of the first step span
+# 18 orders of magnitude, far beyond any contact.
+MAX_BRACKET_STEPS = 60
+
+
+def _find_approach(evaluate, load, d_guess, d_step, load_tol, load_atol=0.0):
     """The state at the root of load(d) = ``load``, for a continuous non-decreasing load(d).
 
     ``evaluate(d)`` returns (load, state). Brackets by doubling steps from ``d_guess``, then
     Brent's method (scipy), stopping early once the load is within ``load_tol`` (relative).
     Where load(d) is nearly a staircase (a fully plastic contact: one more pixel, p_Y·Δx² more
-    load), the closest state found is returned and its load differs from ``load`` by less
-    than one pixel's worth.
+    load), the closest state found is returned if its load is within ``load_atol`` (N, one
+    pixel's worth); otherwise, or when no bracket or root is found, ConvergenceError.
     """
     best = {"err": np.inf, "state": None}
 
@@ -205,23 +210,40 @@ def _find_approach(evaluate, load, d_guess, d_step, load_tol):
             raise _Found(state)
         return f - load
 
+    def failed(why):
+        state = best["state"]
+        return ConvergenceError(
+            f"load control of the plastic solve failed: {why}; closest load is "
+            f"{best['err']:.3e} N from {load:.3e} N",
+            iterations=0 if state is None else state.iterations,
+            residual=np.inf if state is None else state.residual,
+            tol=load_tol,
+            residual_history=np.empty(0) if state is None else state.history,
+        )
+
     try:
         d_lo = d_hi = d_guess
         f0 = residual(d_guess)
         step = d_step
-        if f0 < 0:
-            d_hi = d_guess + step
-            while residual(d_hi) < 0:
-                d_lo, step = d_hi, 2 * step
-                d_hi = d_hi + step
+        for _ in range(MAX_BRACKET_STEPS):
+            if f0 < 0:
+                d_lo, d_hi = d_hi, d_hi + step
+                if residual(d_hi) >= 0:
+                    break
+            else:
+                d_hi, d_lo = d_lo, d_lo - step
+                if residual(d_lo) < 0:
+                    break
+            step *= 2
         else:
-            d_lo = d_guess - step
-            while residual(d_lo) >= 0:
-                d_hi, step = d_lo, 2 * step
-                d_lo = d_lo - step
+            raise failed(f"no approach brackets the load after {MAX_BRACKET_STEPS} doublings")
         optimize.brentq(residual, d_lo, d_hi, xtol=1e-13 * d_step, rtol=1e-15, maxiter=200)
     except _Found as found:
         return found.state
+    except (ValueError, RuntimeError) as error:  # brentq: no sign change / no convergence
+        raise failed(str(error)) from error
+    if best["err"] > max(load_tol * load, load_atol):
+        raise failed("the load is not a continuous function of the approach here")
     return best["state"]
 
 
@@ -356,9 +378,23 @@ def solve_plastic(
             max_iter=max_iter,
         )
         if law.increment == "local" and not iterative:
+            if (plastic_prev > 0).any():
+                # pile-up only comes from volume-conserving increments, which the Winkler
+                # route does not model
+                raise ContactInputError(
+                    "plastic_displacement has pile-up (h_pl > 0, max "
+                    f"{plastic_prev.max():.3e} m), which the exact Winkler route of local "
+                    "increments cannot carry; use increment='volume' for pile-up"
+                )
             return winkler(load=load, displacement=displacement)
     if isinstance(law, PenetrationHardness):
         p_y = np.broadcast_to(np.asarray(law.p_y, dtype=float), heights.shape)
+        capacity = float(p_y.sum()) * pixel_area
+        if load is not None and load >= capacity:
+            raise ContactInputError(
+                f"load {load:.3e} N needs more than the whole window at the hardness "
+                f"(Σ p_Y·Δx² = {capacity:.3e} N); lower the load or enlarge the window"
+            )
 
         def bound(h_pl):
             return p_y
@@ -420,7 +456,9 @@ def solve_plastic(
         target_pixels = min(heights.size, max(1, int(load / (pixel_area * p_mean))))
         d_bearing = -float(np.sort((heights + plastic_prev).ravel())[::-1][target_pixels - 1])
         d_guess = max(elastic.rigid_displacement, d_bearing)
-    return _find_approach(evaluate, load, d_guess, 1e-3 * span, load_tol=tol)
+    # a fully plastic contact's load is a near-staircase in d: one pixel's worth is allowed
+    pixel_worth = float(np.max(bound(plastic_prev))) * pixel_area
+    return _find_approach(evaluate, load, d_guess, 1e-3 * span, load_tol=tol, load_atol=pixel_worth)
 
 
 def _elastic_state(out, plastic_prev):

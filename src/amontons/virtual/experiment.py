@@ -369,6 +369,11 @@ def write_flim(
 # --- one sphere ---------------------------------------------------------------------------------
 
 
+def _load_index(loads_n: list[float], load_n: float) -> int:
+    """Index of ``load_n`` in ``loads_n`` (matched to 1e-9 relative, as the checks do)."""
+    return next(i for i, f in enumerate(loads_n) if np.isclose(f, load_n, rtol=1e-9, atol=0))
+
+
 def _check_load_listed(sphere: str, what: str, load_n: float | None, loads_n: list[float]):
     if load_n is not None and not any(np.isclose(load_n, f, rtol=1e-9) for f in loads_n):
         raise ValueError(
@@ -473,7 +478,7 @@ def generate_sphere(
     )
     dx = solution.spacing_m
     largest = contact_radius_m(solution.results[-1].contact, dx)
-    reflection_index = next(i for i, f in enumerate(loads_n) if f == reflection_load_n)
+    reflection_index = _load_index(loads_n, reflection_load_n)
     reach = reach_radius_m(
         solution.results[reflection_index], ring_reach_gap(settings.reflection_rings)
     )

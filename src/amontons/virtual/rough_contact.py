@@ -190,7 +190,11 @@ def simulate_rough_sphere(
             log.info("window too small (%s); growing it", error)
             window *= WINDOW_GROWTH
             continue
-        reflected = next(r for r, f in zip(results, loads_n, strict=True) if f == reflection_load_n)
+        reflected = next(
+            r
+            for r, f in zip(results, loads_n, strict=True)
+            if np.isclose(f, reflection_load_n, rtol=1e-9, atol=0)
+        )
         reach = reach_radius_m(reflected, reach_gap)
         largest = contact_radius_m(results[-1].contact, dx)
         needed = settings.window_factor * 2 * max(reach, largest)
