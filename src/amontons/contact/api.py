@@ -317,7 +317,6 @@ def _solve(
     p = out.pressure
     _check_finite("solver", out, tol)
     contact = p > 0
-    total = float(p.sum()) * spacing**2
     if check_boundary and not periodic:
         _check_free_boundary(p, contact, spacing)
     info = {
@@ -329,19 +328,34 @@ def _solve(
         "tol": tol,
         "wall_time_s": time.perf_counter() - t0,
     }
+    return _finished(
+        h,
+        spacing,
+        periodic,
+        out,
+        elastic=out.displacement_field,
+        plastic=np.zeros_like(p),
+        displacement=out.rigid_displacement,
+        info=info,
+    )
+
+
+def _finished(h, spacing, periodic, outcome, *, elastic, plastic, displacement, info):
+    """The ContactResult of a converged solve (``outcome``: a CG or plastic state)."""
+    p = outcome.pressure
     return ContactResult(
         pressure=p,
-        gap=out.gap,
-        elastic_displacement=out.displacement_field,
-        plastic_displacement=np.zeros_like(p),
-        contact=contact,
-        load=total,
-        displacement=out.rigid_displacement,
+        gap=outcome.gap,
+        elastic_displacement=elastic,
+        plastic_displacement=plastic,
+        contact=p > 0,
+        load=float(p.sum()) * spacing**2,
+        displacement=displacement,
         spacing=spacing,
-        iterations=out.iterations,
-        residual=out.residual,
-        residual_history=out.history,
-        converged=out.converged,
+        iterations=outcome.iterations,
+        residual=outcome.residual,
+        residual_history=outcome.history,
+        converged=outcome.converged,
         periodic=periodic,
         heights=h,
         info=info,
@@ -461,21 +475,14 @@ def _solve_plastic(
         "tol": tol,
         "wall_time_s": time.perf_counter() - t0,
     }
-    return ContactResult(
-        pressure=p,
-        gap=state.gap,
-        elastic_displacement=state.elastic_displacement,
-        plastic_displacement=state.plastic_displacement,
-        contact=contact,
-        load=float(p.sum()) * spacing**2,
+    return _finished(
+        h,
+        spacing,
+        periodic,
+        state,
+        elastic=state.elastic_displacement,
+        plastic=state.plastic_displacement,
         displacement=state.displacement,
-        spacing=spacing,
-        iterations=state.iterations,
-        residual=state.residual,
-        residual_history=state.history,
-        converged=state.converged,
-        periodic=periodic,
-        heights=h,
         info=info,
     )
 
