@@ -15,7 +15,7 @@ from amontons.virtual.experiment import hertz_contact_state
 from amontons.virtual.fluorescence import FWHM_PER_SIGMA, render_fluorescence
 from amontons.virtual.rough_contact import (
     SolverSettings,
-    image_contact_state,
+    image_contact_states,
     simulate_rough_sphere,
 )
 from amontons.virtual.roughness import Roughness
@@ -43,10 +43,7 @@ def rough_states(request):
         rng_seed=2,
     )
     side = int(np.ceil(min(solution.window_m, 60e-6) / PIXEL)) // 2 * 2
-    return [
-        image_contact_state(solution, i, (side, side), PIXEL, with_gap=False, closing_m=FWHM / 2)
-        for i in range(2)
-    ]
+    return image_contact_states(solution, (side, side), PIXEL, gap_index=None, closing_m=FWHM / 2)
 
 
 def _signal(state, reference):

@@ -6,7 +6,7 @@ import pytest
 
 from amontons.virtual.rough_contact import (
     SolverSettings,
-    image_contact_state,
+    image_contact_states,
     simulate_rough_sphere,
     solver_grid,
 )
@@ -83,9 +83,9 @@ def test_image_grid_carries_the_load_and_the_area(solution, index):
     result = solution.results[index]
     pixel = 200e-9
     side = int(np.ceil(solution.window_m / pixel)) // 2 * 2
-    state = image_contact_state(
-        solution, index, (side, side), pixel, with_gap=True, closing_m=225e-9
-    )
+    state = image_contact_states(solution, (side, side), pixel, gap_index=index, closing_m=225e-9)[
+        index
+    ]
     assert state.pressure_pa.sum() * pixel**2 == pytest.approx(result.load, rel=0.02)
     assert state.contact.sum() * pixel**2 == pytest.approx(result.area, rel=0.05)
     assert state.area_m2 == result.area

@@ -66,6 +66,14 @@ def _default_max_iter(shape):
     return 1000 + 4 * (shape[0] + shape[1])
 
 
+def _start_pressure(h, spacing, e_star, load, displacement):
+    """Starting pressure (Pa) without a warm start: uniform under load control (the solver
+    rescales it to the load), the overlap guess under displacement control."""
+    if load is not None:
+        return np.ones_like(h)
+    return _initial_pressure(h, spacing, e_star, displacement)
+
+
 def _initial_pressure(h, spacing, e_star, displacement):
     """Starting pressure (Pa) for displacement control: a local-stiffness overlap guess."""
     overlap = np.maximum(h + displacement, 0.0)
@@ -295,10 +303,7 @@ def _solve(
             h, spacing, e_star, load, displacement, periodic, backend, threads, COARSE_MIN_SIZE, []
         )
     if p_init is None:
-        if load is not None:
-            p_init = np.ones_like(h)
-        else:
-            p_init = _initial_pressure(h, spacing, e_star, displacement)
+        p_init = _start_pressure(h, spacing, e_star, load, displacement)
     h_scale = float(np.std(h))
     if not h_scale > 0:
         h_scale = spacing  # a flat indenter: any length works, the gap is exactly 0
@@ -314,11 +319,9 @@ def _solve(
         max_iter=max_iter,
         raise_on_failure=raise_on_failure,
     )
-    p = out.pressure
     _check_finite("solver", out, tol)
-    contact = p > 0
     if check_boundary and not periodic:
-        _check_free_boundary(p, contact, spacing)
+        _check_free_boundary(out.pressure, spacing)
     info = {
         "convolutions": out.convolutions,
         "steepest_descent_resets": out.info["steepest_descent_resets"],
@@ -334,7 +337,7 @@ def _solve(
         periodic,
         out,
         elastic=out.displacement_field,
-        plastic=np.zeros_like(p),
+        plastic=np.zeros_like(out.pressure),
         displacement=out.rigid_displacement,
         info=info,
     )
@@ -375,8 +378,9 @@ def _check_finite(what, outcome, tol):
         )
 
 
-def _check_free_boundary(p, contact, spacing):
+def _check_free_boundary(p, spacing):
     """Raise FreeBoundaryError when pressure reaches the outermost ring of the window."""
+    contact = p > 0
     edge = np.zeros_like(contact)
     edge[0, :] = edge[-1, :] = edge[:, 0] = edge[:, -1] = True
     on_edge = contact & edge
@@ -442,10 +446,7 @@ def _solve_plastic(
     op = get_operator(h.shape, spacing, e_star, periodic=periodic, backend=backend, threads=threads)
     p_init = warm_start
     if p_init is None:
-        if load is not None:
-            p_init = np.ones_like(h)
-        else:
-            p_init = _initial_pressure(h + plastic_prev, spacing, e_star, displacement)
+        p_init = _start_pressure(h + plastic_prev, spacing, e_star, load, displacement)
     state = solve_plastic(
         op,
         h,
@@ -461,11 +462,9 @@ def _solve_plastic(
         max_outer=max_outer,
         iterative=iterative,
     )
-    p = state.pressure
     _check_finite("plastic solve", state, tol)
-    contact = p > 0
     if not periodic:
-        _check_free_boundary(p, contact, spacing)
+        _check_free_boundary(state.pressure, spacing)
     info = {
         "convolutions": state.convolutions,
         "outer_iterations": state.outer_iterations,

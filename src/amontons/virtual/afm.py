@@ -12,7 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from amontons.images import write_image
 
@@ -26,16 +25,6 @@ class AfmSettings:
     noise_m: float
     line_offsets: int
     line_offset_m: float
-
-
-def resample(field: np.ndarray, spacing_m: float, rows_m: np.ndarray, cols_m: np.ndarray, order):
-    """``field`` (on a grid of ``spacing_m`` about its centre) at the positions (m) given by
-    the outer product of ``rows_m`` and ``cols_m``; cubic (order 3) or bilinear (order 1)."""
-    n0, n1 = field.shape
-    r = (n0 - 1) / 2 + rows_m / spacing_m
-    c = (n1 - 1) / 2 + cols_m / spacing_m
-    rr, cc = np.meshgrid(r, c, indexing="ij")
-    return ndimage.map_coordinates(field, [rr, cc], order=order, mode="nearest")
 
 
 def scan_artefacts(shape, settings: AfmSettings, rng: np.random.Generator) -> np.ndarray:

@@ -41,10 +41,11 @@ from amontons.rawdata import (
 )
 from amontons.surface import roughness_statistics
 from amontons.virtual.absorbance import absorbance_spectrum, write_absorbance_csv
-from amontons.virtual.afm import AfmSettings, resample, scan_artefacts, write_afm
+from amontons.virtual.afm import AfmSettings, scan_artefacts, write_afm
 from amontons.virtual.bead import render_bead
 from amontons.virtual.flim import render_flim
 from amontons.virtual.fluorescence import pixel_averaged, render_fluorescence
+from amontons.virtual.grid import resample
 from amontons.virtual.reflection import (
     N_FORMAMIDE,
     WAVELENGTH_M,
@@ -59,12 +60,11 @@ from amontons.virtual.rough_contact import (
     SolverSettings,
     contact_radius_m,
     edge_radius_m,
-    image_contact_state,
-    reach_radius_m,
-    ring_reach_gap,
+    image_contact_states,
     simulate_rough_sphere,
 )
 from amontons.virtual.roughness import Roughness, synthesize
+from amontons.virtual.state import ContactState, load_index
 
 log = logging.getLogger(__name__)
 
@@ -158,28 +158,6 @@ class SurfaceSettings:
                 line_offset_m=settings["afm_line_offset_nm"] * 1e-9,
             ),
         )
-
-
-@dataclass(frozen=True)
-class ContactState:
-    """One load's contact on the image grid (origin at the image centre, square pixels).
-
-    ``pressure_pa``: pressure averaged over each pixel (Pa); ``sqrt_pressure``: √p averaged
-    over each pixel (√Pa; what the fluorescence sums, since each molecule responds to its
-    local pressure); ``gap_m``: gap at pixel centres
-    (m, 0 in contact; None where no instrument needs it); ``contact``: pixels in contact;
-    ``area_m2``: the true contact area; ``edge_gap_m``: the average gap at the contact edge
-    (m), what the Newton rings extrapolate to (None with ``gap_m``).
-    """
-
-    load_n: float
-    pressure_pa: np.ndarray
-    sqrt_pressure: np.ndarray
-    gap_m: np.ndarray | None
-    contact: np.ndarray
-    area_m2: float
-    edge_gap_m: float | None
-    centre_px: tuple[float, float]
 
 
 def instrument_rng(seed: int, sphere: str, instrument: str) -> np.random.Generator:
@@ -369,13 +347,8 @@ def write_flim(
 # --- one sphere ---------------------------------------------------------------------------------
 
 
-def _load_index(loads_n: list[float], load_n: float) -> int:
-    """Index of ``load_n`` in ``loads_n`` (matched to 1e-9 relative, as the checks do)."""
-    return next(i for i, f in enumerate(loads_n) if np.isclose(f, load_n, rtol=1e-9, atol=0))
-
-
 def _check_load_listed(sphere: str, what: str, load_n: float | None, loads_n: list[float]):
-    if load_n is not None and not any(np.isclose(load_n, f, rtol=1e-9) for f in loads_n):
+    if load_n is not None and load_index(loads_n, load_n) is None:
         raise ValueError(
             f"{sphere}: {what} load {load_n * 1e3:g} mN is not one of the loads "
             f"{[f * 1e3 for f in loads_n]} mN"
@@ -478,23 +451,20 @@ def generate_sphere(
     )
     dx = solution.spacing_m
     largest = contact_radius_m(solution.results[-1].contact, dx)
-    reflection_index = _load_index(loads_n, reflection_load_n)
-    reach = reach_radius_m(
-        solution.results[reflection_index], ring_reach_gap(settings.reflection_rings)
-    )
     side = max(
         field_of_view_px(largest, pixel_m, settings.field_of_view_factor),
-        int(32 * np.ceil(2 * reach / pixel_m / 32)),
+        int(32 * np.ceil(2 * solution.ring_reach_m / pixel_m / 32)),
     )
     # the solver window holds both with a margin (simulate_rough_sphere); never look past it
     side = min(side, int(solution.window_m / pixel_m) // 32 * 32)
     closing = settings.psf_fwhm_m / 2
-    states = [
-        image_contact_state(
-            solution, i, (side, side), pixel_m, with_gap=i == reflection_index, closing_m=closing
-        )
-        for i in range(len(loads_n))
-    ]
+    states = image_contact_states(
+        solution,
+        (side, side),
+        pixel_m,
+        gap_index=load_index(loads_n, reflection_load_n),
+        closing_m=closing,
+    )
     truth = write_instruments(
         out_dir,
         sphere=sphere,
@@ -562,7 +532,7 @@ def mean_intensity_exponent(states: list[ContactState], pixel_m: float) -> float
 
 
 def _matching(states: list[ContactState], load_n: float) -> ContactState:
-    return next(s for s in states if np.isclose(s.load_n, load_n, rtol=1e-9))
+    return states[load_index([s.load_n for s in states], load_n)]
 
 
 def write_instruments(

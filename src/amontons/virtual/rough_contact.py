@@ -11,7 +11,7 @@ side), separate from the AFM pixel and from the image pixel. Its window holds th
 contact and the Newton rings of the reflection load with a margin; a solve whose contact
 reaches the window edge, or whose rings fall outside it, is repeated on a larger window.
 
-:func:`image_contact_state` maps one load's solution onto an instrument's pixel grid (the
+:func:`image_contact_states` maps the solution onto an instrument's pixel grid (the
 ContactState every instrument of :mod:`amontons.virtual.experiment` reads).
 """
 
@@ -27,9 +27,10 @@ from scipy import ndimage
 from amontons import hertz
 from amontons.contact import ContactHardening, ContactResult, FreeBoundaryError, solve_load_series
 from amontons.contact.surfaces import sphere as sphere_cap
-from amontons.virtual.fluorescence import pixel_averaged
+from amontons.virtual.grid import PixelAverager, resample
 from amontons.virtual.reflection import N_FORMAMIDE, WAVELENGTH_M, ring_gap
 from amontons.virtual.roughness import Roughness, synthesize
+from amontons.virtual.state import ContactState, load_index
 
 log = logging.getLogger(__name__)
 
@@ -55,13 +56,16 @@ class RoughSphereSolution:
     """The rough sphere's load series on the solver grid (apex at the window centre).
 
     ``heights``: indenter heights (m, larger = closer to the glass); ``roughness``: the
-    roughness part of them (m); ``results``: one ContactResult per load (SI units).
+    roughness part of them (m); ``results``: one ContactResult per load (SI units);
+    ``ring_reach_m``: the radius (m) within which the reflection load's image holds its
+    Newton rings.
     """
 
     heights: np.ndarray
     roughness: np.ndarray
     spacing_m: float
     results: list[ContactResult]
+    ring_reach_m: float
 
     @property
     def centre_px(self) -> tuple[float, float]:
@@ -190,37 +194,17 @@ def simulate_rough_sphere(
             log.info("window too small (%s); growing it", error)
             window *= WINDOW_GROWTH
             continue
-        reflected = next(
-            r
-            for r, f in zip(results, loads_n, strict=True)
-            if np.isclose(f, reflection_load_n, rtol=1e-9, atol=0)
-        )
-        reach = reach_radius_m(reflected, reach_gap)
+        reach = reach_radius_m(results[load_index(loads_n, reflection_load_n)], reach_gap)
         largest = contact_radius_m(results[-1].contact, dx)
         needed = settings.window_factor * 2 * max(reach, largest)
         if needed <= n * dx:
-            return RoughSphereSolution(heights, rough, dx, results)
+            return RoughSphereSolution(heights, rough, dx, results, reach)
         log.info("rings or contact reach %.1f µm beyond the window; growing it", needed * 1e6)
         window = max(needed, window * WINDOW_GROWTH)
     raise RuntimeError(
         f"no solver window held the contact and the Newton rings after {MAX_WINDOW_ATTEMPTS} "
         f"attempts (last {window * 1e6:.0f} µm); raise solver_max_grid_px or lower the loads"
     )
-
-
-def _lookup(field: np.ndarray, spacing_m: float, order: int):
-    """field(x, y) at positions in m about the window centre; 0 outside the window."""
-    n0, n1 = field.shape
-
-    def at(x, y):
-        xx, yy = np.broadcast_arrays(x, y)
-        rows = (n0 - 1) / 2 + yy / spacing_m
-        cols = (n1 - 1) / 2 + xx / spacing_m
-        return ndimage.map_coordinates(
-            field, [rows.ravel(), cols.ravel()], order=order, mode="constant", cval=0.0
-        ).reshape(xx.shape)
-
-    return at
 
 
 def edge_radius_m(contact: np.ndarray, spacing_m: float, closing_m: float) -> float:
@@ -236,46 +220,46 @@ def edge_radius_m(contact: np.ndarray, spacing_m: float, closing_m: float) -> fl
     return float(np.sqrt(envelope.sum() * spacing_m**2 / np.pi))
 
 
-def image_contact_state(
+def image_contact_states(
     solution: RoughSphereSolution,
-    index: int,
     shape: tuple[int, int],
     pixel_m: float,
     *,
-    with_gap: bool,
+    gap_index: int | None,
     closing_m: float,
-):
-    """Load ``index`` of the solution on an image grid (image centre = sphere apex).
+) -> list[ContactState]:
+    """Every load of the solution on an image grid (image centre = sphere apex).
 
-    Pressure: averaged over each image pixel (4×4 sub-samples of the solver field, nearest
-    solver pixel, so patch edges keep their covered fraction); contact: pixels more than half
-    covered by contact; area: the solver's true contact area. Gap (only when ``with_gap``:
-    the reflection image is the one instrument that needs it): bilinear at pixel centres.
-    The edge gap is the azimuthal mean gap at :func:`edge_radius_m` - the average local gap
-    the Newton rings measure, at the edge a thresholded fluorescence image shows.
+    Pressure and √p: averaged over each image pixel (:class:`PixelAverager`: 4×4
+    sub-samples, nearest solver pixel, so patch edges keep their covered fraction); contact:
+    pixels more than half covered by contact; area: the solver's true contact area. Gap, at
+    load ``gap_index`` only (the reflection image is the one instrument that needs it):
+    bilinear at pixel centres. The edge gap is the azimuthal mean gap at
+    :func:`edge_radius_m` - the average local gap the Newton rings measure, at the edge a
+    thresholded fluorescence image shows.
     """
-    from amontons.virtual.experiment import ContactState  # the instruments' view
-
-    result = solution.results[index]
     dx = solution.spacing_m
-    pressure = pixel_averaged(_lookup(result.pressure, dx, order=0), shape, pixel_m)
-    sqrt_pressure = pixel_averaged(_lookup(np.sqrt(result.pressure), dx, order=0), shape, pixel_m)
-    covered = pixel_averaged(_lookup(result.contact.astype(float), dx, order=0), shape, pixel_m)
+    average = PixelAverager(solution.heights.shape, dx, shape, pixel_m)
     centre = ((shape[0] - 1) / 2, (shape[1] - 1) / 2)
-    gap = edge_gap = None
-    if with_gap:
-        rows, cols = np.indices(shape)
-        at = _lookup(result.gap, dx, order=1)
-        gap = np.maximum(at((cols - centre[1]) * pixel_m, (rows - centre[0]) * pixel_m), 0.0)
-        r_edge = edge_radius_m(result.contact, dx, closing_m)
-        edge_gap = float(azimuthal_mean(result.gap, dx, np.array([r_edge]))[0])
-    return ContactState(
-        load_n=float(result.load),
-        pressure_pa=pressure,
-        sqrt_pressure=sqrt_pressure,
-        gap_m=gap,
-        contact=covered > 0.5,
-        area_m2=result.area,
-        edge_gap_m=edge_gap,
-        centre_px=centre,
-    )
+    states = []
+    for index, result in enumerate(solution.results):
+        gap = edge_gap = None
+        if index == gap_index:
+            rows_m = (np.arange(shape[0]) - centre[0]) * pixel_m
+            cols_m = (np.arange(shape[1]) - centre[1]) * pixel_m
+            gap = np.maximum(resample(result.gap, dx, rows_m, cols_m, 1, "constant"), 0.0)
+            r_edge = edge_radius_m(result.contact, dx, closing_m)
+            edge_gap = float(azimuthal_mean(result.gap, dx, np.array([r_edge]))[0])
+        states.append(
+            ContactState(
+                load_n=float(result.load),
+                pressure_pa=average(result.pressure),
+                sqrt_pressure=average(np.sqrt(result.pressure)),
+                gap_m=gap,
+                contact=average(result.contact) > 0.5,
+                area_m2=result.area,
+                edge_gap_m=edge_gap,
+                centre_px=centre,
+            )
+        )
+    return states
