@@ -6,6 +6,10 @@ from pathlib import Path
 if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
+# The same seed must give the same files in every run: FFTW_MEASURE picks its algorithm by
+# timing, so round-off (and the plastic field, and afm_after.tif) changed from run to run;
+# FFTW_ESTIMATE plans the same way every time (measured: byte-identical files).
+os.environ.setdefault("AMONTONS_FFTW_EFFORT", "FFTW_ESTIMATE")
 
 from amontons.runlog import run_logged
 from amontons.virtual.experiment import InstrumentSettings, SurfaceSettings, generate_sphere
