@@ -1,10 +1,11 @@
 """Otsu contact area against the virtual experiment's truth (issue 6).
 
-The fluorescence of a contact is ∝ √p (appendix Fig. B.4), so its rim is dim: Otsu's
-threshold, half-way between the background and the contact populations, leaves the dimmest
-contact out even in a perfect image. These tests pin down what the measurement does
-(against the same map rendered without noise) and how far the appendix's method is from
-the true area (the analytic rim loss of a Hertz contact)."""
+The probe's emission is √max(p, p_c) in contact (amontons.virtual.fluorescence). The
+virtual experiment's default is the appendix's bare √p law (p_c = 0), which fades to the
+background at every rim, and Otsu leaves that rim out. With a confinement floor (here
+p_c = 50 MPa) a smooth contact is recovered to < 1 % by Otsu in a perfect image, and what is
+left on a rough contact is pixelisation (patches a few 200 nm pixels wide). These tests pin
+down each effect with the number it was measured at."""
 
 import numpy as np
 import pytest
@@ -20,13 +21,14 @@ from amontons.virtual.rough_contact import (
 )
 from amontons.virtual.roughness import Roughness
 
-PIXEL, FWHM, BACKGROUND, COUNTS = 200e-9, 450e-9, 120.0, 1500.0
+PIXEL, FWHM, BACKGROUND, COUNTS, FLOOR = 200e-9, 450e-9, 120.0, 1500.0, 50e6
+SIGMA_PX = FWHM / FWHM_PER_SIGMA / PIXEL
 
 
 @pytest.fixture(scope="module", params=["PS", "glass"])
-def rough_states(request):
+def rough_solution(request):
     """A rough PS sphere (80 nm, k = 5 MPa/nm) and a 3 nm rough glass sphere at 25 and
-    200 mN, on 200 nm image pixels (solver grid 256 nm, the small-data setting)."""
+    200 mN (solver grid 256 nm, the small-data setting)."""
     radius, e_star, rms, k = {
         "PS": (0.3e-3, 3.7e9, 80e-9, 5e15),
         "glass": (2e-3, 32.8e9, 3e-9, 1e19),
@@ -42,23 +44,36 @@ def rough_states(request):
         settings=SolverSettings(256e-9, 512, 1.3),
         rng_seed=2,
     )
+    return request.param, solution
+
+
+def _states(solution, floor):
+    """The solution on 200 nm image pixels with the given confinement floor."""
     side = int(np.ceil(min(solution.window_m, 60e-6) / PIXEL)) // 2 * 2
-    return image_contact_states(solution, (side, side), PIXEL, gap_index=None, closing_m=FWHM / 2)
+    return image_contact_states(
+        solution,
+        (side, side),
+        PIXEL,
+        gap_index=None,
+        closing_m=FWHM / 2,
+        confinement_floor_pa=floor,
+    )
 
 
 def _signal(state, reference):
-    """Expected counts above background: √p scaled so the smallest load's mean pressure
-    gives COUNTS (as the virtual experiment does)."""
-    return COUNTS / np.sqrt(reference.load_n / reference.area_m2) * state.sqrt_pressure
+    """Expected counts above background, scaled so the smallest load's mean pressure gives
+    COUNTS (as the virtual experiment does)."""
+    return COUNTS / np.sqrt(reference.load_n / reference.area_m2) * state.emission_sqrt_pa
 
 
-def test_otsu_area_equals_the_noise_free_blurred_truth_within_2_percent(rough_states):
+@pytest.mark.parametrize("floor", [0.0, FLOOR])
+def test_otsu_area_equals_the_noise_free_blurred_truth_within_2_percent(rough_solution, floor):
     """Issue 6: the Otsu area of the noisy image equals that of the true map blurred by the
-    same PSF and thresholded the same way within 2 % (measured: 0.1-0.5 %): shot noise does
-    not move Otsu's threshold."""
-    sigma_px = FWHM / FWHM_PER_SIGMA / PIXEL
-    for seed, state in enumerate(rough_states):
-        signal = _signal(state, rough_states[0])
+    same PSF and thresholded the same way within 2 % (measured: 0.0-0.6 %, either emission
+    law): shot noise does not move Otsu's threshold."""
+    states = _states(rough_solution[1], floor)
+    for seed, state in enumerate(states):
+        signal = _signal(state, states[0])
         noisy = render_fluorescence(
             signal,
             PIXEL,
@@ -66,23 +81,63 @@ def test_otsu_area_equals_the_noise_free_blurred_truth_within_2_percent(rough_st
             background_counts=BACKGROUND,
             rng=np.random.default_rng(seed),
         )
-        clean = gaussian_filter(signal, sigma_px, mode="constant") + BACKGROUND
+        clean = gaussian_filter(signal, SIGMA_PX, mode="constant") + BACKGROUND
         measured = otsu_contact_area(noisy, PIXEL).area_m2
         reference = otsu_contact_area(clean, PIXEL).area_m2
         assert measured == pytest.approx(reference, rel=0.02)
 
 
+@pytest.mark.parametrize("load", [25e-3, 100e-3, 300e-3])
+def test_otsu_area_of_a_perfect_image_of_a_smooth_contact_is_the_true_area_within_1_percent(load):
+    """Issue 6: with PSF and noise off, Otsu's area equals the true area within 1 % for the
+    smooth glass sphere (measured −0.4 to −0.6 %: the rim pixels that the edge crosses)."""
+    state = hertz_contact_state(load, 2e-3, 32.8e9, (320, 320), PIXEL, confinement_floor_pa=FLOOR)
+    area = otsu_contact_area(_signal(state, state) + BACKGROUND, PIXEL)
+    assert area.area_m2 == pytest.approx(state.area_m2, rel=0.01)
+
+
+def test_otsu_area_of_a_perfect_image_of_a_rough_contact_is_pixelised(rough_solution):
+    """With PSF and noise off, a rough contact's Otsu area is 2-7 % below the true area
+    (measured: glass −2.3 to −2.6 %, PS −3.8 to −5.5 %): patches a few pixels wide lose
+    the pixels their edges only partly cover. The issue's 1 % is out of reach at 200 nm
+    pixels for these contacts (closing note); the bound here is the measured band ± 1 %
+    and a loss, never a gain."""
+    name, solution = rough_solution
+    low = {"PS": 0.93, "glass": 0.965}[name]
+    states = _states(solution, FLOOR)
+    for state in states:
+        ratio = otsu_contact_area(_signal(state, states[0]) + BACKGROUND, PIXEL).area_m2
+        assert low < ratio / state.area_m2 < 0.99
+
+
 @pytest.mark.parametrize("load", [25e-3, 300e-3])
-def test_otsu_without_psf_and_noise_loses_the_dim_rim_of_a_hertz_contact(load):
-    """Without PSF and noise, Otsu's area is the true area less the rim where √p is below the
-    threshold: with √p ∝ (1 − r²/a²)^(1/4) and τ = threshold/(peak signal), the kept
-    fraction is 1 − τ⁴. Measured −3 % for the smooth glass sphere, so the issue's "within
-    1 % of the true area" is out of reach for Otsu on a √p image (see the closing note); the
-    test asserts the analytic loss to 0.5 % (pixelisation of the rim)."""
+def test_otsu_without_confinement_floor_loses_the_dim_rim_of_a_hertz_contact(load):
+    """The bare √p law (p_c = 0): without PSF and noise, Otsu's area is the true area less the
+    rim where √p is below the threshold: with √p ∝ (1 − r²/a²)^(1/4) and τ = threshold/(peak
+    signal), the kept fraction is 1 − τ⁴ (measured −3 %); asserted to 0.5 % (pixelisation of
+    the rim)."""
     state = hertz_contact_state(load, 2e-3, 32.8e9, (320, 320), PIXEL)
     signal = _signal(state, state)
     area = otsu_contact_area(signal + BACKGROUND, PIXEL)
-    peak = signal.max()
-    tau = (area.threshold - BACKGROUND) / peak
+    tau = (area.threshold - BACKGROUND) / signal.max()
     assert area.area_m2 / state.area_m2 == pytest.approx(1 - tau**4, abs=0.005)
-    assert 0.95 < area.area_m2 / state.area_m2 < 0.99  # the loss the closing note reports
+    assert 0.95 < area.area_m2 / state.area_m2 < 0.99
+
+
+def test_confinement_floor_keeps_the_rim_of_a_rough_contact(rough_solution):
+    """The floor is what makes the Otsu area track the true area on a rough sphere: the
+    same noisy image with p_c = 0 loses 5-17 % of the true area (measured: glass 5-8 %, PS
+    13-16 %), with the floor at most 11 % (glass 0.2-3.5 %, PS 6-10 %)."""
+    solution = rough_solution[1]
+    for floor, low in ((0.0, 0.8), (FLOOR, 0.89)):
+        states = _states(solution, floor)
+        for seed, state in enumerate(states):
+            noisy = render_fluorescence(
+                _signal(state, states[0]),
+                PIXEL,
+                psf_fwhm_m=FWHM,
+                background_counts=BACKGROUND,
+                rng=np.random.default_rng(seed),
+            )
+            ratio = otsu_contact_area(noisy, PIXEL).area_m2 / state.area_m2
+            assert low < ratio < (0.96 if floor == 0.0 else 1.0)

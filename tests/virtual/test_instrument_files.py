@@ -10,6 +10,7 @@ from amontons.optics.newton_rings import newton_ring_gap
 from amontons.optics.psf import measure_psf
 from amontons.virtual.bead import render_bead
 from amontons.virtual.flim import render_flim
+from amontons.virtual.fluorescence import confined_emission
 from amontons.virtual.reflection import hertz_gap, radial_gap_map, render_reflection
 
 PIXEL = 200e-9
@@ -58,3 +59,15 @@ def test_flim_tif_round_trip(tmp_path):
     assert read.data.dtype == np.float32
     # 1256 contact pixels with 0.1 ns noise: standard error 0.003 ns, so 0.01 ns is > 3 σ.
     assert lifetime_statistics(read.data, mask).inside_mean_ns == pytest.approx(1.3, abs=0.01)
+
+
+def test_confined_emission_is_root_pressure_above_the_floor_and_dark_outside():
+    """√max(p, p_c) in contact (√Pa), 0 outside; p_c = 0 is the bare √p law."""
+    pressure = np.array([0.0, 1e6, 100e6, 0.0])
+    contact = np.array([True, True, True, False])
+    bare = confined_emission(pressure, contact, 0.0)
+    np.testing.assert_allclose(bare, [0.0, 1e3, 1e4, 0.0])
+    floored = confined_emission(pressure, contact, 25e6)
+    np.testing.assert_allclose(floored, [5e3, 5e3, 1e4, 0.0])
+    with pytest.raises(ValueError, match="negative"):
+        confined_emission(pressure, contact, -1.0)

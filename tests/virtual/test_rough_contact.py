@@ -83,9 +83,14 @@ def test_image_grid_carries_the_load_and_the_area(solution, index):
     result = solution.results[index]
     pixel = 200e-9
     side = int(np.ceil(solution.window_m / pixel)) // 2 * 2
-    state = image_contact_states(solution, (side, side), pixel, gap_index=index, closing_m=225e-9)[
-        index
-    ]
+    state = image_contact_states(
+        solution,
+        (side, side),
+        pixel,
+        gap_index=index,
+        closing_m=225e-9,
+        confinement_floor_pa=50e6,
+    )[index]
     assert state.pressure_pa.sum() * pixel**2 == pytest.approx(result.load, rel=0.02)
     assert state.contact.sum() * pixel**2 == pytest.approx(result.area, rel=0.05)
     assert state.area_m2 == result.area

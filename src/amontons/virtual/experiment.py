@@ -3,8 +3,9 @@
 Two halves, kept apart on purpose:
 
 1. *The contact state* per load — a pressure map, a gap map and a contact mask on the
-   fluorescence image grid (``ContactState``). For now it is a smooth Hertzian sphere
-   (``hertz_contact_state``); the rough-sphere contact solver will provide the same object.
+   fluorescence image grid (``ContactState``): the rough sphere under contact hardening
+   (``rough_contact.image_contact_states``), or a smooth Hertz sphere
+   (``hertz_contact_state``) where a test needs an analytic contact.
 2. *The instruments*, each a function that takes a contact state (or nothing of it) and writes
    one file of the raw-data layout (amontons.rawdata): ``write_fluorescence``,
    ``write_reflection``, ``write_bead``, ``write_absorbance``, ``write_rheometer``,
@@ -44,7 +45,7 @@ from amontons.virtual.absorbance import absorbance_spectrum, write_absorbance_cs
 from amontons.virtual.afm import AfmSettings, scan_artefacts, write_afm
 from amontons.virtual.bead import render_bead
 from amontons.virtual.flim import render_flim
-from amontons.virtual.fluorescence import pixel_averaged, render_fluorescence
+from amontons.virtual.fluorescence import confined_emission, pixel_averaged, render_fluorescence
 from amontons.virtual.grid import resample
 from amontons.virtual.reflection import (
     N_FORMAMIDE,
@@ -87,6 +88,7 @@ class InstrumentSettings:
     psf_fwhm_m: float
     background_counts: float
     contact_counts: float
+    confinement_floor_pa: float
     field_of_view_factor: float
     reflection_counts: float
     reflection_contrast: float
@@ -111,6 +113,7 @@ class InstrumentSettings:
             psf_fwhm_m=settings["psf_fwhm_nm"] * 1e-9,
             background_counts=settings["background_counts"],
             contact_counts=settings["contact_counts"],
+            confinement_floor_pa=settings["confinement_floor_mpa"] * 1e6,
             field_of_view_factor=settings["field_of_view_factor"],
             reflection_counts=settings["reflection_counts"],
             reflection_contrast=settings["reflection_contrast"],
@@ -181,12 +184,14 @@ def hertz_contact_state(
     shape: tuple[int, int],
     pixel_m: float,
     edge_gap_m: float = 0.0,
+    confinement_floor_pa: float = 0.0,
 ) -> ContactState:
     """Contact state of a smooth Hertz sphere (Johnson 1985 §4.2) at the image centre.
 
     ``edge_gap_m`` lifts the gap outside the contact by a constant: a stand-in for the average
     local gap that roughness leaves at the fluorescent edge (the appendix measures ≤ 9 nm),
-    so that the Newton-ring measurement has a non-zero truth to recover.
+    so that the Newton-ring measurement has a non-zero truth to recover. The emission is
+    :func:`confined_emission` with ``confinement_floor_pa``.
     """
     centre = ((shape[0] - 1) / 2, (shape[1] - 1) / 2)
     a = hertz.contact_radius(load_n, radius_m, e_star_pa)
@@ -202,7 +207,13 @@ def hertz_contact_state(
     return ContactState(
         load_n=load_n,
         pressure_pa=pixel_averaged(pressure, shape, pixel_m),
-        sqrt_pressure=pixel_averaged(lambda x, y: np.sqrt(pressure(x, y)), shape, pixel_m),
+        emission_sqrt_pa=pixel_averaged(
+            lambda x, y: confined_emission(
+                pressure(x, y), np.hypot(x, y) <= a, confinement_floor_pa
+            ),
+            shape,
+            pixel_m,
+        ),
         gap_m=radial_gap_map(shape, pixel_m, centre, gap),
         contact=contact,
         area_m2=float(np.pi * a**2),
@@ -222,8 +233,9 @@ def write_fluorescence(
     settings: InstrumentSettings,
     rng: np.random.Generator,
 ) -> None:
-    """Confocal image: local intensity ∝ √pressure (appendix Fig. B.4), PSF, background, noise."""
-    signal = counts_per_sqrt_pa * state.sqrt_pressure
+    """Confocal image: local intensity ∝ the probe's emission (√max(p, p_c) in contact,
+    appendix Fig. B.4), PSF, background, noise."""
+    signal = counts_per_sqrt_pa * state.emission_sqrt_pa
     image = render_fluorescence(
         signal,
         pixel_m,
@@ -429,8 +441,9 @@ def generate_sphere(
     The contact is a rough sphere under contact hardening (amontons.virtual.rough_contact),
     solved once per load on the solver grid and seen by each instrument on its own grid.
     ``contact_counts`` (settings) is the expected signal at the mean contact pressure of the
-    smallest load; the signal scales as √p. Static friction is ``shear_strength_pa`` × the true
-    contact area at each load (F_f = τ·A); dynamic friction is ``dynamic_fraction`` of it.
+    smallest load; the signal scales as √max(p, p_c) in contact (p_c: the settings'
+    ``confinement_floor_pa``). Static friction is ``shear_strength_pa`` × the true contact
+    area at each load (F_f = τ·A); dynamic friction is ``dynamic_fraction`` of it.
     """
     out_dir = Path(out_dir)
     radius_m = diameter_m / 2
@@ -464,6 +477,7 @@ def generate_sphere(
         pixel_m,
         gap_index=load_index(loads_n, reflection_load_n),
         closing_m=closing,
+        confinement_floor_pa=settings.confinement_floor_pa,
     )
     truth = write_instruments(
         out_dir,
@@ -521,10 +535,10 @@ def generate_sphere(
 
 
 def mean_intensity_exponent(states: list[ContactState], pixel_m: float) -> float:
-    """Power-law exponent of the true mean contact intensity (Σ√p·Δx²/A, √Pa) versus the
-    true mean pressure F/A over the load series: the quantity the intensity-pressure
+    """Power-law exponent of the true mean contact intensity (Σ emission·Δx²/A, √Pa) versus
+    the true mean pressure F/A over the load series: the quantity the intensity-pressure
     measurement estimates from the images."""
-    intensity = [s.sqrt_pressure.sum() * pixel_m**2 / s.area_m2 for s in states]
+    intensity = [s.emission_sqrt_pa.sum() * pixel_m**2 / s.area_m2 for s in states]
     pressure = [s.load_n / s.area_m2 for s in states]
     return fit_power_law(
         np.array(pressure), np.array(intensity), x_ref=pressure[0]
@@ -617,10 +631,12 @@ def write_instruments(
         "psf_fwhm_nm": settings.psf_fwhm_m * 1e9,
         "background_counts": settings.background_counts,
         "local_intensity_pressure_exponent": 0.5,
+        "confinement_floor_mpa": settings.confinement_floor_pa * 1e-6,
         "intensity_pressure_exponent": mean_intensity_exponent(states, pixel_m),
         "intensity_pressure_definition": "exponent of the true mean contact intensity "
-        "(sum of the pixel-averaged sqrt(p) over the true area) versus the true mean pressure "
-        "F/A; the local law is I ~ p^0.5, a rough contact's mean follows its own exponent",
+        "(sum of the pixel-averaged emission sqrt(max(p, p_c)) over the true area) versus the "
+        "true mean pressure F/A; the local law is I ~ p^0.5 above the confinement floor p_c, "
+        "a rough contact's mean follows its own exponent",
         "bead_centre_nm": [c * 1e9 for c in bead_centre],
         "grafting_density_per_um2": density_per_um2,
         "absorbance_peak": peak,

@@ -1,7 +1,14 @@
 """Forward model of a confocal fluorescence image of a rigidochromic contact.
 
-Local intensity ∝ √(local pressure) inside the contact (appendix Fig. B.4), blurred by a
-Gaussian PSF, on a uniform background, with Poisson (shot) noise, written as 16-bit counts.
+Emission: molecules light up where they are confined in the contact, and brighten with the
+degree of confinement as √(local pressure) (appendix Fig. B.4). A molecule trapped in the
+contact is confined even where the contact pressure vanishes, so its brightness does not fall
+below that of a confinement floor p_c: emission ∝ √max(p, p_c) in contact, 0 outside. With
+p_c > 0 the contact and background populations hardly overlap and the contact looks
+homogeneous, as the appendix reports (B.1.1, Fig. B.3) and as its comparison of PSF-blurred
+binary contact maps with Otsu areas (B.2.4) presumes; p_c = 0 is the bare √p law, whose rim
+fades to the background. The signal is blurred by a Gaussian PSF, put on a uniform background
+with Poisson (shot) noise and written as 16-bit counts.
 """
 
 from __future__ import annotations
@@ -11,6 +18,13 @@ from scipy.ndimage import gaussian_filter
 
 FWHM_PER_SIGMA = 2 * np.sqrt(2 * np.log(2))  # 2.3548
 UINT16_MAX = np.iinfo(np.uint16).max
+
+
+def confined_emission(pressure_pa: np.ndarray, contact: np.ndarray, floor_pa: float) -> np.ndarray:
+    """Emission (√Pa) of the probe layer: √max(p, ``floor_pa``) where ``contact``, else 0."""
+    if floor_pa < 0:
+        raise ValueError(f"confinement floor {floor_pa:g} Pa is negative; expected >= 0")
+    return np.where(contact, np.sqrt(np.maximum(pressure_pa, floor_pa)), 0.0)
 
 
 def pixel_averaged(field, shape: tuple[int, int], pixel_m: float, supersample: int = 4):

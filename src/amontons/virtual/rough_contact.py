@@ -27,6 +27,7 @@ from scipy import ndimage
 from amontons import hertz
 from amontons.contact import ContactHardening, ContactResult, FreeBoundaryError, solve_load_series
 from amontons.contact.surfaces import sphere as sphere_cap
+from amontons.virtual.fluorescence import confined_emission
 from amontons.virtual.grid import PixelAverager, resample
 from amontons.virtual.reflection import N_FORMAMIDE, WAVELENGTH_M, ring_gap
 from amontons.virtual.roughness import Roughness, synthesize
@@ -227,11 +228,13 @@ def image_contact_states(
     *,
     gap_index: int | None,
     closing_m: float,
+    confinement_floor_pa: float,
 ) -> list[ContactState]:
     """Every load of the solution on an image grid (image centre = sphere apex).
 
-    Pressure and √p: averaged over each image pixel (:class:`PixelAverager`: 4×4
-    sub-samples, nearest solver pixel, so patch edges keep their covered fraction); contact:
+    Pressure and the probe's emission √max(p, ``confinement_floor_pa``) in contact: averaged
+    over each image pixel (:class:`PixelAverager`: 4×4 sub-samples, nearest solver pixel, so
+    patch edges keep their covered fraction); contact:
     pixels more than half covered by contact; area: the solver's true contact area. Gap, at
     load ``gap_index`` only (the reflection image is the one instrument that needs it):
     bilinear at pixel centres. The edge gap is the azimuthal mean gap at
@@ -254,7 +257,9 @@ def image_contact_states(
             ContactState(
                 load_n=float(result.load),
                 pressure_pa=average(result.pressure),
-                sqrt_pressure=average(np.sqrt(result.pressure)),
+                emission_sqrt_pa=average(
+                    confined_emission(result.pressure, result.contact, confinement_floor_pa)
+                ),
                 gap_m=gap,
                 contact=average(result.contact) > 0.5,
                 area_m2=result.area,

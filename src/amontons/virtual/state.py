@@ -11,9 +11,10 @@ import numpy as np
 class ContactState:
     """One load's contact on the image grid (origin at the image centre, square pixels).
 
-    ``pressure_pa``: pressure averaged over each pixel (Pa); ``sqrt_pressure``: √p averaged
-    over each pixel (√Pa; what the fluorescence sums, since each molecule responds to its
-    local pressure); ``gap_m``: gap at pixel centres
+    ``pressure_pa``: pressure averaged over each pixel (Pa); ``emission_sqrt_pa``: the probe
+    layer's emission (:func:`amontons.virtual.fluorescence.confined_emission`, √Pa) averaged
+    over each pixel - what the fluorescence sums, since each molecule responds to its local
+    pressure; ``gap_m``: gap at pixel centres
     (m, 0 in contact; None where no instrument needs it); ``contact``: pixels in contact;
     ``area_m2``: the true contact area; ``edge_gap_m``: the average gap at the contact edge
     (m), what the Newton rings extrapolate to (None with ``gap_m``).
@@ -21,7 +22,7 @@ class ContactState:
 
     load_n: float
     pressure_pa: np.ndarray
-    sqrt_pressure: np.ndarray
+    emission_sqrt_pa: np.ndarray
     gap_m: np.ndarray | None
     contact: np.ndarray
     area_m2: float
