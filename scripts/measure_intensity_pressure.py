@@ -5,6 +5,7 @@ import logging
 
 from amontons.images import atomic_path
 from amontons.measurements import measure_intensity_pressure
+from amontons.plots import plot_intensity_pressure
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
@@ -14,11 +15,15 @@ def main(
     fluorescence_dir: str,
     table_path: str,
     fit_path: str,
+    figure_paths: list[str],
     loads_mn: list[float],
     pixel_nm: float,
     otsu_bins: int,
     background_margin_px: int,
     pressure_ref_mpa: float,
+    confidence: float,
+    data_label: str,
+    sphere: str,
 ) -> None:
     result, backgrounds = measure_intensity_pressure(
         fluorescence_dir,
@@ -27,6 +32,7 @@ def main(
         otsu_bins=otsu_bins,
         background_margin_px=background_margin_px,
         pressure_ref_pa=pressure_ref_mpa * 1e6,
+        confidence=confidence,
     )
     table = result.table
     out = table.assign(
@@ -46,6 +52,13 @@ def main(
     log.info("%s: intensity exponent %.3f", fluorescence_dir, result.fit.exponent.estimate)
     with atomic_path(fit_path) as tmp:
         tmp.write_text(json.dumps(fit, indent=2))
+    plot_intensity_pressure(
+        out["mean_pressure_MPa"].to_numpy(),
+        out["mean_intensity_counts"].to_numpy(),
+        result.fit,
+        f"{sphere}: contact intensity versus pressure ({data_label})",
+        figure_paths,
+    )
 
 
 if __name__ == "__main__":
@@ -56,9 +69,13 @@ if __name__ == "__main__":
         fluorescence_dir=sm.input.fluorescence,
         table_path=sm.output.table,
         fit_path=sm.output.fit,
+        figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
         otsu_bins=sm.params.otsu_bins,
         background_margin_px=sm.params.intensity["background_margin_px"],
         pressure_ref_mpa=sm.params.intensity["pressure_ref_mpa"],
+        confidence=sm.params.confidence,
+        data_label=sm.params.data_label,
+        sphere=sm.wildcards.sphere,
     )

@@ -175,6 +175,7 @@ def measure_intensity_pressure(
     otsu_bins: int,
     background_margin_px: int,
     pressure_ref_pa: float,
+    confidence: float = 0.95,
 ) -> tuple[IntensityPressure, list[float]]:
     """Mean contact intensity versus mean contact pressure F/A (appendix Fig. B.4).
 
@@ -212,6 +213,7 @@ def measure_intensity_pressure(
         pixel_m=pixel,
         margin_px=background_margin_px,
         pressure_ref_pa=pressure_ref_pa,
+        confidence=confidence,
     )
     return result, backgrounds
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import textwrap
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 
@@ -37,10 +38,7 @@ def plot_normalised_load_area(
     ax.set_ylabel(f"A / A({reference_load_mn:g} mN)")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7)
-    for path in paths:
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=150, format=str(path).rsplit(".", 1)[-1])
-    plt.close(fig)
+    _save(fig, paths)
 
 
 def _save(fig, paths: list[str]) -> None:
@@ -212,4 +210,93 @@ def plot_amontons_deviation(
         ax.set_title(name, fontsize=9)
         ax.legend(fontsize=7)
     fig.suptitle(title, fontsize=9)
+    _save(fig, paths)
+
+
+def plot_contact_separation(
+    loads_mn: list[float],
+    images: list[np.ndarray],
+    masks: list[np.ndarray],
+    thresholds: list[float],
+    separations: list[float],
+    min_separation: float,
+    pixel_um: float,
+    title: str,
+    paths: list[str],
+) -> None:
+    """Per load: the fluorescence image with the Otsu contact edge (green, as in appendix
+    Fig. B.7a) above the histogram of its pixel counts with the threshold and the Otsu
+    separation η, so a reader sees when contact and background overlap. A load whose η is
+    below ``min_separation`` is titled in red as ill-determined."""
+    n = len(loads_mn)
+    fig, axes = plt.subplots(2, n, figsize=(2.4 * n, 5.0), constrained_layout=True, squeeze=False)
+    for column, (load, image, mask, threshold, eta) in enumerate(
+        zip(loads_mn, images, masks, thresholds, separations, strict=True)
+    ):
+        top, bottom = axes[0, column], axes[1, column]
+        extent = [0, image.shape[1] * pixel_um, 0, image.shape[0] * pixel_um]
+        top.imshow(image, cmap="gray", origin="lower", extent=extent)
+        top.contour(
+            mask.astype(float),
+            levels=[0.5],
+            colors="lime",
+            linewidths=0.5,
+            origin="lower",
+            extent=extent,
+        )
+        top.set_title(f"{load:g} mN", fontsize=8)
+        top.set_xlabel("x (µm)", fontsize=7)
+        top.tick_params(labelsize=6)
+        bottom.hist(image.ravel(), bins=128, log=True, color="0.4")
+        bottom.axvline(threshold, color="tab:green", ls="--", lw=1)
+        ok = eta >= min_separation
+        bottom.set_title(
+            f"η = {eta:.2f}" + ("" if ok else " ill-determined"),
+            fontsize=8,
+            color="black" if ok else "red",
+        )
+        bottom.set_xlabel("counts", fontsize=7)
+        bottom.tick_params(labelsize=6)
+    axes[0, 0].set_ylabel("y (µm)", fontsize=7)
+    axes[1, 0].set_ylabel("pixels", fontsize=7)
+    fig.suptitle(title, fontsize=9)
+    _save(fig, paths)
+
+
+def plot_intensity_pressure(
+    pressure_mpa: np.ndarray, intensity_counts: np.ndarray, fit, title: str, paths: list[str]
+) -> None:
+    """Appendix Fig. B.4: background-subtracted mean contact intensity versus mean contact
+    pressure F/A (log–log), the fitted power law (``fit``: amontons.powerlaw.PowerLawFit with
+    x_ref in Pa) and the appendix's square-root law through the fit at the middle pressure."""
+    fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
+    ax.plot(pressure_mpa, intensity_counts, "o", label="per load")
+    span = np.geomspace(pressure_mpa.min(), pressure_mpa.max(), 50)
+    exponent = fit.exponent
+
+    def fitted(p_mpa):
+        return fit.prefactor.estimate * (p_mpa * 1e6 / fit.x_ref) ** exponent.estimate
+
+    ax.plot(
+        span,
+        fitted(span),
+        "-",
+        label=(
+            f"fit: α = {exponent.estimate:.3f} "
+            f"[{exponent.ci_low:.3f}, {exponent.ci_high:.3f}] ({exponent.confidence:.0%})"
+        ),
+    )
+    middle = float(np.sqrt(span[0] * span[-1]))
+    ax.plot(span, fitted(middle) * (span / middle) ** 0.5, "k:", lw=0.8, label="I ∝ p^1/2")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    # A narrow log range gets only minor ticks; label them plainly instead of as powers.
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+        axis.set_minor_formatter(matplotlib.ticker.ScalarFormatter())
+    ax.tick_params(which="both", labelsize=7)
+    ax.set_xlabel("mean contact pressure F/A (MPa)")
+    ax.set_ylabel("mean contact intensity (counts)")
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7)
     _save(fig, paths)

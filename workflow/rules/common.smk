@@ -130,6 +130,8 @@ def data_label(spheres):
 # Per-sphere results of each stage; lifetime only where a FLIM map exists.
 OPTICS_RESULTS = [
     "contact_area.csv",
+    "contact_area.png",
+    "contact_area.pdf",
     "psf.json",
     "psf.png",
     "psf.pdf",
@@ -141,6 +143,8 @@ OPTICS_RESULTS = [
     "edge_gap.pdf",
     "intensity_pressure.csv",
     "intensity_pressure_fit.json",
+    "intensity_pressure.png",
+    "intensity_pressure.pdf",
     "hertz_check.csv",
 ]
 FRICTION_RESULTS = ["friction.csv"]

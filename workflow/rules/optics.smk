@@ -7,6 +7,13 @@ rule measure_contact_area:
         fluorescence=lambda wc: f"{raw_dir(wc.sphere)}/fluorescence",
     output:
         table="results/{material}/{sphere}/contact_area.csv",
+        png=report(
+            "results/{material}/{sphere}/contact_area.png",
+            caption="../report/contact_area.rst",
+            category="Optics",
+            subcategory="{material}",
+        ),
+        pdf="results/{material}/{sphere}/contact_area.pdf",
     log:
         "logs/{material}/{sphere}/measure_contact_area.log",
     benchmark:
@@ -22,6 +29,7 @@ rule measure_contact_area:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu_bins=config["optics"]["otsu_bins"],
         min_separation=config["optics"]["min_separation"],
+        data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_contact_area.py"
 
@@ -126,6 +134,13 @@ rule measure_intensity_pressure:
     output:
         table="results/{material}/{sphere}/intensity_pressure.csv",
         fit="results/{material}/{sphere}/intensity_pressure_fit.json",
+        png=report(
+            "results/{material}/{sphere}/intensity_pressure.png",
+            caption="../report/intensity_pressure.rst",
+            category="Optics",
+            subcategory="{material}",
+        ),
+        pdf="results/{material}/{sphere}/intensity_pressure.pdf",
     log:
         "logs/{material}/{sphere}/measure_intensity_pressure.log",
     benchmark:
@@ -142,6 +157,7 @@ rule measure_intensity_pressure:
         otsu_bins=config["optics"]["otsu_bins"],
         intensity=config["optics"]["intensity"],
         confidence=config["load_area"]["confidence"],
+        data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_intensity_pressure.py"
 

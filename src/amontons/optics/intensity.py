@@ -48,6 +48,7 @@ def intensity_pressure(
     pixel_m: float,
     margin_px: int = 5,
     pressure_ref_pa: float = 1e8,
+    confidence: float = 0.95,
 ) -> IntensityPressure:
     """Mean contact intensity (counts) vs mean contact pressure (Pa) and its exponent.
 
@@ -90,5 +91,6 @@ def intensity_pressure(
         table["mean_pressure_Pa"].to_numpy(),
         table["mean_intensity_counts"].to_numpy(),
         x_ref=pressure_ref_pa,
+        confidence=confidence,
     )
     return IntensityPressure(table=table, fit=fit)
