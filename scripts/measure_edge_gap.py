@@ -5,7 +5,7 @@ import logging
 
 from amontons.hertz import contact_radius
 from amontons.images import atomic_path
-from amontons.measurements import RingsUnreadable, measure_edge_gap
+from amontons.measurements import NotMeasurable, measure_edge_gap
 from amontons.plots import plot_edge_gap, plot_unmeasured
 from amontons.rawdata import fluorescence_image
 from amontons.runlog import run_logged
@@ -21,6 +21,7 @@ def main(
     reflection_load_mn: float,
     pixel_nm: float,
     otsu_bins: int,
+    min_separation: float,
     n_profiles: int,
     edge_model: str,
     max_rings: int,
@@ -36,6 +37,7 @@ def main(
             fluorescence_image(fluorescence_dir, reflection_load_mn),
             pixel_nm * 1e-9,
             otsu_bins=otsu_bins,
+            min_separation=min_separation,
             n_profiles=n_profiles,
             edge_model=edge_model,
             max_rings=max_rings,
@@ -43,9 +45,10 @@ def main(
                 reflection_load_mn * 1e-3, diameter_mm * 0.5e-3, e_star_gpa * 1e9
             ),
         )
-    except RingsUnreadable as error:
-        # A rough sphere scatters its rings: the gap is not measurable, and the result says
-        # so (a flagged null, never a number), so the other spheres' analysis goes on.
+    except NotMeasurable as error:
+        # A rough sphere scatters its rings, an image may show no contact: the gap is not
+        # measurable, and the result says so (a flagged null, never a number), so the other
+        # spheres' analysis goes on.
         log.warning("edge gap not measurable: %s", error)
         with atomic_path(gap_path) as tmp:
             tmp.write_text(
@@ -114,6 +117,7 @@ if __name__ == "__main__":
         reflection_load_mn=sm.params.reflection_load_mn,
         pixel_nm=sm.params.pixel_nm,
         otsu_bins=sm.params.otsu_bins,
+        min_separation=sm.params.min_separation,
         n_profiles=sm.params.newton_rings["n_profiles"],
         edge_model=sm.params.newton_rings["edge_model"],
         max_rings=sm.params.newton_rings["max_rings"],

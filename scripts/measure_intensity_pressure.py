@@ -19,17 +19,19 @@ def main(
     loads_mn: list[float],
     pixel_nm: float,
     otsu_bins: int,
+    min_separation: float,
     background_margin_px: int,
     pressure_ref_mpa: float,
     confidence: float,
     data_label: str,
     sphere: str,
 ) -> None:
-    result, backgrounds = measure_intensity_pressure(
+    result, backgrounds, excluded = measure_intensity_pressure(
         fluorescence_dir,
         loads_mn,
         pixel_nm * 1e-9,
         otsu_bins=otsu_bins,
+        min_separation=min_separation,
         background_margin_px=background_margin_px,
         pressure_ref_pa=pressure_ref_mpa * 1e6,
         confidence=confidence,
@@ -48,7 +50,11 @@ def main(
         "F/A, I = I_ref (p / p_ref)^exponent (appendix Fig. B.4: exponent 1/2)",
         "units": {"prefactor": "counts (intensity at p_ref)", "x_ref": "Pa"},
         **result.fit.to_dict(),
+        # images without a separable contact have no contact intensity: left out, with why
+        "excluded_loads_mN": {f"{load:g}": why for load, why in excluded.items()},
     }
+    for load, why in excluded.items():
+        log.warning("%g mN left out of the intensity-pressure fit: %s", load, why)
     log.info("%s: intensity exponent %.3f", fluorescence_dir, result.fit.exponent.estimate)
     with atomic_path(fit_path) as tmp:
         tmp.write_text(json.dumps(fit, indent=2))
@@ -73,6 +79,7 @@ if __name__ == "__main__":
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
         otsu_bins=sm.params.otsu_bins,
+        min_separation=sm.params.min_separation,
         background_margin_px=sm.params.intensity["background_margin_px"],
         pressure_ref_mpa=sm.params.intensity["pressure_ref_mpa"],
         confidence=sm.params.confidence,

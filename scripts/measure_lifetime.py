@@ -11,10 +11,19 @@ log = logging.getLogger(__name__)
 
 
 def main(
-    flim_path: str, lifetime_path: str, pixel_nm: float, otsu_bins: int, exclude_edge_px: int
+    flim_path: str,
+    lifetime_path: str,
+    pixel_nm: float,
+    otsu_bins: int,
+    min_separation: float,
+    exclude_edge_px: int,
 ) -> None:
     stats = measure_lifetime(
-        flim_path, pixel_nm * 1e-9, otsu_bins=otsu_bins, exclude_edge_px=exclude_edge_px
+        flim_path,
+        pixel_nm * 1e-9,
+        otsu_bins=otsu_bins,
+        min_separation=min_separation,
+        exclude_edge_px=exclude_edge_px,
     )
     result = {
         "quantity": "mean photon arrival time, ns, inside and outside the contact (Otsu mask "
@@ -53,5 +62,6 @@ if __name__ == "__main__":
         lifetime_path=sm.output.lifetime,
         pixel_nm=sm.params.pixel_nm,
         otsu_bins=sm.params.otsu_bins,
+        min_separation=sm.params.min_separation,
         exclude_edge_px=sm.params.lifetime["exclude_edge_px"],
     )

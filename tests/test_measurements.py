@@ -6,11 +6,13 @@ import pytest
 
 from amontons.images import saturated_pixels, write_image
 from amontons.measurements import (
+    NoContact,
     amontons_table,
     background_level,
     contact_geometry,
     hertz_check_table,
     measure_intensity_pressure,
+    measure_lifetime,
 )
 from amontons.rawdata import RawDataError
 
@@ -106,5 +108,48 @@ def test_saturated_image_is_refused_for_intensity_and_counted(tmp_path):
         assert saturated_pixels(image) == (contact.sum() if level == 65535 else 0)
     with pytest.raises(RawDataError, match=r"50\.tif: 697 saturated pixels"):
         measure_intensity_pressure(
-            folder, [25, 50], None, otsu_bins=256, background_margin_px=5, pressure_ref_pa=1e8
+            folder,
+            [25, 50],
+            None,
+            otsu_bins=256,
+            min_separation=0.8,
+            background_margin_px=5,
+            pressure_ref_pa=1e8,
+        )
+
+
+def _disc_images(folder, radii_px, rng):
+    """One 16-bit image per load: a disc of 1500 counts (radius in px; 0 = no contact) on a
+    Poisson background of 120 counts, 200 nm pixels."""
+    rows, cols = np.indices((128, 128))
+    for load, radius in radii_px.items():
+        expected = np.where(np.hypot(rows - 64, cols - 64) < radius, 1500.0, 120.0)
+        write_image(folder / f"{load:g}.tif", rng.poisson(expected).astype(np.uint16), 200e-9)
+
+
+def test_image_without_contact_is_left_out_of_the_intensity_fit(tmp_path):
+    """An image with no contact has no contact intensity: its load is left out with the
+    reason (Otsu separation ≈ 2/π of pure noise) and the fit runs on the others."""
+    folder = tmp_path / "fluorescence"
+    _disc_images(folder, {25.0: 10, 50.0: 0, 100.0: 14, 200.0: 18}, np.random.default_rng(3))
+    kwargs = dict(otsu_bins=256, min_separation=0.8, background_margin_px=5, pressure_ref_pa=1e8)
+    result, backgrounds, excluded = measure_intensity_pressure(folder, LOADS_MN, None, **kwargs)
+    assert list(excluded) == [50.0] and "50.tif: Otsu separation 0.6" in excluded[50.0]
+    assert result.fit.n == 3 and len(backgrounds) == 3
+    np.testing.assert_allclose(result.table["load_N"], [25e-3, 100e-3, 200e-3])
+    # uniform discs: the same mean intensity at every load, so the exponent is ~0
+    assert abs(result.fit.exponent.estimate) < 0.05
+    _disc_images(folder, {25.0: 0}, np.random.default_rng(4))
+    with pytest.raises(RawDataError, match=r"2 of 4 images show a contact .*\[25\.0, 50\.0\]"):
+        measure_intensity_pressure(folder, LOADS_MN, None, **kwargs)
+
+
+def test_flim_map_without_contact_is_refused(tmp_path):
+    """A FLIM map of one population (no confined molecules) has no contact class: an error
+    naming the file, not two means of the same noise."""
+    noise = np.random.default_rng(6).normal(0.5, 0.1, (64, 64)).clip(0.05)
+    write_image(tmp_path / "flim.tif", noise.astype(np.float32), 200e-9)
+    with pytest.raises(NoContact, match=r"flim\.tif: Otsu separation"):
+        measure_lifetime(
+            tmp_path / "flim.tif", None, otsu_bins=256, min_separation=0.8, exclude_edge_px=2
         )

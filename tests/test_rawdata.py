@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from amontons.images import read_image, write_image
-from amontons.measurements import measure_bead, measure_edge_gap, measure_friction
+from amontons.measurements import NoContact, measure_bead, measure_edge_gap, measure_friction
 from amontons.rawdata import (
     RawDataError,
     fluorescence_image,
@@ -95,6 +95,19 @@ def test_reflection_on_another_field_than_the_fluorescence(tmp_path):
         read_reflection(tmp_path / "reflection.tif", like=like)
 
 
+def _edge_gap_of(folder):
+    """The Newton-ring edge gap of ``folder``'s reflection.tif at 25.tif, 4 profiles."""
+    return measure_edge_gap(
+        folder / "reflection.tif",
+        folder / "25.tif",
+        None,
+        otsu_bins=256,
+        min_separation=0.8,
+        n_profiles=4,
+        edge_model="hertz",
+    )
+
+
 def test_reflection_without_rings_names_the_file(tmp_path):
     # A contact in the fluorescence image but a ring-free reflection: no gap can be read.
     rows, cols = np.indices((128, 128))
@@ -105,14 +118,17 @@ def test_reflection_without_rings_names_the_file(tmp_path):
     )
     write_image(tmp_path / "reflection.tif", rng.poisson(400, (128, 128)).astype(np.uint16), PIXEL)
     with pytest.raises(RawDataError, match=r"reflection\.tif: .*profile at .*ring maxima"):
-        measure_edge_gap(
-            tmp_path / "reflection.tif",
-            tmp_path / "25.tif",
-            None,
-            otsu_bins=256,
-            n_profiles=4,
-            edge_model="hertz",
-        )
+        _edge_gap_of(tmp_path)
+
+
+def test_edge_gap_of_an_image_without_contact_is_not_measurable(tmp_path):
+    """No contact stands out (Otsu separation of pure shot noise ≈ 2/π): a NoContact error
+    naming the image, which the rule turns into a flagged null."""
+    rng = np.random.default_rng(5)
+    write_image(tmp_path / "25.tif", rng.poisson(120, (128, 128)).astype(np.uint16), PIXEL)
+    write_image(tmp_path / "reflection.tif", np.full((128, 128), 400, np.uint16), PIXEL)
+    with pytest.raises(NoContact, match=r"25\.tif: Otsu separation 0\.6\d+ < 0\.8"):
+        _edge_gap_of(tmp_path)
 
 
 def test_flim_map_of_counts_is_refused(tmp_path):

@@ -18,9 +18,9 @@ from scipy.ndimage import binary_dilation, binary_fill_holes
 
 from amontons.friction import RheometerError, amontons_deviation, static_friction
 from amontons.hertz_check import hertz_check
-from amontons.images import read_image, saturated_pixels
+from amontons.images import Image, read_image, saturated_pixels
 from amontons.optics.absorbance import AbsorbanceError, GraftingDensity, grafting_density
-from amontons.optics.area import otsu_contact_area
+from amontons.optics.area import ContactArea, otsu_contact_area
 from amontons.optics.intensity import IntensityPressure, intensity_pressure
 from amontons.optics.lifetime import LifetimeStatistics, lifetime_statistics
 from amontons.optics.newton_rings import NewtonRingError, NewtonRingGap, newton_ring_gap
@@ -105,8 +105,34 @@ class EdgeGap:
     reflection_path: Path
 
 
-class RingsUnreadable(RawDataError):
+class NotMeasurable(RawDataError):
+    """Well-formed data that hold nothing to measure: the result says so (a flagged null)
+    instead of giving a number."""
+
+
+class RingsUnreadable(NotMeasurable):
     """A reflection image whose Newton rings cannot be numbered (e.g. a rough sphere's)."""
+
+
+class NoContact(NotMeasurable):
+    """An image in which no contact stands out from the background (Otsu classes overlap)."""
+
+
+def separated_contact(image: Image, *, otsu_bins: int, min_separation: float) -> ContactArea:
+    """Otsu contact of ``image``; raises NoContact, naming the file and the separation η,
+    when η < ``min_separation`` (an image without contact gives η ≈ 2/π)."""
+    try:
+        area = otsu_contact_area(
+            image.data, image.pixel_m, bins=otsu_bins, min_separation=min_separation
+        )
+    except ValueError as error:
+        raise NoContact(f"{image.path}: {error}") from error
+    if not area.well_separated:
+        raise NoContact(
+            f"{image.path}: Otsu separation {area.separation:.3f} < {min_separation:g}: no "
+            "contact stands out from the background; expected a contact brighter than it"
+        )
+    return area
 
 
 def measure_edge_gap(
@@ -115,6 +141,7 @@ def measure_edge_gap(
     fallback_pixel_m: float | None,
     *,
     otsu_bins: int,
+    min_separation: float,
     n_profiles: int,
     edge_model: str,
     max_rings: int | None = None,
@@ -127,10 +154,11 @@ def measure_edge_gap(
     the radius of the circle with the area of the mask with its holes filled (the outer
     boundary of a patchy contact). ``hertz_radius_m``, the Hertz radius of the load from
     the sheet's E* and diameter, is the radius of the exterior shape the rings are fitted
-    with (amontons.optics.newton_rings.newton_ring_gap).
+    with (amontons.optics.newton_rings.newton_ring_gap). Raises NoContact if the
+    fluorescence image shows no contact, RingsUnreadable if the rings cannot be numbered.
     """
     fluorescence = read_image(fluorescence_path, fallback_pixel_m)
-    area = otsu_contact_area(fluorescence.data, fluorescence.pixel_m, bins=otsu_bins)
+    area = separated_contact(fluorescence, otsu_bins=otsu_bins, min_separation=min_separation)
     try:
         centre, _ = contact_geometry(area.mask, fluorescence.pixel_m)
     except ValueError as error:
@@ -173,16 +201,22 @@ def measure_intensity_pressure(
     fallback_pixel_m: float | None,
     *,
     otsu_bins: int,
+    min_separation: float,
     background_margin_px: int,
     pressure_ref_pa: float,
     confidence: float = 0.95,
-) -> tuple[IntensityPressure, list[float]]:
+) -> tuple[IntensityPressure, list[float], dict[float, str]]:
     """Mean contact intensity versus mean contact pressure F/A (appendix Fig. B.4).
 
-    Returns the fit and each image's background (counts, from the pixels far from the mask).
+    Returns the fit, each fitted image's background (counts, from the pixels far from the
+    mask) and the loads left out (mN → why): an image without a separable contact (Otsu
+    separation below ``min_separation``) has no contact intensity, as in the load–area fit.
+    Raises RawDataError if fewer than three loads are left.
     """
-    images, masks, backgrounds, pixel = [], [], [], None
-    for path in fluorescence_images(fluorescence_dir, list(loads_mn)):
+    images, masks, backgrounds, kept_loads, excluded, pixel = [], [], [], [], {}, None
+    for load, path in zip(
+        loads_mn, fluorescence_images(fluorescence_dir, list(loads_mn)), strict=True
+    ):
         image = read_image(path, fallback_pixel_m)
         if pixel is not None and abs(image.pixel_m - pixel) > 1e-6 * pixel:
             raise RawDataError(
@@ -197,14 +231,24 @@ def measure_intensity_pressure(
                 "mean contact intensity of a clipped image is too low - expected none (lower "
                 "the laser power or the detector gain)"
             )
-        mask = otsu_contact_area(image.data, image.pixel_m, bins=otsu_bins).mask
+        try:
+            mask = separated_contact(image, otsu_bins=otsu_bins, min_separation=min_separation).mask
+        except NoContact as error:
+            excluded[load] = str(error)
+            continue
         images.append(image.data)
         masks.append(mask)
+        kept_loads.append(load)
         try:
             backgrounds.append(background_level(image.data, mask, background_margin_px))
         except ValueError as error:
             raise RawDataError(f"{path}: {error}") from error
-    loads_n = [load * 1e-3 for load in loads_mn]
+    if len(kept_loads) < 3:
+        raise RawDataError(
+            f"{fluorescence_dir}: {len(kept_loads)} of {len(loads_mn)} images show a contact "
+            f"(left out: {sorted(excluded)} mN); the intensity-pressure fit needs at least 3"
+        )
+    loads_n = [load * 1e-3 for load in kept_loads]
     result = intensity_pressure(
         images,
         masks,
@@ -215,7 +259,7 @@ def measure_intensity_pressure(
         pressure_ref_pa=pressure_ref_pa,
         confidence=confidence,
     )
-    return result, backgrounds
+    return result, backgrounds, excluded
 
 
 def measure_lifetime(
@@ -223,17 +267,18 @@ def measure_lifetime(
     fallback_pixel_m: float | None,
     *,
     otsu_bins: int,
+    min_separation: float,
     exclude_edge_px: int,
 ) -> LifetimeStatistics:
     """Arrival-time statistics inside and outside the contact of the FLIM map ``path``.
 
     The FLIM map comes from another microscope (appendix Fig. B.3), so its contact mask is
     found in the map itself: confined molecules emit later, so the contact is the Otsu class of
-    long arrival times.
+    long arrival times. Raises NoContact if no such class stands out.
     """
     image = read_flim(path, fallback_pixel_m)
+    mask = separated_contact(image, otsu_bins=otsu_bins, min_separation=min_separation).mask
     try:
-        mask = otsu_contact_area(image.data, image.pixel_m, bins=otsu_bins).mask
         return lifetime_statistics(image.data, mask, exclude_edge_px=exclude_edge_px)
     except ValueError as error:
         raise RawDataError(f"{image.path}: {error}") from error

@@ -120,6 +120,7 @@ rule measure_edge_gap:
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu_bins=config["optics"]["otsu_bins"],
+        min_separation=config["optics"]["min_separation"],
         newton_rings=config["optics"]["newton_rings"],
         data_label=lambda wc: data_label([wc.sphere]),
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
@@ -155,6 +156,7 @@ rule measure_intensity_pressure:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu_bins=config["optics"]["otsu_bins"],
+        min_separation=config["optics"]["min_separation"],
         intensity=config["optics"]["intensity"],
         confidence=config["load_area"]["confidence"],
         data_label=lambda wc: data_label([wc.sphere]),
@@ -180,6 +182,7 @@ rule measure_lifetime:
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu_bins=config["optics"]["otsu_bins"],
+        min_separation=config["optics"]["min_separation"],
         lifetime=config["optics"]["lifetime"],
     script:
         "../../scripts/measure_lifetime.py"
