@@ -14,10 +14,12 @@ log = logging.getLogger(__name__)
 
 def main(table_path: str, fit_path: str, reference_load_mn: float, confidence: float) -> None:
     table = pd.read_csv(table_path)
-    usable = table[table["well_separated"]]
-    excluded = table.loc[~table["well_separated"], "load_mN"].tolist()
+    found = table["contact_found"].astype(bool)
+    usable = table[found]
+    excluded = table.loc[~found, "load_mN"].tolist()
+    flags = table.loc[~found, "flag"].tolist()
     if excluded:
-        log.warning("%s: loads %s mN excluded (ill-determined threshold)", table_path, excluded)
+        log.warning("%s: loads %s mN excluded (no contact found): %s", table_path, excluded, flags)
     fit = fit_power_law(
         usable["load_mN"].to_numpy(),
         usable["area_um2"].to_numpy(),
@@ -28,6 +30,7 @@ def main(table_path: str, fit_path: str, reference_load_mn: float, confidence: f
         "quantity": "real contact area versus normal load, A = A_ref (F / F_ref)^exponent",
         "units": {"prefactor": "um2 (area at the reference load)", "x_ref": "mN"},
         "excluded_loads_mN": excluded,
+        "exclusion_flags": flags,
         **fit.to_dict(),
     }
     log.info(

@@ -5,9 +5,9 @@ import logging
 import pandas as pd
 
 from amontons.images import atomic_path, read_image, saturated_pixels
-from amontons.optics.area import otsu_contact_area
+from amontons.optics.area import OtsuSettings, otsu_contact_area
 from amontons.plots import plot_contact_separation
-from amontons.rawdata import fluorescence_images
+from amontons.rawdata import RawDataError, fluorescence_images
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
@@ -19,24 +19,26 @@ def main(
     figure_paths: list[str],
     loads_mn: list[float],
     pixel_nm: float,
-    otsu_bins: int,
-    min_separation: float,
+    otsu: dict,
     data_label: str,
     sphere: str,
 ) -> None:
+    settings = OtsuSettings.from_config(otsu)
     rows, images, areas = [], [], []
     for load, path in zip(loads_mn, fluorescence_images(fluorescence_dir, loads_mn), strict=True):
         image = read_image(path, fallback_pixel_m=pixel_nm * 1e-9)
-        area = otsu_contact_area(
-            image.data, image.pixel_m, bins=otsu_bins, min_separation=min_separation
-        )
-        if not area.well_separated:
-            log.warning(
-                "%s: Otsu separation %.3f < %.3f; the threshold is ill-determined",
-                path,
-                area.separation,
-                min_separation,
+        if images and abs(image.pixel_m - images[0].pixel_m) > 1e-6 * image.pixel_m:
+            raise RawDataError(
+                f"{path}: pixel {image.pixel_m * 1e9:.4g} nm differs from "
+                f"{images[0].path}'s {images[0].pixel_m * 1e9:.4g} nm; expected one pixel size "
+                "per sphere"
             )
+        try:
+            area = otsu_contact_area(image.data, image.pixel_m, settings)
+        except ValueError as error:
+            raise RawDataError(f"{path}: {error}") from error
+        if not area.contact_found:
+            log.warning("%s: no contact found: %s", path, area.flag)
         saturated = saturated_pixels(image.data)
         if saturated:
             # The threshold still separates contact from background, but the brightest
@@ -50,7 +52,10 @@ def main(
                 "pixel_nm": image.pixel_m * 1e9,
                 "otsu_threshold_counts": area.threshold,
                 "otsu_separation": area.separation,
-                "well_separated": area.well_separated,
+                "contrast_noise_sd": area.contrast,
+                "largest_patch_px": area.largest_patch_px,
+                "contact_found": area.contact_found,
+                "flag": area.flag or "",
                 "saturated_pixels": saturated,
                 "image": str(path),
             }
@@ -66,7 +71,7 @@ def main(
         [area.mask for area in areas],
         [area.threshold for area in areas],
         [area.separation for area in areas],
-        min_separation,
+        [area.flag for area in areas],
         images[0].pixel_m * 1e6,
         f"{sphere}: Otsu contact edge and intensity histogram per load ({data_label})",
         figure_paths,
@@ -83,8 +88,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
-        otsu_bins=sm.params.otsu_bins,
-        min_separation=sm.params.min_separation,
+        otsu=sm.params.otsu,
         data_label=sm.params.data_label,
         sphere=sm.wildcards.sphere,
     )

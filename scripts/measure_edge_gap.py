@@ -6,6 +6,7 @@ import logging
 from amontons.hertz import contact_radius
 from amontons.images import atomic_path
 from amontons.measurements import NotMeasurable, measure_edge_gap
+from amontons.optics.area import OtsuSettings
 from amontons.plots import plot_edge_gap, plot_unmeasured
 from amontons.rawdata import fluorescence_image
 from amontons.runlog import run_logged
@@ -20,8 +21,7 @@ def main(
     figure_paths: list[str],
     reflection_load_mn: float,
     pixel_nm: float,
-    otsu_bins: int,
-    min_separation: float,
+    otsu: dict,
     n_profiles: int,
     edge_model: str,
     max_rings: int,
@@ -36,8 +36,7 @@ def main(
             reflection_path,
             fluorescence_image(fluorescence_dir, reflection_load_mn),
             pixel_nm * 1e-9,
-            otsu_bins=otsu_bins,
-            min_separation=min_separation,
+            otsu=OtsuSettings.from_config(otsu),
             n_profiles=n_profiles,
             edge_model=edge_model,
             max_rings=max_rings,
@@ -116,8 +115,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         reflection_load_mn=sm.params.reflection_load_mn,
         pixel_nm=sm.params.pixel_nm,
-        otsu_bins=sm.params.otsu_bins,
-        min_separation=sm.params.min_separation,
+        otsu=sm.params.otsu,
         n_profiles=sm.params.newton_rings["n_profiles"],
         edge_model=sm.params.newton_rings["edge_model"],
         max_rings=sm.params.newton_rings["max_rings"],

@@ -5,6 +5,7 @@ import logging
 
 from amontons.images import atomic_path
 from amontons.measurements import measure_intensity_pressure
+from amontons.optics.area import OtsuSettings
 from amontons.plots import plot_intensity_pressure
 from amontons.runlog import run_logged
 
@@ -18,8 +19,7 @@ def main(
     figure_paths: list[str],
     loads_mn: list[float],
     pixel_nm: float,
-    otsu_bins: int,
-    min_separation: float,
+    otsu: dict,
     background_margin_px: int,
     pressure_ref_mpa: float,
     confidence: float,
@@ -30,8 +30,7 @@ def main(
         fluorescence_dir,
         loads_mn,
         pixel_nm * 1e-9,
-        otsu_bins=otsu_bins,
-        min_separation=min_separation,
+        otsu=OtsuSettings.from_config(otsu),
         background_margin_px=background_margin_px,
         pressure_ref_pa=pressure_ref_mpa * 1e6,
         confidence=confidence,
@@ -50,8 +49,9 @@ def main(
         "F/A, I = I_ref (p / p_ref)^exponent (appendix Fig. B.4: exponent 1/2)",
         "units": {"prefactor": "counts (intensity at p_ref)", "x_ref": "Pa"},
         **result.fit.to_dict(),
-        # images without a separable contact have no contact intensity: left out, with why
-        "excluded_loads_mN": {f"{load:g}": why for load, why in excluded.items()},
+        # images in which no contact stands out have no contact intensity: left out, with why
+        "excluded_loads_mN": list(excluded),
+        "exclusion_flags": list(excluded.values()),
     }
     for load, why in excluded.items():
         log.warning("%g mN left out of the intensity-pressure fit: %s", load, why)
@@ -78,8 +78,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
-        otsu_bins=sm.params.otsu_bins,
-        min_separation=sm.params.min_separation,
+        otsu=sm.params.otsu,
         background_margin_px=sm.params.intensity["background_margin_px"],
         pressure_ref_mpa=sm.params.intensity["pressure_ref_mpa"],
         confidence=sm.params.confidence,

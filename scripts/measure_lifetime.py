@@ -5,6 +5,7 @@ import logging
 
 from amontons.images import atomic_path
 from amontons.measurements import measure_lifetime
+from amontons.optics.area import OtsuSettings
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
@@ -14,15 +15,13 @@ def main(
     flim_path: str,
     lifetime_path: str,
     pixel_nm: float,
-    otsu_bins: int,
-    min_separation: float,
+    otsu: dict,
     exclude_edge_px: int,
 ) -> None:
     stats = measure_lifetime(
         flim_path,
         pixel_nm * 1e-9,
-        otsu_bins=otsu_bins,
-        min_separation=min_separation,
+        otsu=OtsuSettings.from_config(otsu),
         exclude_edge_px=exclude_edge_px,
     )
     result = {
@@ -61,7 +60,6 @@ if __name__ == "__main__":
         flim_path=sm.input.flim,
         lifetime_path=sm.output.lifetime,
         pixel_nm=sm.params.pixel_nm,
-        otsu_bins=sm.params.otsu_bins,
-        min_separation=sm.params.min_separation,
+        otsu=sm.params.otsu,
         exclude_edge_px=sm.params.lifetime["exclude_edge_px"],
     )

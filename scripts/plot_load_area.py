@@ -33,7 +33,7 @@ def main(
                     # Normalised by the fitted area at the reference load, defined for any series.
                     "area_norm": table["area_um2"] / fit["prefactor"]["estimate"],
                     "fit_exponent": fit["exponent"]["estimate"],
-                    "well_separated": table["well_separated"],
+                    "contact_found": table["contact_found"],
                 }
             )
         )

@@ -49,8 +49,8 @@ def test_misspelled_key_is_named_with_the_allowed_keys(repo, config_schema):
     assert "my.yaml" in message
     assert "'otsu_bin'" in message and "optics" in message
     assert (
-        "allowed keys: absorbance, intensity, lifetime, min_separation, newton_rings, otsu_bins"
-        in message
+        "allowed keys: absorbance, intensity, lifetime, min_contrast, min_patch_px, "
+        "min_separation, newton_rings, otsu_bins" in message
     )
 
 

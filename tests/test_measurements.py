@@ -14,18 +14,17 @@ from amontons.measurements import (
     measure_intensity_pressure,
     measure_lifetime,
 )
+from amontons.optics.area import OtsuSettings
 from amontons.rawdata import RawDataError
 
 LOADS_MN = [25.0, 50.0, 100.0, 200.0]
 
 
-def _tables(tau_mpa=20.0, alpha=2 / 3, separated=(True, True, True, True)):
+def _tables(tau_mpa=20.0, alpha=2 / 3, found=(True, True, True, True)):
     """Area ∝ F^alpha and F_s = τ·A exactly, as contact_area.csv and friction.csv hold them."""
     loads = np.array(LOADS_MN)
     area_um2 = 400.0 * (loads / 25.0) ** alpha
-    areas = pd.DataFrame(
-        {"load_mN": loads, "area_um2": area_um2, "well_separated": list(separated)}
-    )
+    areas = pd.DataFrame({"load_mN": loads, "area_um2": area_um2, "contact_found": list(found)})
     friction = pd.DataFrame(
         {
             "load_mN": loads,
@@ -48,7 +47,7 @@ def test_amontons_table_normalises_at_the_reference_load():
 
 
 def test_amontons_table_leaves_out_ill_determined_areas_and_keeps_spheres_apart():
-    areas, friction = _tables(separated=(True, True, False, True))
+    areas, friction = _tables(found=(True, True, False, True))
     other_areas, other_friction = _tables(tau_mpa=5.0, alpha=0.9)
     table = amontons_table(["A", "B"], [areas, other_areas], [friction, other_friction], 25.0)
     assert table.loc[table["sphere"] == "A", "load_mN"].tolist() == [25.0, 50.0, 200.0]
@@ -56,7 +55,7 @@ def test_amontons_table_leaves_out_ill_determined_areas_and_keeps_spheres_apart(
 
 
 def test_amontons_table_needs_the_reference_load():
-    areas, friction = _tables(separated=(False, True, True, True))
+    areas, friction = _tables(found=(False, True, True, True))
     with pytest.raises(ValueError, match="no load within 10% of the reference 0.025 N"):
         amontons_table(["A"], [areas], [friction], 25.0)
 
@@ -66,7 +65,7 @@ def test_hertz_check_table_units():
     radius, e_star = 2e-3, 32.8e9
     a = np.array([(3 * f * 1e-3 * radius / (4 * e_star)) ** (1 / 3) for f in LOADS_MN])
     areas = pd.DataFrame(
-        {"load_mN": LOADS_MN, "area_um2": np.pi * a**2 * 1e12, "well_separated": True}
+        {"load_mN": LOADS_MN, "area_um2": np.pi * a**2 * 1e12, "contact_found": True}
     )
     table = hertz_check_table(areas, radius, e_star)
     np.testing.assert_allclose(table["radius_ratio"], 1.0, rtol=1e-12)
@@ -111,8 +110,7 @@ def test_saturated_image_is_refused_for_intensity_and_counted(tmp_path):
             folder,
             [25, 50],
             None,
-            otsu_bins=256,
-            min_separation=0.8,
+            otsu=OtsuSettings(),
             background_margin_px=5,
             pressure_ref_pa=1e8,
         )
@@ -132,9 +130,9 @@ def test_image_without_contact_is_left_out_of_the_intensity_fit(tmp_path):
     reason (Otsu separation ≈ 2/π of pure noise) and the fit runs on the others."""
     folder = tmp_path / "fluorescence"
     _disc_images(folder, {25.0: 10, 50.0: 0, 100.0: 14, 200.0: 18}, np.random.default_rng(3))
-    kwargs = dict(otsu_bins=256, min_separation=0.8, background_margin_px=5, pressure_ref_pa=1e8)
+    kwargs = dict(otsu=OtsuSettings(), background_margin_px=5, pressure_ref_pa=1e8)
     result, backgrounds, excluded = measure_intensity_pressure(folder, LOADS_MN, None, **kwargs)
-    assert list(excluded) == [50.0] and "50.tif: Otsu separation 0.6" in excluded[50.0]
+    assert list(excluded) == [50.0] and "50.tif: the upper class is only" in excluded[50.0]
     assert result.fit.n == 3 and len(backgrounds) == 3
     np.testing.assert_allclose(result.table["load_N"], [25e-3, 100e-3, 200e-3])
     # uniform discs: the same mean intensity at every load, so the exponent is ~0
@@ -149,7 +147,5 @@ def test_flim_map_without_contact_is_refused(tmp_path):
     naming the file, not two means of the same noise."""
     noise = np.random.default_rng(6).normal(0.5, 0.1, (64, 64)).clip(0.05)
     write_image(tmp_path / "flim.tif", noise.astype(np.float32), 200e-9)
-    with pytest.raises(NoContact, match=r"flim\.tif: Otsu separation"):
-        measure_lifetime(
-            tmp_path / "flim.tif", None, otsu_bins=256, min_separation=0.8, exclude_edge_px=2
-        )
+    with pytest.raises(NoContact, match=r"flim\.tif: the upper class is only"):
+        measure_lifetime(tmp_path / "flim.tif", None, otsu=OtsuSettings(), exclude_edge_px=2)

@@ -6,6 +6,7 @@ import pytest
 
 from amontons.images import read_image, write_image
 from amontons.measurements import NoContact, measure_bead, measure_edge_gap, measure_friction
+from amontons.optics.area import OtsuSettings
 from amontons.rawdata import (
     RawDataError,
     fluorescence_image,
@@ -101,8 +102,7 @@ def _edge_gap_of(folder):
         folder / "reflection.tif",
         folder / "25.tif",
         None,
-        otsu_bins=256,
-        min_separation=0.8,
+        otsu=OtsuSettings(),
         n_profiles=4,
         edge_model="hertz",
     )
@@ -127,7 +127,7 @@ def test_edge_gap_of_an_image_without_contact_is_not_measurable(tmp_path):
     rng = np.random.default_rng(5)
     write_image(tmp_path / "25.tif", rng.poisson(120, (128, 128)).astype(np.uint16), PIXEL)
     write_image(tmp_path / "reflection.tif", np.full((128, 128), 400, np.uint16), PIXEL)
-    with pytest.raises(NoContact, match=r"25\.tif: Otsu separation 0\.6\d+ < 0\.8"):
+    with pytest.raises(NoContact, match=r"25\.tif: the upper class is only 1\.\d noise sd"):
         _edge_gap_of(tmp_path)
 
 

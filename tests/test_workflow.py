@@ -198,7 +198,7 @@ def test_intensity_exponent_follows_from_the_light_and_the_otsu_area(small_run, 
     is: with A ∝ F^β, α − 1 = d ln(L/F) / d ln p = (α_true − 1)(1 − β_true)/(1 − β). The
     intensity exponent is therefore right exactly when the light is all counted and the area
     exponent is right; its error is the area exponent's error amplified by (1 − α)/(1 − β), 2-4.
-    Measured off this prediction by 0.000 (glass) and 0.017 (PS) here, ≤ 0.015 on the five
+    Measured off this prediction by 0.000 (glass) and 0.017 (PS) here, ≤ 0.017 on the five
     full-run spheres (the OLS lines through five points that are not exact power laws); 0.03,
     which a lost rim of light (the mask-only sum: +0.1) or a wrong background still breaks."""
     results = small_run / "results" / sphere / sphere

@@ -20,7 +20,7 @@ from amontons.friction import RheometerError, amontons_deviation, static_frictio
 from amontons.hertz_check import hertz_check
 from amontons.images import Image, read_image, saturated_pixels
 from amontons.optics.absorbance import AbsorbanceError, GraftingDensity, grafting_density
-from amontons.optics.area import ContactArea, otsu_contact_area
+from amontons.optics.area import ContactArea, OtsuSettings, otsu_contact_area
 from amontons.optics.intensity import IntensityPressure, intensity_pressure
 from amontons.optics.lifetime import LifetimeStatistics, lifetime_statistics
 from amontons.optics.newton_rings import NewtonRingError, NewtonRingGap, newton_ring_gap
@@ -118,20 +118,15 @@ class NoContact(NotMeasurable):
     """An image in which no contact stands out from the background (Otsu classes overlap)."""
 
 
-def separated_contact(image: Image, *, otsu_bins: int, min_separation: float) -> ContactArea:
-    """Otsu contact of ``image``; raises NoContact, naming the file and the separation η,
-    when η < ``min_separation`` (an image without contact gives η ≈ 2/π)."""
+def separated_contact(image: Image, otsu: OtsuSettings) -> ContactArea:
+    """Otsu contact of ``image``; raises NoContact, naming the file and why, when no contact
+    stands out (amontons.optics.area: separation, contrast, patch size)."""
     try:
-        area = otsu_contact_area(
-            image.data, image.pixel_m, bins=otsu_bins, min_separation=min_separation
-        )
+        area = otsu_contact_area(image.data, image.pixel_m, otsu)
     except ValueError as error:
         raise NoContact(f"{image.path}: {error}") from error
-    if not area.well_separated:
-        raise NoContact(
-            f"{image.path}: Otsu separation {area.separation:.3f} < {min_separation:g}: no "
-            "contact stands out from the background; expected a contact brighter than it"
-        )
+    if not area.contact_found:
+        raise NoContact(f"{image.path}: {area.flag}; expected a contact brighter than it")
     return area
 
 
@@ -140,8 +135,7 @@ def measure_edge_gap(
     fluorescence_path: str | Path,
     fallback_pixel_m: float | None,
     *,
-    otsu_bins: int,
-    min_separation: float,
+    otsu: OtsuSettings,
     n_profiles: int,
     edge_model: str,
     max_rings: int | None = None,
@@ -158,7 +152,7 @@ def measure_edge_gap(
     fluorescence image shows no contact, RingsUnreadable if the rings cannot be numbered.
     """
     fluorescence = read_image(fluorescence_path, fallback_pixel_m)
-    area = separated_contact(fluorescence, otsu_bins=otsu_bins, min_separation=min_separation)
+    area = separated_contact(fluorescence, otsu)
     try:
         centre, _ = contact_geometry(area.mask, fluorescence.pixel_m)
     except ValueError as error:
@@ -200,8 +194,7 @@ def measure_intensity_pressure(
     loads_mn: Sequence[float],
     fallback_pixel_m: float | None,
     *,
-    otsu_bins: int,
-    min_separation: float,
+    otsu: OtsuSettings,
     background_margin_px: int,
     pressure_ref_pa: float,
     confidence: float = 0.95,
@@ -209,8 +202,8 @@ def measure_intensity_pressure(
     """Mean contact intensity versus mean contact pressure F/A (appendix Fig. B.4).
 
     Returns the fit, each fitted image's background (counts, from the pixels far from the
-    mask) and the loads left out (mN → why): an image without a separable contact (Otsu
-    separation below ``min_separation``) has no contact intensity, as in the load–area fit.
+    mask) and the loads left out (mN → why): an image in which no contact stands out
+    (:func:`separated_contact`) has no contact intensity, as in the load–area fit.
     Raises RawDataError if fewer than three loads are left.
     """
     images, masks, backgrounds, kept_loads, excluded, pixel = [], [], [], [], {}, None
@@ -232,7 +225,7 @@ def measure_intensity_pressure(
                 "the laser power or the detector gain)"
             )
         try:
-            mask = separated_contact(image, otsu_bins=otsu_bins, min_separation=min_separation).mask
+            mask = separated_contact(image, otsu).mask
         except NoContact as error:
             excluded[load] = str(error)
             continue
@@ -249,16 +242,19 @@ def measure_intensity_pressure(
             f"(left out: {sorted(excluded)} mN); the intensity-pressure fit needs at least 3"
         )
     loads_n = [load * 1e-3 for load in kept_loads]
-    result = intensity_pressure(
-        images,
-        masks,
-        loads_n,
-        backgrounds,
-        pixel_m=pixel,
-        margin_px=background_margin_px,
-        pressure_ref_pa=pressure_ref_pa,
-        confidence=confidence,
-    )
+    try:
+        result = intensity_pressure(
+            images,
+            masks,
+            loads_n,
+            backgrounds,
+            pixel_m=pixel,
+            margin_px=background_margin_px,
+            pressure_ref_pa=pressure_ref_pa,
+            confidence=confidence,
+        )
+    except ValueError as error:
+        raise RawDataError(f"{fluorescence_dir}: {error}") from error
     return result, backgrounds, excluded
 
 
@@ -266,8 +262,7 @@ def measure_lifetime(
     path: str | Path,
     fallback_pixel_m: float | None,
     *,
-    otsu_bins: int,
-    min_separation: float,
+    otsu: OtsuSettings,
     exclude_edge_px: int,
 ) -> LifetimeStatistics:
     """Arrival-time statistics inside and outside the contact of the FLIM map ``path``.
@@ -277,7 +272,7 @@ def measure_lifetime(
     long arrival times. Raises NoContact if no such class stands out.
     """
     image = read_flim(path, fallback_pixel_m)
-    mask = separated_contact(image, otsu_bins=otsu_bins, min_separation=min_separation).mask
+    mask = separated_contact(image, otsu).mask
     try:
         return lifetime_statistics(image.data, mask, exclude_edge_px=exclude_edge_px)
     except ValueError as error:
@@ -330,7 +325,7 @@ def measure_friction(
 def hertz_check_table(area_table: pd.DataFrame, radius_m: float, e_star_pa: float) -> pd.DataFrame:
     """Measured (Otsu) contact radius against Hertz per load, units in the column names.
 
-    Loads with an ill-determined threshold are kept but flagged (column well_separated).
+    Loads where no contact was found are kept but flagged (column contact_found).
     """
     table = hertz_check(
         area_table["load_mN"].to_numpy() * 1e-3,
@@ -345,7 +340,7 @@ def hertz_check_table(area_table: pd.DataFrame, radius_m: float, e_star_pa: floa
             "measured_radius_um": table["measured_radius_m"] * 1e6,
             "hertz_radius_um": table["hertz_radius_m"] * 1e6,
             "radius_ratio": table["radius_ratio"],
-            "well_separated": area_table["well_separated"].to_numpy(),
+            "contact_found": area_table["contact_found"].to_numpy(),
         }
     )
 
@@ -364,7 +359,7 @@ def amontons_table(
     """
     frames = []
     for sphere, areas, friction in zip(spheres, area_tables, friction_tables, strict=True):
-        merged = areas[areas["well_separated"]].merge(friction, on="load_mN", how="inner")
+        merged = areas[areas["contact_found"]].merge(friction, on="load_mN", how="inner")
         deviation = amontons_deviation(
             merged["normal_force_mN"].to_numpy() * 1e-3,
             merged["area_um2"].to_numpy() * 1e-12,

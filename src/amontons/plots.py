@@ -219,19 +219,19 @@ def plot_contact_separation(
     masks: list[np.ndarray],
     thresholds: list[float],
     separations: list[float],
-    min_separation: float,
+    flags: list[str | None],
     pixel_um: float,
     title: str,
     paths: list[str],
 ) -> None:
     """Per load: the fluorescence image with the Otsu contact edge (green, as in appendix
     Fig. B.7a) above the histogram of its pixel counts with the threshold and the Otsu
-    separation η, so a reader sees when contact and background overlap. A load whose η is
-    below ``min_separation`` is titled in red as ill-determined."""
+    separation η, so a reader sees when contact and background overlap. A load whose flag
+    says no contact was found (amontons.optics.area) is titled in red, "no contact"."""
     n = len(loads_mn)
     fig, axes = plt.subplots(2, n, figsize=(2.4 * n, 5.0), constrained_layout=True, squeeze=False)
-    for column, (load, image, mask, threshold, eta) in enumerate(
-        zip(loads_mn, images, masks, thresholds, separations, strict=True)
+    for column, (load, image, mask, threshold, eta, flag) in enumerate(
+        zip(loads_mn, images, masks, thresholds, separations, flags, strict=True)
     ):
         top, bottom = axes[0, column], axes[1, column]
         extent = [0, image.shape[1] * pixel_um, 0, image.shape[0] * pixel_um]
@@ -249,11 +249,10 @@ def plot_contact_separation(
         top.tick_params(labelsize=6)
         bottom.hist(image.ravel(), bins=128, log=True, color="0.4")
         bottom.axvline(threshold, color="tab:green", ls="--", lw=1)
-        ok = eta >= min_separation
         bottom.set_title(
-            f"η = {eta:.2f}" + ("" if ok else " ill-determined"),
+            f"η = {eta:.2f}" + ("" if flag is None else ": no contact"),
             fontsize=8,
-            color="black" if ok else "red",
+            color="black" if flag is None else "red",
         )
         bottom.set_xlabel("counts", fontsize=7)
         bottom.tick_params(labelsize=6)

@@ -120,6 +120,14 @@ def material_results(material, name):
     return [sphere_result(material, s, name) for s in spheres_of(material)]
 
 
+def otsu_settings():
+    """The optics keys that decide where a contact is and whether there is one."""
+    return {
+        key: config["optics"][key]
+        for key in ("otsu_bins", "min_separation", "min_contrast", "min_patch_px")
+    }
+
+
 def data_label(spheres):
     """'synthetic data' if any of the spheres comes from the virtual experiment."""
     return (

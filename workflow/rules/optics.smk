@@ -27,8 +27,7 @@ rule measure_contact_area:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu_bins=config["optics"]["otsu_bins"],
-        min_separation=config["optics"]["min_separation"],
+        otsu=otsu_settings(),
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_contact_area.py"
@@ -119,8 +118,7 @@ rule measure_edge_gap:
     params:
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu_bins=config["optics"]["otsu_bins"],
-        min_separation=config["optics"]["min_separation"],
+        otsu=otsu_settings(),
         newton_rings=config["optics"]["newton_rings"],
         data_label=lambda wc: data_label([wc.sphere]),
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
@@ -155,8 +153,7 @@ rule measure_intensity_pressure:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu_bins=config["optics"]["otsu_bins"],
-        min_separation=config["optics"]["min_separation"],
+        otsu=otsu_settings(),
         intensity=config["optics"]["intensity"],
         confidence=config["load_area"]["confidence"],
         data_label=lambda wc: data_label([wc.sphere]),
@@ -181,8 +178,7 @@ rule measure_lifetime:
         runtime=5,
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu_bins=config["optics"]["otsu_bins"],
-        min_separation=config["optics"]["min_separation"],
+        otsu=otsu_settings(),
         lifetime=config["optics"]["lifetime"],
     script:
         "../../scripts/measure_lifetime.py"
