@@ -66,7 +66,6 @@ def _signal(state, reference):
     return COUNTS / np.sqrt(reference.load_n / reference.area_m2) * state.emission_sqrt_pa
 
 
-@pytest.mark.parametrize("floor", [0.0, FLOOR])
 def _noisy_image(state, reference, seed):
     """The fluorescence image of ``state`` as the virtual experiment renders it: PSF,
     background, shot noise."""
@@ -79,6 +78,7 @@ def _noisy_image(state, reference, seed):
     )
 
 
+@pytest.mark.parametrize("floor", [0.0, FLOOR])
 def test_otsu_area_equals_the_noise_free_blurred_truth_within_2_percent(rough_solution, floor):
     """Issue 6: the Otsu area of the noisy image equals that of the true map blurred by the
     same PSF and thresholded the same way within 2 % (measured: 0.0-0.6 %, either emission
