@@ -83,7 +83,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        fluorescence_dir=sm.input.fluorescence,
+        fluorescence_dir=sm.params.fluorescence_dir,
         table_path=sm.output.table,
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,

@@ -110,7 +110,7 @@ if __name__ == "__main__":
         main,
         sm.log[0],
         reflection_path=sm.input.reflection,
-        fluorescence_dir=sm.input.fluorescence,
+        fluorescence_dir=sm.params.fluorescence_dir,
         gap_path=sm.output.gap,
         figure_paths=[sm.output.png, sm.output.pdf],
         reflection_load_mn=sm.params.reflection_load_mn,

@@ -33,7 +33,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        rheometer_dir=sm.input.rheometer,
+        rheometer_dir=sm.params.rheometer_dir,
         table_path=sm.output.table,
         loads_mn=sm.params.loads_mn,
         median_window_s=sm.params.friction["median_window_s"],

@@ -72,7 +72,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        fluorescence_dir=sm.input.fluorescence,
+        fluorescence_dir=sm.params.fluorescence_dir,
         table_path=sm.output.table,
         fit_path=sm.output.fit,
         figure_paths=[sm.output.png, sm.output.pdf],

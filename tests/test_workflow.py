@@ -17,6 +17,8 @@ import pandas as pd
 import pytest
 import yaml
 
+from amontons.images import read_image, write_image
+
 pytestmark = pytest.mark.workflow
 
 REPO = Path(__file__).resolve().parents[1]
@@ -233,6 +235,47 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
     changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
     stats = changed.stdout.split("Job stats:", 1)[1].split("total", 1)[0]
     assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {"measure_psf": "2", "all": "1"}
+
+
+def test_own_data_is_measured_and_a_replaced_image_reruns_its_jobs(small_run, tmp_path):
+    """A sphere whose data_source is a folder of measured files (here a copy of the virtual
+    PS sphere, names as a user writes them: 25mN.tif): its measurements run on it, and
+    overwriting one image in place re-runs exactly the jobs that read the images - a folder
+    input would not see it, since a folder's time does not change when a file in it is
+    overwritten. The overwritten image shows no contact: it is flagged and left out of the
+    fit, and the run goes on."""
+    own = tmp_path / "my_data" / "PS-own"
+    shutil.copytree(small_run / "resources" / "synthetic" / "PS", own)
+    (own / "truth.json").unlink()
+    for image in (own / "fluorescence").glob("*.tif"):
+        image.rename(image.with_name(f"{image.stem}mN.tif"))
+    shutil.copytree(REPO / "config", tmp_path / "config")
+    sheet = pd.read_csv(tmp_path / "config" / "materials.tsv", sep="\t", dtype=str)
+    row = sheet[sheet["sphere"] == "PS"].assign(sphere="PS-own", data_source=str(own))
+    row.to_csv(tmp_path / "config" / "own.tsv", sep="\t", index=False)
+    _edit_config(tmp_path, lambda c: c.update(materials=["PS"], materials_sheet="config/own.tsv"))
+    target = "results/PS/PS-own/load_area_fit.json"
+    args = (target, "--cores", "2", "--configfile", "config/test.yaml")
+    first = snakemake(tmp_path, *args)
+    assert first.returncode == 0, first.stderr[-3000:]
+
+    image = own / "fluorescence" / "50mN.tif"
+    pixel = read_image(image).pixel_m
+    noise = np.random.default_rng(0).poisson(120, read_image(image).data.shape)
+    write_image(image, noise.astype(np.uint16), pixel)
+    dry = snakemake(tmp_path, *args, "-n")
+    stats = dry.stdout.split("Job stats:", 1)[1].split("total", 1)[0]
+    assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {
+        "measure_contact_area": "1",
+        "fit_load_area": "1",
+    }
+    second = snakemake(tmp_path, *args)
+    assert second.returncode == 0, second.stderr[-3000:]
+    area = pd.read_csv(tmp_path / "results/PS/PS-own/contact_area.csv")
+    assert area["contact_found"].tolist() == [True, False, True, True, True]
+    assert "noise sd above the background" in area["flag"].iloc[1]
+    fit = json.loads((tmp_path / target).read_text())
+    assert fit["excluded_loads_mN"] == [50.0] and fit["n"] == 4
 
 
 def check_measurements_against_truth(project, material, sphere):

@@ -5,7 +5,7 @@ import pandas as pd
 
 from amontons.config import load_schema, load_workflow_config
 from amontons.measurements import afm_file
-from amontons.rawdata import AFM_SUFFIXES
+from amontons.rawdata import AFM_SUFFIXES, fluorescence_images, rheometer_files
 
 SCHEMAS = os.path.join(workflow.basedir, "workflow", "schemas")
 CONFIG_SOURCE = ", ".join(
@@ -68,6 +68,23 @@ def sheet_value(sphere, column):
 
 def pixel_nm(sphere):
     return float(sphere_row(sphere)["fluorescence_pixel_nm"])
+
+
+def per_load_dir(sphere, kind):
+    """A sphere's folder of per-load raw files: 'fluorescence' or 'rheometer'."""
+    return f"{raw_dir(sphere)}/{kind}"
+
+
+def per_load_inputs(sphere, kind):
+    """Inputs of a per-load folder. Measured data: each load's file, so that a replaced file
+    re-runs the jobs that read it (a folder's time does not change when a file in it is
+    overwritten); a folder that does not match the loads stops the run here, naming it.
+    Synthetic data: the folder, which the virtual experiment writes whole."""
+    folder = per_load_dir(sphere, kind)
+    if is_synthetic(sphere):
+        return folder
+    files = fluorescence_images if kind == "fluorescence" else rheometer_files
+    return [str(path) for path in files(folder, loads_mn(sphere))]
 
 
 def raw_file(sphere, name):

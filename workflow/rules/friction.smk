@@ -3,7 +3,7 @@
 
 rule measure_friction:
     input:
-        rheometer=lambda wc: f"{raw_dir(wc.sphere)}/rheometer",
+        rheometer=lambda wc: per_load_inputs(wc.sphere, "rheometer"),
     output:
         table="results/{material}/{sphere}/friction.csv",
     log:
@@ -17,6 +17,7 @@ rule measure_friction:
         mem_mb=1000,
         runtime=5,
     params:
+        rheometer_dir=lambda wc: per_load_dir(wc.sphere, "rheometer"),
         loads_mn=lambda wc: loads_mn(wc.sphere),
         friction=config["friction"],
     script:

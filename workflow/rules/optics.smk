@@ -4,7 +4,7 @@
 
 rule measure_contact_area:
     input:
-        fluorescence=lambda wc: f"{raw_dir(wc.sphere)}/fluorescence",
+        fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
         table="results/{material}/{sphere}/contact_area.csv",
         png=report(
@@ -25,6 +25,7 @@ rule measure_contact_area:
         mem_mb=2000,
         runtime=10,
     params:
+        fluorescence_dir=lambda wc: per_load_dir(wc.sphere, "fluorescence"),
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
@@ -95,7 +96,7 @@ rule measure_grafting_density:
 rule measure_edge_gap:
     input:
         reflection=lambda wc: raw_file(wc.sphere, "reflection.tif"),
-        fluorescence=lambda wc: f"{raw_dir(wc.sphere)}/fluorescence",
+        fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
         gap="results/{material}/{sphere}/edge_gap.json",
         png=report(
@@ -116,6 +117,7 @@ rule measure_edge_gap:
         mem_mb=2000,
         runtime=10,
     params:
+        fluorescence_dir=lambda wc: per_load_dir(wc.sphere, "fluorescence"),
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
@@ -129,7 +131,7 @@ rule measure_edge_gap:
 
 rule measure_intensity_pressure:
     input:
-        fluorescence=lambda wc: f"{raw_dir(wc.sphere)}/fluorescence",
+        fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
         table="results/{material}/{sphere}/intensity_pressure.csv",
         fit="results/{material}/{sphere}/intensity_pressure_fit.json",
@@ -151,6 +153,7 @@ rule measure_intensity_pressure:
         mem_mb=2000,
         runtime=10,
     params:
+        fluorescence_dir=lambda wc: per_load_dir(wc.sphere, "fluorescence"),
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
