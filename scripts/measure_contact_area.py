@@ -4,10 +4,10 @@ import logging
 
 import pandas as pd
 
-from amontons.images import atomic_path, read_image, saturated_pixels
-from amontons.optics.area import OtsuSettings, otsu_contact_area
+from amontons.images import atomic_path, saturated_pixels
+from amontons.measurements import image_contact_area, read_fluorescence_series
+from amontons.optics.area import OtsuSettings
 from amontons.plots import plot_contact_separation
-from amontons.rawdata import RawDataError, fluorescence_images
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
@@ -24,19 +24,11 @@ def main(
     sphere: str,
 ) -> None:
     settings = OtsuSettings.from_config(otsu)
-    rows, images, areas = [], [], []
-    for load, path in zip(loads_mn, fluorescence_images(fluorescence_dir, loads_mn), strict=True):
-        image = read_image(path, fallback_pixel_m=pixel_nm * 1e-9)
-        if images and abs(image.pixel_m - images[0].pixel_m) > 1e-6 * image.pixel_m:
-            raise RawDataError(
-                f"{path}: pixel {image.pixel_m * 1e9:.4g} nm differs from "
-                f"{images[0].path}'s {images[0].pixel_m * 1e9:.4g} nm; expected one pixel size "
-                "per sphere"
-            )
-        try:
-            area = otsu_contact_area(image.data, image.pixel_m, settings)
-        except ValueError as error:
-            raise RawDataError(f"{path}: {error}") from error
+    images = read_fluorescence_series(fluorescence_dir, loads_mn, pixel_nm * 1e-9)
+    rows, areas = [], []
+    for load, image in zip(loads_mn, images, strict=True):
+        path = image.path
+        area = image_contact_area(image, settings)
         if not area.contact_found:
             log.warning("%s: no contact found: %s", path, area.flag)
         saturated = saturated_pixels(image.data)
@@ -61,7 +53,6 @@ def main(
             }
         )
         log.info("%s: %g mN → %.1f µm²", path, load, area.area_m2 * 1e12)
-        images.append(image)
         areas.append(area)
     with atomic_path(table_path) as tmp:
         pd.DataFrame(rows).to_csv(tmp, index=False)

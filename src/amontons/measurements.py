@@ -118,13 +118,37 @@ class NoContact(NotMeasurable):
     """An image in which no contact stands out from the background (Otsu classes overlap)."""
 
 
+def read_fluorescence_series(
+    fluorescence_dir: str | Path, loads_mn: Sequence[float], fallback_pixel_m: float | None
+) -> list[Image]:
+    """A sphere's fluorescence images in the order of ``loads_mn``; raises RawDataError if
+    their pixel sizes differ (areas and pressures of one series share one pixel)."""
+    images = []
+    for path in fluorescence_images(fluorescence_dir, list(loads_mn)):
+        image = read_image(path, fallback_pixel_m)
+        if images and abs(image.pixel_m - images[0].pixel_m) > 1e-6 * images[0].pixel_m:
+            raise RawDataError(
+                f"{path}: pixel {image.pixel_m * 1e9:.4g} nm differs from "
+                f"{images[0].path}'s {images[0].pixel_m * 1e9:.4g} nm; expected one pixel size "
+                "per sphere"
+            )
+        images.append(image)
+    return images
+
+
+def image_contact_area(image: Image, otsu: OtsuSettings) -> ContactArea:
+    """Otsu contact of ``image``, flagged where no contact stands out; a constant image
+    raises NoContact naming the file."""
+    try:
+        return otsu_contact_area(image.data, image.pixel_m, otsu)
+    except ValueError as error:
+        raise NoContact(f"{image.path}: {error}") from error
+
+
 def separated_contact(image: Image, otsu: OtsuSettings) -> ContactArea:
     """Otsu contact of ``image``; raises NoContact, naming the file and why, when no contact
     stands out (amontons.optics.area: separation, contrast, patch size)."""
-    try:
-        area = otsu_contact_area(image.data, image.pixel_m, otsu)
-    except ValueError as error:
-        raise NoContact(f"{image.path}: {error}") from error
+    area = image_contact_area(image, otsu)
     if not area.contact_found:
         raise NoContact(f"{image.path}: {area.flag}; expected a contact brighter than it")
     return area
@@ -206,17 +230,10 @@ def measure_intensity_pressure(
     (:func:`separated_contact`) has no contact intensity, as in the load–area fit.
     Raises RawDataError if fewer than three loads are left.
     """
-    images, masks, backgrounds, kept_loads, excluded, pixel = [], [], [], [], {}, None
-    for load, path in zip(
-        loads_mn, fluorescence_images(fluorescence_dir, list(loads_mn)), strict=True
-    ):
-        image = read_image(path, fallback_pixel_m)
-        if pixel is not None and abs(image.pixel_m - pixel) > 1e-6 * pixel:
-            raise RawDataError(
-                f"{path}: pixel {image.pixel_m * 1e9:.4g} nm differs from the other images' "
-                f"{pixel * 1e9:.4g} nm; expected one pixel size per sphere"
-            )
-        pixel = image.pixel_m
+    images, masks, backgrounds, kept_loads, excluded = [], [], [], [], {}
+    series = read_fluorescence_series(fluorescence_dir, loads_mn, fallback_pixel_m)
+    for load, image in zip(loads_mn, series, strict=True):
+        path = image.path
         saturated = saturated_pixels(image.data)
         if saturated:
             raise RawDataError(
@@ -248,7 +265,7 @@ def measure_intensity_pressure(
             masks,
             loads_n,
             backgrounds,
-            pixel_m=pixel,
+            pixel_m=series[0].pixel_m,
             margin_px=background_margin_px,
             pressure_ref_pa=pressure_ref_pa,
             confidence=confidence,
