@@ -10,7 +10,8 @@ Three variants on the same surface:
 * ``+ coarse-to-fine``: the default plus a start from the solution on 2x, 4x, ... coarser
   grids (coarse levels solved to 1e-4; their iterations are listed separately).
 
-Times are medians over ``--repeats`` runs (plans are built before timing).
+Times are medians over ``--repeats`` runs (plans are built before timing, with
+``planner_effort="FFTW_MEASURE"`` passed explicitly: see _common.TIMING_EFFORT).
 
     python benchmarks/bench_convergence.py           # 512², 1024², 2048²
     python benchmarks/bench_convergence.py --quick   # 128², 256²
@@ -22,7 +23,7 @@ import statistics
 import sys
 import time
 
-from _common import E_STAR, header, parser, rough_load, rough_surface, table
+from _common import E_STAR, TIMING_EFFORT, header, parser, rough_load, rough_surface, table
 
 import amontons.contact.cg as cg
 from amontons.contact import solve
@@ -32,7 +33,17 @@ def timed_solve(h, load, repeats, threads, **kw):
     ts, res = [], None
     for _ in range(repeats):
         t0 = time.perf_counter()
-        res = solve(h, 1.0, E_STAR, load=load, periodic=True, tol=1e-8, threads=threads, **kw)
+        res = solve(
+            h,
+            1.0,
+            E_STAR,
+            load=load,
+            periodic=True,
+            tol=1e-8,
+            threads=threads,
+            planner_effort=TIMING_EFFORT,
+            **kw,
+        )
         ts.append(time.perf_counter() - t0)
     return res, statistics.median(ts)
 
@@ -56,6 +67,7 @@ def main():
             tol=1e-2,
             coarse_to_fine=True,
             threads=args.threads,
+            planner_effort=TIMING_EFFORT,
         )
         variants = [
             ("PK reset-on-violator", 0.0, False),
@@ -69,16 +81,15 @@ def main():
                 res, t = timed_solve(h, load, reps, args.threads, coarse_to_fine=c2f)
             finally:
                 cg.RESET_FRACTION = default_fraction
-            levels = res.info["coarse_levels"]
+            levels = res.info.coarse_levels
             rows.append(
                 {
                     "grid": f"{n}²",
                     "variant": name,
                     "iterations": res.iterations,
-                    "convolutions": res.info["convolutions"],
-                    "steepest-descent resets": res.info["steepest_descent_resets"],
-                    "coarse-level iterations": "+".join(str(lv["iterations"]) for lv in levels)
-                    or "-",
+                    "convolutions": res.info.convolutions,
+                    "steepest-descent resets": res.info.steepest_descent_resets,
+                    "coarse-level iterations": "+".join(str(lv.iterations) for lv in levels) or "-",
                     "time s": t,
                     "contact fraction": res.contact_fraction,
                 }

@@ -1,8 +1,9 @@
 """Benchmark 1: time per CG iteration as a multiple of one FFT pair of the padded grid.
 
-The floor is one forward + one inverse real 2-D FFT (pyfftw, FFTW_MEASURE, same
-threads) of the grid the convolution works on: n² periodic, (2n)² non-periodic (Hockney
-padding). Both are measured in the same run, alternating, and the median of several runs
+The floor is one forward + one inverse real 2-D FFT (pyfftw, same threads) of the grid the
+convolution works on: n² periodic, (2n)² non-periodic (Hockney padding). Floor and
+convolutions are planned with FFTW_MEASURE, passed explicitly (planner_effort=). Both are
+measured in the same run, alternating, and the median of several runs
 is quoted. The CG runs a fixed number of iterations on a realistic problem (rough periodic
 surface at ~10 % contact; rough sphere for the non-periodic case), and the time spent inside
 the convolutions is measured separately to say where the rest goes.
@@ -18,7 +19,16 @@ import sys
 import time
 
 import numpy as np
-from _common import E_STAR, header, parser, rough_load, rough_surface, sphere_problem, table
+from _common import (
+    E_STAR,
+    TIMING_EFFORT,
+    header,
+    parser,
+    rough_load,
+    rough_surface,
+    sphere_problem,
+    table,
+)
 
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
@@ -43,8 +53,11 @@ def run(n, periodic, iterations, repeats, threads):
         h, load = rough_surface(n), rough_load(n)
     else:
         h, load = sphere_problem(n)
-    op = get_operator(h.shape, 1.0, E_STAR, periodic=periodic, threads=threads)
-    pair = RealFFT2Pair(h.shape if periodic else (2 * n, 2 * n), threads=threads)
+    op = get_operator(
+        h.shape, 1.0, E_STAR, periodic=periodic, threads=threads, planner_effort=TIMING_EFFORT
+    )
+    fft_shape = h.shape if periodic else (2 * n, 2 * n)
+    pair = RealFFT2Pair(fft_shape, threads=threads, planner_effort=TIMING_EFFORT)
     pair.real[...] = np.random.default_rng(0).random(pair.shape)
     # warm start: a few iterations first, so the timed ones are mid-solve iterations
     warm = polonsky_keer(

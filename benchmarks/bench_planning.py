@@ -1,11 +1,11 @@
 """Benchmark 0 (supporting): FFTW planner effort - planning time vs transform time.
 
 For the periodic operator (rfft2 + irfft2 of n²) and the pruned non-periodic operator
-(padded 2n²), plans are built with FFTW_ESTIMATE, FFTW_MEASURE and FFTW_PATIENT in fresh
-subprocesses (FFTW wisdom is per process, so every planning starts cold) and one
-convolution is timed (median). The default (FFTW_MEASURE) is chosen from this table: it
-must pay for its planning within a fraction of one solve (~100 iterations = ~200
-convolutions).
+(padded 2n²), plans are built with FFTW_ESTIMATE, FFTW_MEASURE and FFTW_PATIENT
+(``planner_effort=``) in fresh subprocesses (FFTW wisdom is per process, so every planning
+starts cold) and one convolution is timed (median). The solver's default is FFTW_ESTIMATE,
+the one deterministic effort (same plan, same bytes in every run); the table says what
+``planner_effort="FFTW_MEASURE"`` buys per convolution and costs in planning.
 
     python benchmarks/bench_planning.py           # 1024²
     python benchmarks/bench_planning.py --quick   # 256²
@@ -14,7 +14,6 @@ convolutions).
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 
@@ -27,7 +26,7 @@ from amontons.contact.convolution import NonPeriodicConvolution, PeriodicConvolu
 n, periodic, threads = {n}, {periodic}, {threads}
 t0 = time.perf_counter()
 cls = PeriodicConvolution if periodic else NonPeriodicConvolution
-op = cls((n, n), 1.0, 1.0, backend="pyfftw", threads=threads)
+op = cls((n, n), 1.0, 1.0, backend="pyfftw", threads=threads, planner_effort={effort!r})
 plan = time.perf_counter() - t0
 p = np.random.default_rng(0).random((n, n))
 out = np.empty((n, n))
@@ -50,14 +49,11 @@ def main():
     for n in sizes:
         for periodic in (True, False):
             for effort in ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT"):
-                env = dict(os.environ, AMONTONS_FFTW_EFFORT=effort)
-                code = CHILD.format(n=n, periodic=periodic, threads=args.threads, repeats=repeats)
+                code = CHILD.format(
+                    n=n, periodic=periodic, threads=args.threads, repeats=repeats, effort=effort
+                )
                 proc = subprocess.run(
-                    [sys.executable, "-c", code],
-                    capture_output=True,
-                    text=True,
-                    env=env,
-                    check=True,
+                    [sys.executable, "-c", code], capture_output=True, text=True, check=True
                 )
                 r = json.loads(proc.stdout.strip().splitlines()[-1])
                 rows.append(

@@ -73,6 +73,7 @@ def test_convergence_error_carries_history():
     err = info.value
     assert err.iterations == 2 and len(err.residual_history) == 2
     assert err.residual > err.tol == 1e-8
+    assert err.status == 1  # iteration cap, as a returned result would say
 
 
 def test_free_boundary_error():
@@ -89,5 +90,6 @@ def test_periodic_displacement_control_full_contact_is_refused():
     no displacement): the solver must say so instead of diverging."""
     x = np.arange(64) / 64
     h = np.broadcast_to(1e-3 * np.cos(2 * np.pi * x), (4, 64)).copy()
-    with pytest.raises(ConvergenceError, match="full contact"):
+    with pytest.raises(ConvergenceError, match="full contact") as info:
         solve(h, 1 / 64, 1.0, displacement=5e-3, periodic=True)
+    assert info.value.status == 2  # stalled

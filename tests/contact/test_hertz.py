@@ -1,4 +1,5 @@
-"""Hertz: non-periodic sphere on a 128² window, contact radius ~30 pixels."""
+"""Hertz: non-periodic sphere on a 128² window, contact radius ~30 pixels (docs/models.md
+§2.7)."""
 
 import numpy as np
 

@@ -112,7 +112,7 @@ def test_coarse_to_fine_same_answer(periodic, hertz_case, rough_case):
         tol=tol,
         coarse_to_fine=True,
     )
-    assert len(res.info["coarse_levels"]) >= 1
+    assert len(res.info.coarse_levels) >= 1
     assert np.abs(res.pressure - ref.pressure).max() < 1e-6 * ref.pressure.max()
 
 

@@ -1,4 +1,4 @@
-"""Westergaard: periodic sinusoidal indenter (science.md §2.6)."""
+"""Westergaard: periodic sinusoidal indenter (docs/models.md §2.7)."""
 
 import numpy as np
 import pytest

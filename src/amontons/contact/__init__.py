@@ -1,7 +1,10 @@
 """amontons.contact: FFT boundary-element solver for rough frictionless contact.
 
 Self-contained: imports numpy, scipy and (optionally) pyfftw only. SI units throughout:
-lengths in m, pressures and moduli in Pa, forces in N.
+lengths in m, pressures and moduli in Pa, forces in N. The models and their equations are
+described in docs/models.md (§2.1 sign conventions and Green's functions, §2.2 the bounded
+Polonsky–Keer conjugate gradient, §2.3 penetration hardness, §2.4 contact hardening,
+§2.5 Greenwood–Tripp, §2.6 self-affine surfaces, §2.7 analytic checks).
 
 Sign convention
 ---------------
@@ -17,32 +20,88 @@ Sign convention
 
 Public API
 ----------
-``solve``, ``solve_load_series``, ``ContactResult``, the plasticity laws
-``PenetrationHardness`` and ``ContactHardening`` (:mod:`amontons.contact.plasticity`)
-and the exceptions
-``ContactInputError``, ``ConvergenceError``, ``FreeBoundaryError``; surface synthesis in
-:mod:`amontons.contact.surfaces`.
+``solve(heights, spacing, e_star, *, load | displacement, periodic, tol, max_iter, threads,
+warm_start, coarse_to_fine, backend, plasticity, plastic_displacement, method, max_outer,
+planner_effort, raise_on_failure) -> ContactResult`` and ``solve_load_series(heights,
+spacing, e_star, loads, *, ...) -> list[ContactResult]``; the plasticity laws
+``PenetrationHardness(p_y)`` and ``ContactHardening(k)`` (:mod:`amontons.contact.plasticity`);
+surface synthesis ``sphere`` and ``self_affine`` (:mod:`amontons.contact.surfaces`).
+
+Result (:class:`ContactResult`, frozen; ``==`` is identity)
+    Fields ``pressure`` (Pa), ``gap``, ``elastic_displacement``, ``plastic_displacement``
+    (m), ``contact`` (bool mask), ``load`` (N), ``displacement`` (m), ``spacing`` (m),
+    ``iterations``, ``residual``, ``residual_history``, ``success``, ``status``,
+    ``message``, ``periodic``, ``heights`` (m), ``info``; properties ``area`` (m²),
+    ``contact_fraction``, ``mean_pressure`` (Pa), ``deformed_heights`` (m) and
+    ``converged`` (read-only alias of ``success``).
+
+Status codes (``ContactResult.status``, ``ConvergenceError.status``)
+    0 converged; 1 iteration cap reached (``max_iter`` CG iterations, or ``max_outer``
+    plastic updates / active-set rounds); 2 stalled (e.g. a periodic displacement-controlled
+    solve at full contact, or the load control of a plastic solve finding no approach). By
+    default a solve that does not converge raises :class:`ConvergenceError`; with
+    ``raise_on_failure=False`` it returns the last (finite) iterate with ``success=False``,
+    its status and a message naming the iterations and the residual.
+    :class:`ContactInputError` is raised always, and so is :class:`FreeBoundaryError` for a
+    converged solution (a non-converged iterate's edge pressure is not checked).
+
+Diagnostics (``ContactResult.info``: :class:`SolveInfo`, frozen, the same fields on every route)
+    ``route`` ("elastic", "winkler" or "appendix"), ``convolutions``,
+    ``steepest_descent_resets``, ``outer_iterations`` (0 for elastic solves),
+    ``coarse_levels`` (tuple of :class:`CoarseLevel`), ``plasticity``, ``backend``,
+    ``threads``, ``planner_effort``, ``tol``, ``max_iter``, ``max_outer`` (None for elastic
+    solves), ``wall_time_s`` (s).
+
+Options
+    ``method``: route of a plastic solve, ``"winkler"`` (contact hardening with local
+    increments, exact elastic-plus-Winkler; the default there) or ``"appendix"`` (the
+    appendix's iterative scheme; the only route for penetration hardness and
+    volume-conserving increments); None picks the default. ``planner_effort``: FFTW
+    planner effort, default ``"FFTW_ESTIMATE"`` (deterministic: the same bytes in every
+    run); ``"FFTW_MEASURE"`` plans by timing (faster convolutions, not reproducible bit for
+    bit). An unknown value of either raises :class:`ContactInputError` naming the allowed
+    values.
+
+Warnings
+    :class:`IgnoredOptionWarning` (a ``UserWarning``), once per call, for an option given
+    to a solve that has no effect on it: ``method`` or ``max_outer`` on an elastic solve;
+    ``coarse_to_fine=True`` with plasticity, with a ``warm_start`` or on a grid without a
+    coarse level; ``threads > 1`` or a non-default ``planner_effort`` with the numpy
+    backend.
+
+Exceptions
+    ``ContactError`` (base) with ``ContactInputError`` (also a ValueError),
+    ``ConvergenceError`` and ``FreeBoundaryError`` (also RuntimeErrors), and
+    ``amontons.contact.greenwood_tripp.GreenwoodTrippError`` (also a RuntimeError; not
+    imported here, to keep ``import amontons.contact`` free of the Greenwood–Tripp tables'
+    scipy modules).
 """
 
 from .api import solve, solve_load_series
 from .plasticity import ContactHardening, PenetrationHardness
 from .result import (
+    CoarseLevel,
     ContactError,
     ContactInputError,
     ContactResult,
     ConvergenceError,
     FreeBoundaryError,
+    IgnoredOptionWarning,
+    SolveInfo,
 )
 from .surfaces import self_affine, sphere
 
 __all__ = [
+    "CoarseLevel",
     "ContactError",
     "ContactHardening",
     "ContactInputError",
     "ContactResult",
     "ConvergenceError",
     "FreeBoundaryError",
+    "IgnoredOptionWarning",
     "PenetrationHardness",
+    "SolveInfo",
     "self_affine",
     "solve",
     "solve_load_series",

@@ -4,136 +4,42 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
 
 from .cg import polonsky_keer
 from .convolution import get_operator
-from .plasticity import ContactHardening, PenetrationHardness, solve_plastic
-from .result import ContactInputError, ContactResult, ConvergenceError, FreeBoundaryError
+from .fft import DEFAULT_PLANNER_EFFORT
+from .inputs import (
+    SolveOptions,
+    check_control,
+    check_heights,
+    check_loads,
+    check_plastic_history,
+    check_positive,
+    check_warm_start,
+    default_max_iter,
+    solve_options,
+)
+from .plasticity import solve_plastic
+from .result import (
+    STALLED,
+    CoarseLevel,
+    ContactInputError,
+    ContactResult,
+    ConvergenceError,
+    FreeBoundaryError,
+    IgnoredOptionWarning,
+    SolveInfo,
+)
 
 # Coarse levels stop at this many pixels along the shorter side: below it a solve costs
 # nothing and the coarse surface no longer resembles the fine one.
 COARSE_MIN_SIZE = 32
 # Coarse levels only provide a starting guess, so they are solved loosely.
 COARSE_TOL = 1e-4
-
-
-def _check_positive(name, value, unit):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ContactInputError(f"{name} must be a number in {unit}, got {value!r}") from None
-    if not math.isfinite(v) or v <= 0:
-        raise ContactInputError(f"{name} must be a finite positive number in {unit}, got {v!r}")
-    return v
-
-
-def _check_heights(heights):
-    h = np.asarray(heights)
-    if h.ndim != 2:
-        raise ContactInputError(f"heights must be a 2-D array (m), got an array of shape {h.shape}")
-    if min(h.shape) < 2:
-        raise ContactInputError(f"heights must be at least 2x2 pixels, got shape {h.shape}")
-    if not np.issubdtype(h.dtype, np.number) or np.iscomplexobj(h):
-        raise ContactInputError(f"heights must be real numbers (m), got dtype {h.dtype}")
-    h = np.ascontiguousarray(h, dtype=np.float64)
-    bad = ~np.isfinite(h)
-    if bad.any():
-        i, j = np.argwhere(bad)[0]
-        raise ContactInputError(
-            f"heights contain {int(bad.sum())} non-finite value(s) (NaN or inf), first at "
-            f"pixel ({i}, {j}); expected finite heights in m"
-        )
-    return h
-
-
-def _check_warm_start(warm_start, shape):
-    w = np.asarray(warm_start, dtype=np.float64)
-    if w.shape != shape:
-        raise ContactInputError(f"warm_start must have the shape of heights {shape}, got {w.shape}")
-    if not np.isfinite(w).all():
-        raise ContactInputError("warm_start contains NaN or inf; expected a pressure in Pa")
-    if (w < 0).any():
-        raise ContactInputError(f"warm_start must be a pressure >= 0 (Pa), min is {w.min():.3e}")
-    return w
-
-
-def _default_max_iter(shape):
-    # PK needs O(n) iterations on an n x n grid for rough surfaces (~1200 at 2048²);
-    # generous, so hitting the cap means something is wrong, not just slow.
-    return 1000 + 4 * (shape[0] + shape[1])
-
-
-def _start_pressure(h, spacing, e_star, load, displacement):
-    """Starting pressure (Pa) without a warm start: uniform under load control (the solver
-    rescales it to the load), the overlap guess under displacement control."""
-    if load is not None:
-        return np.ones_like(h)
-    return _initial_pressure(h, spacing, e_star, displacement)
-
-
-def _initial_pressure(h, spacing, e_star, displacement):
-    """Starting pressure (Pa) for displacement control: a local-stiffness overlap guess."""
-    overlap = np.maximum(h + displacement, 0.0)
-    n = np.count_nonzero(overlap)
-    if n == 0:
-        return np.zeros_like(h)
-    # a patch of size L has stiffness ~E*/L, so p ~ E* overlap / L
-    return overlap * (e_star / (math.sqrt(n) * spacing))
-
-
-def _coarsen(h):
-    n0, n1 = h.shape
-    return h.reshape(n0 // 2, 2, n1 // 2, 2).mean(axis=(1, 3))
-
-
-def _coarse_start(
-    h, spacing, e_star, load, displacement, periodic, backend, threads, min_size, levels
-):
-    """Pressure (Pa) on the grid of ``h`` from a solve on a 2x coarser grid, or None.
-
-    Heights are block-averaged 2x2 (spacing doubles); the coarse pressure is prolonged by
-    pixel replication, which keeps the total force. Recurses down to ``min_size``.
-    """
-    n0, n1 = h.shape
-    if n0 % 2 or n1 % 2 or min(n0, n1) < 2 * min_size:
-        return None, levels
-    hc = _coarsen(h)
-    start, levels = _coarse_start(
-        hc, 2 * spacing, e_star, load, displacement, periodic, backend, threads, min_size, levels
-    )
-    try:
-        res = _solve(
-            hc,
-            2 * spacing,
-            e_star,
-            load=load,
-            displacement=displacement,
-            periodic=periodic,
-            tol=COARSE_TOL,
-            max_iter=_default_max_iter(hc.shape),
-            backend=backend,
-            threads=threads,
-            warm_start=start,
-            check_boundary=False,
-            raise_on_failure=False,
-        )
-    except ConvergenceError:  # pragma: no cover - raise_on_failure=False
-        return None, levels
-    p = res.pressure
-    if not np.isfinite(p).all() or not p.any():
-        return None, levels
-    levels.append(
-        {"shape": hc.shape, "iterations": res.iterations, "convolutions": res.info["convolutions"]}
-    )
-    return _prolong(p), levels
-
-
-def _prolong(p):
-    """Pixel replication 2x2: keeps the total force and the support of the pressure."""
-    return np.repeat(np.repeat(p, 2, axis=0), 2, axis=1)
 
 
 def solve(
@@ -152,8 +58,10 @@ def solve(
     backend=None,
     plasticity=None,
     plastic_displacement=None,
-    iterative=False,
-    max_outer=200,
+    method=None,
+    max_outer=None,
+    planner_effort=DEFAULT_PLANNER_EFFORT,
+    raise_on_failure=True,
 ) -> ContactResult:
     """Solve the frictionless contact of a rigid rough indenter on an elastic half-space.
 
@@ -174,16 +82,19 @@ def solve(
         Periodic boundary conditions (nominally flat surfaces) or a free half-space with
         Hockney padding (spheres; contact must stay off the window edge).
     tol : float
-        Convergence tolerance on the residual (see :mod:`amontons.contact.cg`).
+        Convergence tolerance on the residual (dimensionless, see :mod:`amontons.contact.cg`).
     max_iter : int, optional
-        Iteration cap on the finest grid (default ``1000 + 4(n0 + n1)``).
+        Conjugate-gradient iteration cap per solve on the finest grid (default
+        ``1000 + 4(n0 + n1)``).
     threads : int
-        FFTW threads.
+        FFTW threads (ignored, with a warning, by the numpy backend).
     warm_start : array_like, optional
         Initial pressure, Pa (e.g. the pressure of a previous, nearby solve).
     coarse_to_fine : bool
-        Start from the prolonged solution of the same problem on 2x, 4x, ... coarser grids
-        (ignored when ``warm_start`` is given or the shape is odd).
+        Elastic solves: start from the prolonged solution of the same problem on 2x, 4x, ...
+        coarser grids. Ignored, with an :class:`IgnoredOptionWarning`, with plasticity, with
+        a ``warm_start``, or when the grid has no coarse level (a side odd or below
+        ``2 * COARSE_MIN_SIZE`` = 64 pixels).
     backend : {"pyfftw", "numpy", None}
         FFT backend; None picks pyfftw when importable.
     plasticity : PenetrationHardness or ContactHardening, optional
@@ -192,11 +103,26 @@ def solve(
         where material flowed) and ``deformed_heights`` is h + h_pl.
     plastic_displacement : array_like, optional
         Plastic displacement left by earlier loading, m (the history of a load series).
-    iterative : bool
-        Contact hardening with local increments: force the appendix's iterative scheme
-        instead of the exact elastic-plus-Winkler route (used as the test oracle).
-    max_outer : int
-        Cap on the outer (plastic-update or active-set) iterations of a plastic solve.
+    method : {"winkler", "appendix", None}
+        Route of a plastic solve. ``"winkler"``: contact hardening with local increments
+        solved exactly as an elastic half-space plus a Winkler layer (docs/models.md §2.4);
+        ``"appendix"``: the appendix's iterative scheme (bounded solve, plastic increment,
+        repeat; needs ``alpha < 1`` for contact hardening). None (default): ``"winkler"``
+        where it applies, else ``"appendix"`` (penetration hardness, volume-conserving
+        increments). Ignored, with a warning, by an elastic solve.
+    max_outer : int, optional
+        Cap on the outer loop of a plastic solve: plastic updates per approach
+        (``"appendix"``, default 200) or active-set rounds (``"winkler"``, default 50).
+        Ignored, with a warning, by an elastic solve.
+    planner_effort : {"FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE"}
+        FFTW planner effort. The default ``"FFTW_ESTIMATE"`` is deterministic (same plan,
+        same result bytes in every run); ``"FFTW_MEASURE"`` times candidate plans, which is
+        faster per convolution but not reproducible bit for bit (benchmarks/README.md).
+        Operators are cached per effort. Ignored, with a warning, by the numpy backend.
+    raise_on_failure : bool
+        True (default): a solve that does not converge raises :class:`ConvergenceError`.
+        False: it returns a :class:`ContactResult` with ``success=False``, its ``status``
+        (1 iteration cap, 2 stalled) and ``message``, holding the last (finite) iterate.
 
     Returns
     -------
@@ -205,110 +131,344 @@ def solve(
     Raises
     ------
     ContactInputError
-        Invalid input (names the value and what was expected).
+        Invalid input (names the value and what was expected), always.
     ConvergenceError
-        No convergence within ``max_iter`` (carries the residual history).
+        No convergence (carries the residual history and ``status``), unless
+        ``raise_on_failure=False``; a solve whose fields hold NaN or inf raises always.
     FreeBoundaryError
-        Non-periodic solve with pressure on the outermost ring of the window.
+        Converged non-periodic solution with pressure on the outermost ring of the window,
+        whatever ``raise_on_failure`` (a non-converged iterate is not checked: its edge
+        pressure says nothing about the window).
+
+    Warns
+    -----
+    IgnoredOptionWarning
+        An option was given that has no effect on this solve (see the options above).
     """
-    h = _check_heights(heights)
-    spacing = _check_positive("spacing", spacing, "m")
-    e_star = _check_positive("e_star", e_star, "Pa")
-    if (load is None) == (displacement is None):
-        raise ContactInputError(
-            "give exactly one of load (N) and displacement (m); got "
-            f"load={load!r}, displacement={displacement!r}"
-        )
-    if load is not None:
-        load = _check_positive("load", load, "N")
-    else:
-        try:
-            displacement = float(displacement)
-        except (TypeError, ValueError):
-            raise ContactInputError(
-                f"displacement must be a number in m, got {displacement!r}"
-            ) from None
-        if not math.isfinite(displacement):
-            raise ContactInputError(f"displacement must be finite (m), got {displacement!r}")
-    tol = _check_positive("tol", tol, "(dimensionless)")
-    if max_iter is not None and (int(max_iter) != max_iter or max_iter < 1):
-        raise ContactInputError(f"max_iter must be a positive integer, got {max_iter!r}")
-    threads = int(threads)
-    if threads < 1:
-        raise ContactInputError(f"threads must be >= 1, got {threads}")
+    h = check_heights(heights)
+    spacing = check_positive("spacing", spacing, "m")
+    e_star = check_positive("e_star", e_star, "Pa")
+    load, displacement = check_control(load, displacement)
+    opts = solve_options(
+        h.shape,
+        periodic=periodic,
+        tol=tol,
+        max_iter=max_iter,
+        threads=threads,
+        backend=backend,
+        planner_effort=planner_effort,
+        plasticity=plasticity,
+        method=method,
+        max_outer=max_outer,
+        raise_on_failure=raise_on_failure,
+    )
     if warm_start is not None:
-        warm_start = _check_warm_start(warm_start, h.shape)
-    if plasticity is not None:
-        return _solve_plastic(
-            h,
-            spacing,
-            e_star,
-            _check_law(plasticity),
-            load=load,
-            displacement=displacement,
-            plastic_prev=_check_plastic_history(plastic_displacement, h.shape),
-            periodic=bool(periodic),
-            tol=tol,
-            max_iter=_default_max_iter(h.shape) if max_iter is None else int(max_iter),
-            backend=backend,
-            threads=threads,
-            warm_start=warm_start,
-            iterative=bool(iterative),
-            max_outer=_check_count("max_outer", max_outer),
-        )
-    if plastic_displacement is not None:
+        warm_start = check_warm_start(warm_start, h.shape)
+    if opts.law is None and plastic_displacement is not None:
         raise ContactInputError(
             "plastic_displacement was given without a plasticity law; pass plasticity="
             "PenetrationHardness(...) or ContactHardening(...)"
         )
-    return _solve(
+    plastic_prev = None
+    if opts.law is not None:
+        plastic_prev = check_plastic_history(plastic_displacement, h.shape)
+    _warn_ignored(
+        opts,
+        h.shape,
+        method=method,
+        max_outer=max_outer,
+        coarse_to_fine=coarse_to_fine,
+        warm_start=warm_start is not None,
+    )
+    return _solve_step(
         h,
         spacing,
         e_star,
+        opts,
         load=load,
         displacement=displacement,
-        periodic=bool(periodic),
-        tol=tol,
-        max_iter=_default_max_iter(h.shape) if max_iter is None else int(max_iter),
-        backend=backend,
-        threads=threads,
         warm_start=warm_start,
-        coarse_to_fine=coarse_to_fine,
+        plastic_prev=plastic_prev,
+        coarse_to_fine=bool(coarse_to_fine),
     )
 
 
-def _solve(
-    h,
+def solve_load_series(
+    heights,
     spacing,
     e_star,
+    loads: Sequence[float],
     *,
-    load,
-    displacement,
-    periodic,
-    tol,
-    max_iter,
-    backend,
-    threads,
-    warm_start,
+    periodic=False,
+    tol=1e-8,
+    max_iter=None,
+    threads=1,
     coarse_to_fine=False,
-    check_boundary=True,
+    backend=None,
+    plasticity=None,
+    method=None,
+    max_outer=None,
+    planner_effort=DEFAULT_PLANNER_EFFORT,
     raise_on_failure=True,
+) -> list[ContactResult]:
+    """Solve for increasing loads, each step warm-started from the previous pressure.
+
+    Parameters
+    ----------
+    heights, spacing, e_star, periodic, tol, max_iter, threads, backend
+        As in :func:`solve`.
+    loads : sequence of float
+        Total forces, N; strictly increasing and positive.
+    coarse_to_fine : bool
+        Coarse-to-fine start for the first load only (later loads are warm-started).
+        Ignored, with one :class:`IgnoredOptionWarning` per call, with plasticity or when
+        the grid has no coarse level.
+    plasticity : PenetrationHardness or ContactHardening, optional
+        Plasticity law; each load step starts from the plastic displacement and the
+        pressure of the previous one, so the series carries the plastic history.
+    method, max_outer, planner_effort
+        As in :func:`solve` (a warning about an ignored option is issued once per call).
+    raise_on_failure : bool
+        As in :func:`solve`. With False a step that does not converge is returned with
+        ``success=False`` and the series goes on from its state: check every result.
+
+    Returns
+    -------
+    list of ContactResult, one per load.
+    """
+    h = check_heights(heights)
+    spacing = check_positive("spacing", spacing, "m")
+    e_star = check_positive("e_star", e_star, "Pa")
+    arr = check_loads(loads)
+    opts = solve_options(
+        h.shape,
+        periodic=periodic,
+        tol=tol,
+        max_iter=max_iter,
+        threads=threads,
+        backend=backend,
+        planner_effort=planner_effort,
+        plasticity=plasticity,
+        method=method,
+        max_outer=max_outer,
+        raise_on_failure=raise_on_failure,
+    )
+    _warn_ignored(opts, h.shape, method=method, max_outer=max_outer, coarse_to_fine=coarse_to_fine)
+    plastic = None if opts.law is None else np.zeros(h.shape)
+    results = []
+    prev = None
+    for i, w in enumerate(arr):
+        res = _solve_step(
+            h,
+            spacing,
+            e_star,
+            opts,
+            load=float(w),
+            displacement=None,
+            warm_start=_scaled_start(prev, w),
+            plastic_prev=plastic,
+            coarse_to_fine=bool(coarse_to_fine) and i == 0,
+        )
+        if opts.law is not None:
+            plastic = res.plastic_displacement
+        results.append(res)
+        prev = res
+    return results
+
+
+def _scaled_start(prev, load):
+    """The previous step's pressure scaled to ``load`` (N): right total, right shape to first
+    order; None for the first step (or a previous step without load)."""
+    if prev is None or not prev.load > 0:
+        return None
+    return prev.pressure * (load / prev.load)
+
+
+def _warn_ignored(opts, shape, *, method, max_outer, coarse_to_fine, warm_start=False):
+    """Warn (IgnoredOptionWarning, from the caller's caller) about each ignored option."""
+    notes = _ignored_options(
+        opts,
+        shape,
+        method=method,
+        max_outer=max_outer,
+        coarse_to_fine=coarse_to_fine,
+        warm_start=warm_start,
+    )
+    for note in notes:
+        warnings.warn(note, IgnoredOptionWarning, stacklevel=3)
+
+
+def _ignored_options(opts, shape, *, method, max_outer, coarse_to_fine, warm_start):
+    """Messages naming every option given to a solve that has no effect on it."""
+    notes = []
+    if opts.law is None and method is not None:
+        notes.append(
+            f"method={method!r} is ignored: it picks the route of a plastic solve and this "
+            "solve is elastic (plasticity=None)"
+        )
+    if opts.law is None and max_outer is not None:
+        notes.append(
+            f"max_outer={max_outer!r} is ignored: it caps the outer loop of a plastic solve "
+            "and this solve is elastic (plasticity=None)"
+        )
+    if coarse_to_fine:
+        reason = _coarse_to_fine_obstacle(opts, shape, warm_start)
+        if reason:
+            notes.append(f"coarse_to_fine=True is ignored: {reason}")
+    if opts.backend == "numpy" and opts.threads > 1:
+        notes.append(f"threads={opts.threads} is ignored: the numpy FFT backend is serial")
+    if opts.backend == "numpy" and opts.planner_effort != DEFAULT_PLANNER_EFFORT:
+        notes.append(
+            f"planner_effort={opts.planner_effort!r} is ignored: the numpy FFT backend does "
+            "not plan"
+        )
+    return notes
+
+
+def _coarse_to_fine_obstacle(opts, shape, warm_start):
+    """Why a coarse-to-fine start cannot run, or None when it can."""
+    if opts.law is not None:
+        return "the coarse-to-fine start is only implemented for elastic solves"
+    if warm_start:
+        return "warm_start gives the starting pressure"
+    if not _has_coarse_level(shape):
+        return (
+            f"a {shape[0]}x{shape[1]} grid has no coarse level (both sides must be even and "
+            f"at least {2 * COARSE_MIN_SIZE} pixels)"
+        )
+    return None
+
+
+def _solve_step(
+    h, spacing, e_star, opts, *, load, displacement, warm_start, plastic_prev, coarse_to_fine
 ):
+    """One validated solve: elastic, or plastic from the plastic state ``plastic_prev``."""
+    if opts.law is None:
+        return _solve_elastic(
+            h,
+            spacing,
+            e_star,
+            opts,
+            load=load,
+            displacement=displacement,
+            warm_start=warm_start,
+            coarse_to_fine=coarse_to_fine,
+        )
+    return _solve_plastic(
+        h,
+        spacing,
+        e_star,
+        opts,
+        load=load,
+        displacement=displacement,
+        warm_start=warm_start,
+        plastic_prev=plastic_prev,
+    )
+
+
+def _solve_elastic(h, spacing, e_star, opts, *, load, displacement, warm_start, coarse_to_fine):
     t0 = time.perf_counter()
-    op = get_operator(h.shape, spacing, e_star, periodic=periodic, backend=backend, threads=threads)
-    levels = []
+    levels = ()
     p_init = warm_start
     if p_init is None and coarse_to_fine:
-        p_init, levels = _coarse_start(
-            h, spacing, e_star, load, displacement, periodic, backend, threads, COARSE_MIN_SIZE, []
-        )
+        p_init, levels = _coarse_start(h, spacing, e_star, load, displacement, opts)
     if p_init is None:
         p_init = _start_pressure(h, spacing, e_star, load, displacement)
+    out = _run_cg(
+        h,
+        spacing,
+        e_star,
+        opts,
+        load=load,
+        displacement=displacement,
+        p_init=p_init,
+        tol=opts.tol,
+        max_iter=opts.max_iter,
+    )
+    info = _solve_info(
+        opts,
+        convolutions=out.convolutions,
+        resets=out.info["steepest_descent_resets"],
+        outer_iterations=0,
+        coarse_levels=levels,
+        t0=t0,
+    )
+    return _finished(
+        h,
+        spacing,
+        opts,
+        out,
+        elastic=out.displacement_field,
+        plastic=np.zeros_like(out.pressure),
+        displacement=out.rigid_displacement,
+        info=info,
+        what="solver",
+    )
+
+
+def _solve_plastic(h, spacing, e_star, opts, *, load, displacement, warm_start, plastic_prev):
+    t0 = time.perf_counter()
+    op = _operator(h.shape, spacing, e_star, opts)
+    p_init = warm_start
+    if p_init is None:
+        p_init = _start_pressure(h + plastic_prev, spacing, e_star, load, displacement)
+    state = solve_plastic(
+        op,
+        h,
+        spacing,
+        opts.law,
+        load=load,
+        displacement=displacement,
+        plastic_prev=plastic_prev,
+        p_init=p_init,
+        periodic=opts.periodic,
+        tol=opts.tol,
+        max_iter=opts.max_iter,
+        max_outer=opts.max_outer,
+        route=opts.route,
+    )
+    info = _solve_info(
+        opts,
+        convolutions=state.convolutions,
+        resets=state.resets,
+        outer_iterations=state.outer_iterations,
+        coarse_levels=(),
+        t0=t0,
+    )
+    return _finished(
+        h,
+        spacing,
+        opts,
+        state,
+        elastic=state.elastic_displacement,
+        plastic=state.plastic_displacement,
+        displacement=state.displacement,
+        info=info,
+        what="plastic solve",
+    )
+
+
+def _operator(shape, spacing, e_star, opts: SolveOptions):
+    """The cached convolution operator of a grid (m, Pa) under the solve's options."""
+    return get_operator(
+        shape,
+        spacing,
+        e_star,
+        periodic=opts.periodic,
+        backend=opts.backend,
+        threads=opts.threads,
+        planner_effort=opts.planner_effort,
+    )
+
+
+def _run_cg(h, spacing, e_star, opts, *, load, displacement, p_init, tol, max_iter):
+    """One Polonsky–Keer solve of the hard-wall problem; returns its outcome, never raises
+    on non-convergence."""
     h_scale = float(np.std(h))
     if not h_scale > 0:
         h_scale = spacing  # a flat indenter: any length works, the gap is exactly 0
-    out = polonsky_keer(
-        op,
+    return polonsky_keer(
+        _operator(h.shape, spacing, e_star, opts),
         h,
         pixel_area=spacing**2,
         h_scale=h_scale,
@@ -317,34 +477,46 @@ def _solve(
         displacement=displacement,
         tol=tol,
         max_iter=max_iter,
-        raise_on_failure=raise_on_failure,
-    )
-    _check_finite("solver", out, tol)
-    if check_boundary and not periodic:
-        _check_free_boundary(out.pressure, spacing)
-    info = {
-        "convolutions": out.convolutions,
-        "steepest_descent_resets": out.info["steepest_descent_resets"],
-        "coarse_levels": levels,
-        "backend": op.backend,
-        "threads": threads,
-        "tol": tol,
-        "wall_time_s": time.perf_counter() - t0,
-    }
-    return _finished(
-        h,
-        spacing,
-        periodic,
-        out,
-        elastic=out.displacement_field,
-        plastic=np.zeros_like(out.pressure),
-        displacement=out.rigid_displacement,
-        info=info,
+        raise_on_failure=False,
     )
 
 
-def _finished(h, spacing, periodic, outcome, *, elastic, plastic, displacement, info):
-    """The ContactResult of a converged solve (``outcome``: a CG or plastic state)."""
+def _solve_info(opts, *, convolutions, resets, outer_iterations, coarse_levels, t0):
+    """The SolveInfo of a solve that started at ``t0`` (perf_counter, s)."""
+    return SolveInfo(
+        route=opts.route,
+        convolutions=int(convolutions),
+        steepest_descent_resets=int(resets),
+        outer_iterations=int(outer_iterations),
+        coarse_levels=tuple(coarse_levels),
+        plasticity=opts.law,
+        backend=opts.backend,
+        threads=opts.threads,
+        planner_effort=opts.planner_effort,
+        tol=opts.tol,
+        max_iter=opts.max_iter,
+        max_outer=opts.max_outer,
+        wall_time_s=time.perf_counter() - t0,
+    )
+
+
+def _finished(h, spacing, opts, outcome, *, elastic, plastic, displacement, info, what):
+    """The ContactResult of a solve (``outcome``: a CG or plastic state), after the checks:
+    non-convergence (raises unless ``raise_on_failure=False``), non-finite fields (raise
+    always) and, for a converged non-periodic solution, pressure on the window edge (raises
+    always; a non-converged iterate's edge pressure says nothing about the window)."""
+    if not outcome.converged and opts.raise_on_failure:
+        raise ConvergenceError(
+            outcome.message,
+            iterations=outcome.iterations,
+            residual=outcome.residual,
+            tol=opts.tol,
+            residual_history=outcome.history,
+            status=outcome.status,
+        )
+    _check_finite(what, outcome, opts.tol)
+    if outcome.converged and not opts.periodic:
+        _check_free_boundary(outcome.pressure, spacing)
     p = outcome.pressure
     return ContactResult(
         pressure=p,
@@ -358,8 +530,10 @@ def _finished(h, spacing, periodic, outcome, *, elastic, plastic, displacement, 
         iterations=outcome.iterations,
         residual=outcome.residual,
         residual_history=outcome.history,
-        converged=outcome.converged,
-        periodic=periodic,
+        success=outcome.converged,
+        status=outcome.status,
+        message=outcome.message,
+        periodic=opts.periodic,
         heights=h,
         info=info,
     )
@@ -367,15 +541,20 @@ def _finished(h, spacing, periodic, outcome, *, elastic, plastic, displacement, 
 
 def _check_finite(what, outcome, tol):
     """Raise ConvergenceError when a solve's pressure or gap holds NaN or inf (never return
-    them)."""
-    if not (np.isfinite(outcome.pressure).all() and np.isfinite(outcome.gap).all()):
+    them, whatever ``raise_on_failure``)."""
+    if not _finite(outcome):
         raise ConvergenceError(
             f"{what} produced non-finite pressure or gap (NaN/inf)",
             iterations=outcome.iterations,
             residual=outcome.residual,
             tol=tol,
             residual_history=outcome.history,
+            status=STALLED,
         )
+
+
+def _finite(outcome) -> bool:
+    return bool(np.isfinite(outcome.pressure).all() and np.isfinite(outcome.gap).all())
 
 
 def _check_free_boundary(p, spacing):
@@ -397,161 +576,69 @@ def _check_free_boundary(p, spacing):
         )
 
 
-def _check_law(law):
-    if not isinstance(law, PenetrationHardness | ContactHardening):
-        raise ContactInputError(
-            f"plasticity must be PenetrationHardness(p_y) or ContactHardening(k), got {law!r}"
-        )
-    return law
+# --- starting pressures -------------------------------------------------------------------
 
 
-def _check_plastic_history(plastic, shape):
-    if plastic is None:
-        return np.zeros(shape)
-    h_pl = np.asarray(plastic, dtype=np.float64)
-    if h_pl.shape != shape:
-        raise ContactInputError(
-            f"plastic_displacement must have the shape of heights {shape}, got {h_pl.shape}"
-        )
-    if not np.isfinite(h_pl).all():
-        raise ContactInputError("plastic_displacement contains NaN or inf; expected metres")
-    return h_pl
+def _start_pressure(h, spacing, e_star, load, displacement):
+    """Starting pressure (Pa) without a warm start: uniform under load control (the solver
+    rescales it to the load), the overlap guess under displacement control."""
+    if load is not None:
+        return np.ones_like(h)
+    return _initial_pressure(h, spacing, e_star, displacement)
 
 
-def _check_count(name, value):
-    if int(value) != value or value < 1:
-        raise ContactInputError(f"{name} must be a positive integer, got {value!r}")
-    return int(value)
+def _initial_pressure(h, spacing, e_star, displacement):
+    """Starting pressure (Pa) for displacement control: a local-stiffness overlap guess."""
+    overlap = np.maximum(h + displacement, 0.0)
+    n = np.count_nonzero(overlap)
+    if n == 0:
+        return np.zeros_like(h)
+    # a patch of size L has stiffness ~E*/L, so p ~ E* overlap / L
+    return overlap * (e_star / (math.sqrt(n) * spacing))
 
 
-def _solve_plastic(
-    h,
-    spacing,
-    e_star,
-    law,
-    *,
-    load,
-    displacement,
-    plastic_prev,
-    periodic,
-    tol,
-    max_iter,
-    backend,
-    threads,
-    warm_start,
-    iterative,
-    max_outer,
-):
-    t0 = time.perf_counter()
-    op = get_operator(h.shape, spacing, e_star, periodic=periodic, backend=backend, threads=threads)
-    p_init = warm_start
-    if p_init is None:
-        p_init = _start_pressure(h + plastic_prev, spacing, e_star, load, displacement)
-    state = solve_plastic(
-        op,
-        h,
-        spacing,
-        law,
+def _has_coarse_level(shape) -> bool:
+    """Whether a grid can be coarsened 2x2 at least once (even sides, >= 2 COARSE_MIN_SIZE)."""
+    n0, n1 = shape
+    return not (n0 % 2 or n1 % 2 or min(n0, n1) < 2 * COARSE_MIN_SIZE)
+
+
+def _coarsen(h):
+    n0, n1 = h.shape
+    return h.reshape(n0 // 2, 2, n1 // 2, 2).mean(axis=(1, 3))
+
+
+def _coarse_start(h, spacing, e_star, load, displacement, opts, levels=()):
+    """Pressure (Pa) on the grid of ``h`` from a solve on a 2x coarser grid, or None, and
+    the coarse levels solved (coarsest first).
+
+    Heights are block-averaged 2x2 (spacing doubles); the coarse pressure is prolonged by
+    pixel replication, which keeps the total force. Recurses down to ``COARSE_MIN_SIZE``.
+    A level that stalls or has no usable pressure gives no start.
+    """
+    if not _has_coarse_level(h.shape):
+        return None, levels
+    hc = _coarsen(h)
+    start, levels = _coarse_start(hc, 2 * spacing, e_star, load, displacement, opts, levels)
+    if start is None:
+        start = _start_pressure(hc, 2 * spacing, e_star, load, displacement)
+    out = _run_cg(
+        hc,
+        2 * spacing,
+        e_star,
+        opts,
         load=load,
         displacement=displacement,
-        plastic_prev=plastic_prev,
-        p_init=p_init,
-        periodic=periodic,
-        tol=tol,
-        max_iter=max_iter,
-        max_outer=max_outer,
-        iterative=iterative,
+        p_init=start,
+        tol=COARSE_TOL,
+        max_iter=default_max_iter(hc.shape),
     )
-    _check_finite("plastic solve", state, tol)
-    if not periodic:
-        _check_free_boundary(state.pressure, spacing)
-    info = {
-        "convolutions": state.convolutions,
-        "outer_iterations": state.outer_iterations,
-        "plasticity": law,
-        "backend": op.backend,
-        "threads": threads,
-        "tol": tol,
-        "wall_time_s": time.perf_counter() - t0,
-    }
-    return _finished(
-        h,
-        spacing,
-        periodic,
-        state,
-        elastic=state.elastic_displacement,
-        plastic=state.plastic_displacement,
-        displacement=state.displacement,
-        info=info,
-    )
+    if out.status == STALLED or not _finite(out) or not out.pressure.any():
+        return None, levels
+    levels = (*levels, CoarseLevel(hc.shape, out.iterations, out.convolutions))
+    return _prolong(out.pressure), levels
 
 
-def solve_load_series(
-    heights,
-    spacing,
-    e_star,
-    loads: Sequence[float],
-    *,
-    periodic=False,
-    tol=1e-8,
-    max_iter=None,
-    threads=1,
-    coarse_to_fine=False,
-    backend=None,
-    plasticity=None,
-    max_outer=200,
-) -> list[ContactResult]:
-    """Solve for increasing loads, each step warm-started from the previous pressure.
-
-    Parameters
-    ----------
-    heights, spacing, e_star, periodic, tol, max_iter, threads, backend
-        As in :func:`solve`.
-    loads : sequence of float
-        Total forces, N; strictly increasing and positive.
-    coarse_to_fine : bool
-        Coarse-to-fine start for the first load only (later loads are warm-started;
-        ignored with plasticity).
-    plasticity : PenetrationHardness or ContactHardening, optional
-        Plasticity law; each load step starts from the plastic displacement and the
-        pressure of the previous one, so the series carries the plastic history.
-    max_outer : int
-        As in :func:`solve`.
-
-    Returns
-    -------
-    list of ContactResult, one per load.
-    """
-    arr = np.asarray(loads, dtype=float)
-    if arr.ndim != 1 or arr.size == 0:
-        raise ContactInputError(f"loads must be a non-empty 1-D sequence (N), got {loads!r}")
-    if not np.isfinite(arr).all() or (arr <= 0).any():
-        raise ContactInputError(f"loads must be finite and positive (N), got {arr.tolist()}")
-    if arr.size > 1 and (np.diff(arr) <= 0).any():
-        raise ContactInputError(f"loads must be strictly increasing (N), got {arr.tolist()}")
-    results = []
-    prev = None
-    for i, w in enumerate(arr):
-        # scale the previous field to the new load: right total, right shape to first order
-        start = None if prev is None else prev.pressure * (w / prev.load)
-        res = solve(
-            heights,
-            spacing,
-            e_star,
-            load=float(w),
-            periodic=periodic,
-            tol=tol,
-            max_iter=max_iter,
-            threads=threads,
-            warm_start=start,
-            coarse_to_fine=coarse_to_fine and i == 0 and plasticity is None,
-            backend=backend,
-            plasticity=plasticity,
-            plastic_displacement=None
-            if prev is None or plasticity is None
-            else prev.plastic_displacement,
-            max_outer=max_outer,
-        )
-        results.append(res)
-        prev = res
-    return results
+def _prolong(p):
+    """Pixel replication 2x2: keeps the total force and the support of the pressure."""
+    return np.repeat(np.repeat(p, 2, axis=0), 2, axis=1)

@@ -6,7 +6,7 @@ either the total force ``A0 Σp = W`` prescribed (load control; ``d`` is then th
 multiplier of the force constraint) or the rigid-body approach ``d`` prescribed
 (displacement control). ``K*`` is a convolution operator (m/Pa), ``A0`` the pixel area.
 
-Algorithm (science.md §2.1), per iteration on the free set ``Ic`` (``p > 0``):
+Algorithm (docs/models.md §2.2), per iteration on the free set ``Ic`` (``p > 0``):
 gap ``g`` (load control: minus its mean over ``Ic``, which is the approach ``d``),
 ``G = Σ_Ic g²``, conjugate direction ``t = g + δ (G/G_old) t`` on ``Ic`` (0 elsewhere),
 ``r = K*t`` (load control: minus its mean over ``Ic``), step ``τ = Σ g t / Σ r t``,
@@ -32,7 +32,10 @@ Convergence: two dimensionless measures,
 
 The solve has converged when both are below ``tol``, the complementarity re-evaluated
 with a freshly convolved ``u`` (never the incrementally updated one); the reported final
-residual is the larger of the two.
+residual is the larger of the two. The outcome's ``status`` is 0 (converged), 1
+(``max_iter`` reached) or 2 (stalled: a periodic displacement-controlled solve reached full
+contact, where the mean pressure is undetermined); see
+:class:`amontons.contact.ContactResult`.
 
 Cost: ``r = K*t`` is one convolution per iteration. ``u = K*p`` would be a second one, but
 the new pressure is ``s (p - τ t + c)`` with ``c`` non-zero only on the points the
@@ -58,7 +61,7 @@ import numpy as np
 from scipy.linalg.blas import daxpy as _axpy
 
 from . import fft as _fft
-from .result import ConvergenceError
+from .result import CONVERGED, ITERATION_CAP, STALLED, ConvergenceError
 
 _ALIGNED_BACKEND = "pyfftw" if _fft.HAVE_PYFFTW else "numpy"
 
@@ -162,7 +165,11 @@ RESET_FRACTION = 0.01
 
 @dataclass
 class CGOutcome:
-    """Raw output of :func:`polonsky_keer` (fields in SI units)."""
+    """Raw output of :func:`polonsky_keer` (fields in SI units).
+
+    ``status``: 0 converged, 1 ``max_iter`` reached, 2 stalled; ``message`` says which,
+    with the iterations and the residual.
+    """
 
     pressure: np.ndarray
     displacement_field: np.ndarray
@@ -171,9 +178,15 @@ class CGOutcome:
     iterations: int
     residual: float
     history: np.ndarray
-    converged: bool
+    status: int
+    message: str
     convolutions: int
     info: dict = field(default_factory=dict)
+
+    @property
+    def converged(self) -> bool:
+        """True when ``status == 0``."""
+        return self.status == CONVERGED
 
 
 def polonsky_keer(
@@ -219,7 +232,8 @@ def polonsky_keer(
     constraint : HardWall, optional
         The inequality constraint (default: hard wall).
     raise_on_failure : bool
-        Raise :class:`ConvergenceError` when ``max_iter`` is reached (else return).
+        Raise :class:`ConvergenceError` when the solve stops without converging (status 1
+        or 2); else return the last iterate with that status.
     """
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
@@ -271,6 +285,7 @@ def polonsky_keer(
     d = 0.0 if load_control else float(displacement)
     residual = np.inf
     converged = False
+    stalled = None  # message when the solve cannot go on (status 2)
     it = 0
     # periodic kernel with q = 0 set to 0: a uniform pressure over the whole grid costs no
     # displacement, so displacement control is singular once every point is in contact
@@ -280,15 +295,22 @@ def polonsky_keer(
     while it < max_iter:
         it += 1
         if singular_full and nc == n:
-            raise ConvergenceError(
+            stalled = (
                 "periodic displacement-controlled solve reached full contact: the mean "
                 "pressure is then undetermined (the q = 0 mode is the rigid mode); use load "
-                f"control or a smaller displacement (d = {d:.3e} m)",
-                iterations=it,
-                residual=float(residual),
-                tol=tol,
-                residual_history=np.asarray(history),
+                f"control or a smaller displacement (d = {d:.3e} m)"
             )
+            if raise_on_failure:
+                raise ConvergenceError(
+                    stalled,
+                    iterations=it,
+                    residual=float(residual),
+                    tol=tol,
+                    residual_history=np.asarray(history),
+                    status=STALLED,
+                )
+            it -= 1  # this iteration did not run
+            break
         # --- gap on the free set m (maintained sparsely, see HardWall) ---------------
         np.subtract(u, h, out=g)
         if nc == 0:
@@ -422,15 +444,15 @@ def polonsky_keer(
         d = float(np.dot(u - h, m) / nc)
     gap = u - h - d
     hist = np.asarray(history)
-    if not converged and raise_on_failure:
+    status, message = _status_message(converged, stalled, it, residual, tol, shape, p)
+    if status != CONVERGED and raise_on_failure:
         raise ConvergenceError(
-            f"Polonsky-Keer CG did not converge in {it} iterations: residual "
-            f"{residual:.3e} > tol {tol:.1e} (grid {shape[0]}x{shape[1]}, "
-            f"{int(np.count_nonzero(p))} contact pixels)",
+            message,
             iterations=it,
             residual=float(residual),
             tol=tol,
             residual_history=hist,
+            status=status,
         )
     return CGOutcome(
         pressure=np.array(p.reshape(shape)),
@@ -440,9 +462,26 @@ def polonsky_keer(
         iterations=it,
         residual=float(residual),
         history=hist,
-        converged=converged,
+        status=status,
+        message=message,
         convolutions=calls,
         info={"steepest_descent_resets": resets},
+    )
+
+
+def _status_message(converged, stalled, it, residual, tol, shape, p):
+    """Status code (0, 1, 2) and message of a finished CG solve."""
+    if converged:
+        return CONVERGED, (
+            f"Polonsky-Keer CG converged in {it} iterations: residual {residual:.3e} < "
+            f"tol {tol:.1e}"
+        )
+    if stalled is not None:
+        return STALLED, f"{stalled}; stopped after {it} iterations at residual {residual:.3e}"
+    return ITERATION_CAP, (
+        f"Polonsky-Keer CG did not converge in {it} iterations: residual "
+        f"{residual:.3e} > tol {tol:.1e} (grid {shape[0]}x{shape[1]}, "
+        f"{int(np.count_nonzero(p))} contact pixels)"
     )
 
 

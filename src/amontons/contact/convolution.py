@@ -22,8 +22,8 @@ displacement (m) on the same grid:
     transform, kept for tests and benchmarks.
 
 Operators own aligned work arrays and FFTW plans; :func:`get_operator` caches them per
-(shape, spacing, E*, periodic, backend, threads, pruned). Operators are not thread-safe
-(shared work arrays); use one process per concurrent solve.
+(shape, spacing, E*, periodic, backend, threads, pruned, planner effort). Operators are not
+thread-safe (shared work arrays); use one process per concurrent solve.
 """
 
 from __future__ import annotations
@@ -65,16 +65,28 @@ class PeriodicConvolution(_MultiplierMixin):
     backend : {"pyfftw", "numpy", None}
     threads : int
         FFTW threads.
+    planner_effort : str
+        FFTW planner effort, one of :data:`amontons.contact.fft.PLANNER_EFFORTS`
+        (default ``"FFTW_ESTIMATE"``: deterministic).
     """
 
     periodic = True
 
-    def __init__(self, shape, spacing, e_star, backend=None, threads=1):
+    def __init__(
+        self,
+        shape,
+        spacing,
+        e_star,
+        backend=None,
+        threads=1,
+        planner_effort=_fft.DEFAULT_PLANNER_EFFORT,
+    ):
         self.shape = tuple(int(s) for s in shape)
         self.spacing = float(spacing)
         self.e_star = float(e_star)
         self.backend = _fft.resolve_backend(backend)
         self.threads = int(threads)
+        self.planner_effort = _fft.check_planner_effort(planner_effort)
         self._multiplier = periodic_multiplier(self.shape, spacing, e_star)
         self._green = None  # real-space kernel, built on first use
         self.ncalls = 0
@@ -82,10 +94,9 @@ class PeriodicConvolution(_MultiplierMixin):
             spec_shape = self._multiplier.shape
             self._real = _fft.empty(self.shape, np.float64, self.backend)
             self._spec = _fft.empty(spec_shape, np.complex128, self.backend)
-            self._fwd = _fft.fftw_plan(self._real, self._spec, (0, 1), threads=threads)
-            self._inv = _fft.fftw_plan(
-                self._spec, self._real, (0, 1), inverse=True, threads=threads
-            )
+            kw = {"threads": threads, "planner_effort": planner_effort}
+            self._fwd = _fft.fftw_plan(self._real, self._spec, (0, 1), **kw)
+            self._inv = _fft.fftw_plan(self._spec, self._real, (0, 1), inverse=True, **kw)
             # plans run through execute(), which does not normalise the inverse: fold the
             # 1/(n0 n1) of the inverse DFT into the multiplier instead of an extra pass
             self._scale = 1.0 / (self.shape[0] * self.shape[1])
@@ -162,17 +173,30 @@ class NonPeriodicConvolution(_MultiplierMixin):
         FFTW threads.
     pruned : bool
         Use the pruned transform (default) or the plain ``2n0 × 2n1`` one.
+    planner_effort : str
+        FFTW planner effort, one of :data:`amontons.contact.fft.PLANNER_EFFORTS`
+        (default ``"FFTW_ESTIMATE"``: deterministic).
     """
 
     periodic = False
 
-    def __init__(self, shape, spacing, e_star, backend=None, threads=1, pruned=True):
+    def __init__(
+        self,
+        shape,
+        spacing,
+        e_star,
+        backend=None,
+        threads=1,
+        pruned=True,
+        planner_effort=_fft.DEFAULT_PLANNER_EFFORT,
+    ):
         self.shape = tuple(int(s) for s in shape)
         self.spacing = float(spacing)
         self.e_star = float(e_star)
         self.backend = _fft.resolve_backend(backend)
         self.threads = int(threads)
         self.pruned = bool(pruned)
+        self.planner_effort = _fft.check_planner_effort(planner_effort)
         self._multiplier = hockney_multiplier(self.shape, spacing, e_star)
         self.ncalls = 0
         n0, n1 = self.shape
@@ -188,14 +212,13 @@ class NonPeriodicConvolution(_MultiplierMixin):
             self._rows = _fft.empty((n0, 2 * n1), np.float64, be)
             self._spec = _fft.empty(spec_shape, np.complex128, be)
             self._out = _fft.empty((n0, 2 * n1), np.float64, be)
-            t = threads
-            self._row_fwd = _fft.fftw_plan(self._rows, self._spec[:n0], (1,), threads=t)
-            self._col_fwd = _fft.fftw_plan(self._spec, self._spec, (0,), threads=t)
-            self._col_inv = _fft.fftw_plan(self._spec, self._spec, (0,), inverse=True, threads=t)
-            self._row_inv = _fft.fftw_plan(
-                self._spec[:n0], self._out, (1,), inverse=True, threads=t
-            )
-            # planning (FFTW_MEASURE) scribbles over the arrays: set the padding afterwards
+            kw = {"threads": threads, "planner_effort": planner_effort}
+            self._row_fwd = _fft.fftw_plan(self._rows, self._spec[:n0], (1,), **kw)
+            self._col_fwd = _fft.fftw_plan(self._spec, self._spec, (0,), **kw)
+            self._col_inv = _fft.fftw_plan(self._spec, self._spec, (0,), inverse=True, **kw)
+            self._row_inv = _fft.fftw_plan(self._spec[:n0], self._out, (1,), inverse=True, **kw)
+            # planning (FFTW_MEASURE and above) scribbles over the arrays: set the padding
+            # afterwards
             self._rows[...] = 0.0
             # plans run through execute(), which does not normalise inverses: the
             # 1/(2n0 · 2n1) of the inverse DFT is folded into the multiplier
@@ -205,10 +228,9 @@ class NonPeriodicConvolution(_MultiplierMixin):
         else:
             self._real = _fft.empty((2 * n0, 2 * n1), np.float64, be)
             self._spec = _fft.empty(spec_shape, np.complex128, be)
-            self._fwd = _fft.fftw_plan(self._real, self._spec, (0, 1), threads=threads)
-            self._inv = _fft.fftw_plan(
-                self._spec, self._real, (0, 1), inverse=True, threads=threads
-            )
+            kw = {"threads": threads, "planner_effort": planner_effort}
+            self._fwd = _fft.fftw_plan(self._real, self._spec, (0, 1), **kw)
+            self._inv = _fft.fftw_plan(self._spec, self._real, (0, 1), inverse=True, **kw)
             self._real[...] = 0.0
             self._scale = 1.0 / (4 * n0 * n1)
             self._mult_scaled = _scaled(self._multiplier, self._scale)
@@ -252,13 +274,23 @@ class NonPeriodicConvolution(_MultiplierMixin):
 
 
 @lru_cache(maxsize=8)
-def _cached_operator(shape, spacing, e_star, periodic, backend, threads, pruned):
+def _cached_operator(shape, spacing, e_star, periodic, backend, threads, pruned, effort):
     if periodic:
-        return PeriodicConvolution(shape, spacing, e_star, backend, threads)
-    return NonPeriodicConvolution(shape, spacing, e_star, backend, threads, pruned)
+        return PeriodicConvolution(shape, spacing, e_star, backend, threads, effort)
+    return NonPeriodicConvolution(shape, spacing, e_star, backend, threads, pruned, effort)
 
 
-def get_operator(shape, spacing, e_star, *, periodic, backend=None, threads=1, pruned=True):
+def get_operator(
+    shape,
+    spacing,
+    e_star,
+    *,
+    periodic,
+    backend=None,
+    threads=1,
+    pruned=True,
+    planner_effort=_fft.DEFAULT_PLANNER_EFFORT,
+):
     """Cached convolution operator (plans and kernel spectrum built once).
 
     Parameters
@@ -273,8 +305,14 @@ def get_operator(shape, spacing, e_star, *, periodic, backend=None, threads=1, p
     threads : int
     pruned : bool
         Non-periodic only: pruned (default) or plain padded transform.
+    planner_effort : str
+        FFTW planner effort, one of :data:`amontons.contact.fft.PLANNER_EFFORTS`; part of
+        the cache key (operators planned with different efforts are distinct).
     """
     backend = _fft.resolve_backend(backend)
+    effort = _fft.check_planner_effort(planner_effort)
+    if backend == "numpy":
+        effort = _fft.DEFAULT_PLANNER_EFFORT  # numpy.fft does not plan: one cache entry
     key_pruned = bool(pruned) and not periodic
     return _cached_operator(
         tuple(int(s) for s in shape),
@@ -284,6 +322,7 @@ def get_operator(shape, spacing, e_star, *, periodic, backend=None, threads=1, p
         backend,
         int(threads),
         key_pruned,
+        effort,
     )
 
 

@@ -3,15 +3,23 @@
 ``pyfftw`` is optional. When it cannot be imported, or when ``backend="numpy"`` is
 requested, transforms go through :mod:`numpy.fft`. Plans are bound to aligned work arrays
 owned by the convolution operators (see :mod:`amontons.contact.convolution`), which are
-themselves cached per (shape, spacing, E*, backend, threads), so every FFTW plan is built
-once per process and reused across iterations, solves and load steps.
+themselves cached per (shape, spacing, E*, backend, threads, planner effort), so every FFTW
+plan is built once per process and reused across iterations, solves and load steps.
+
+Planner effort is an explicit argument (no environment variable). The default,
+``FFTW_ESTIMATE``, picks the plan by heuristics: the same plan, hence the same round-off
+and the same output bytes, in every run. ``FFTW_MEASURE`` (and ``FFTW_PATIENT``,
+``FFTW_EXHAUSTIVE``) time candidate algorithms while planning, so the plan, and the last
+bits of every result, can change from run to run; benchmarks/README.md measures what they
+gain (512²: ~5 % per periodic convolution, ~25 % per pruned non-periodic one, for
+0.4-0.6 s of planning per operator).
 """
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
+
+from .result import ContactInputError
 
 try:  # pyfftw is optional: numpy.fft is the fallback
     import pyfftw
@@ -23,12 +31,9 @@ except ImportError:  # pragma: no cover - depends on the environment
 
 BACKENDS = ("pyfftw", "numpy")
 
-# Measured (benchmarks/README.md, 512²): FFTW_MEASURE plans in ~0.4-0.6 s and makes the
-# pruned non-periodic convolution ~25 % faster than FFTW_ESTIMATE (periodic: ~5 %);
-# FFTW_PATIENT plans for 4-12 s and gains nothing more, so MEASURE is the default.
-# Override with the environment variable AMONTONS_FFTW_EFFORT (FFTW_ESTIMATE /
-# FFTW_MEASURE / FFTW_PATIENT).
-PLANNER_EFFORT = os.environ.get("AMONTONS_FFTW_EFFORT", "FFTW_MEASURE")
+# FFTW planner flags, cheapest first; only the first is deterministic.
+PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
+DEFAULT_PLANNER_EFFORT = "FFTW_ESTIMATE"
 
 
 def resolve_backend(backend: str | None) -> str:
@@ -36,16 +41,33 @@ def resolve_backend(backend: str | None) -> str:
 
     Raises
     ------
-    ValueError
-        For an unknown name, or ``"pyfftw"`` requested but not importable.
+    ContactInputError
+        (a ValueError) For an unknown name, or ``"pyfftw"`` requested but not importable.
     """
     if backend is None:
         return "pyfftw" if HAVE_PYFFTW else "numpy"
     if backend not in BACKENDS:
-        raise ValueError(f"unknown FFT backend {backend!r}; expected one of {BACKENDS}")
+        raise ContactInputError(
+            f"unknown FFT backend {backend!r}; expected one of {BACKENDS} or None"
+        )
     if backend == "pyfftw" and not HAVE_PYFFTW:
-        raise ValueError("FFT backend 'pyfftw' requested but pyfftw is not importable")
+        raise ContactInputError("FFT backend 'pyfftw' requested but pyfftw is not importable")
     return backend
+
+
+def check_planner_effort(planner_effort: str) -> str:
+    """Return ``planner_effort`` if it is one of :data:`PLANNER_EFFORTS`.
+
+    Raises
+    ------
+    ContactInputError
+        (a ValueError) Naming the allowed values.
+    """
+    if not isinstance(planner_effort, str) or planner_effort not in PLANNER_EFFORTS:
+        raise ContactInputError(
+            f"planner_effort must be one of {PLANNER_EFFORTS}, got {planner_effort!r}"
+        )
+    return planner_effort
 
 
 def empty(shape, dtype, backend: str) -> np.ndarray:
@@ -74,18 +96,28 @@ def aligned(a: np.ndarray, shape) -> bool:
     )
 
 
-def fftw_plan(src, dst, axes, *, inverse: bool = False, threads: int = 1):
+def fftw_plan(
+    src,
+    dst,
+    axes,
+    *,
+    inverse: bool = False,
+    threads: int = 1,
+    planner_effort: str = DEFAULT_PLANNER_EFFORT,
+):
     """Build an FFTW plan ``src -> dst`` over ``axes`` (pyfftw only).
 
     The plan's kind (r2c, c2r, c2c) follows from the dtypes. Inverse transforms are
-    normalised like :func:`numpy.fft.ifft` (divide by the transform length).
-    Planning with FFTW_MEASURE overwrites ``src`` and ``dst``: callers fill the arrays
-    after planning.
+    normalised like :func:`numpy.fft.ifft` (divide by the transform length) when called,
+    not through ``execute()``. ``planner_effort`` is one of :data:`PLANNER_EFFORTS`.
+    Planning with FFTW_MEASURE or more overwrites ``src`` and ``dst``: callers fill the
+    arrays after planning.
     """
+    effort = check_planner_effort(planner_effort)
     direction = "FFTW_BACKWARD" if inverse else "FFTW_FORWARD"
     # Inverse plans only ever read scratch spectra, so FFTW may overwrite them (faster c2r).
     # Forward plans must not: their inputs hold the permanent zero padding.
-    flags = (PLANNER_EFFORT, "FFTW_DESTROY_INPUT") if inverse else (PLANNER_EFFORT,)
+    flags = (effort, "FFTW_DESTROY_INPUT") if inverse else (effort,)
     return pyfftw.FFTW(
         src, dst, axes=tuple(axes), direction=direction, flags=flags, threads=int(threads)
     )
@@ -100,17 +132,26 @@ class RealFFT2Pair:
         Real array shape.
     backend : {"pyfftw", "numpy", None}
     threads : int
+    planner_effort : str
+        One of :data:`PLANNER_EFFORTS` (pyfftw only).
     """
 
-    def __init__(self, shape, backend: str | None = None, threads: int = 1):
+    def __init__(
+        self,
+        shape,
+        backend: str | None = None,
+        threads: int = 1,
+        planner_effort: str = DEFAULT_PLANNER_EFFORT,
+    ):
         self.backend = resolve_backend(backend)
         self.shape = tuple(shape)
         spec_shape = (shape[0], shape[1] // 2 + 1)
         self.real = empty(self.shape, np.float64, self.backend)
         self.spec = empty(spec_shape, np.complex128, self.backend)
         if self.backend == "pyfftw":
-            self._fwd = fftw_plan(self.real, self.spec, (0, 1), threads=threads)
-            self._inv = fftw_plan(self.spec, self.real, (0, 1), inverse=True, threads=threads)
+            kw = {"threads": threads, "planner_effort": planner_effort}
+            self._fwd = fftw_plan(self.real, self.spec, (0, 1), **kw)
+            self._inv = fftw_plan(self.spec, self.real, (0, 1), inverse=True, **kw)
         self.real[...] = 0.0
 
     def __call__(self) -> None:

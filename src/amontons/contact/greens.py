@@ -1,4 +1,5 @@
-"""Green's functions (surface displacement per unit pressure) of the elastic half-space.
+"""Green's functions (surface displacement per unit pressure) of the elastic half-space
+(docs/models.md §2.1).
 
 Units: lengths in m, contact modulus ``e_star`` in Pa; the kernels map a pressure in Pa
 to a displacement in m.

@@ -9,8 +9,8 @@ roughness-averaged pressure at radius r is the GW pressure of the local mean-pla
 where d is the approach of the sphere and w(r) the elastic bulk deflection under p (positive
 into the solid), F_n(h) = ∫_h^∞ (s − h)^n φ(s) ds with φ the standard normal density.
 
-Notation trap (science.md §2.7): in GT's paper B is the sphere radius and β the asperity radius;
-the appendix's "B = 1/h''_rms, η h_rms B ≈ 0.05" is β = 1/h''_rms and ησβ ≈ 0.05.
+Notation trap (docs/models.md §2.5): in GT's paper B is the sphere radius and β the asperity
+radius; the appendix's "B = 1/h''_rms, η h_rms B ≈ 0.05" is β = 1/h''_rms and ησβ ≈ 0.05.
 
 The axisymmetric bulk deflection uses the exact influence of uniform pressure on annuli
 (Johnson 1985, §3.4, difference of two uniformly loaded disks), and the nonlinear system is
@@ -26,6 +26,8 @@ from functools import cache
 
 import numpy as np
 from scipy import integrate, interpolate, optimize, special
+
+from .result import ContactError, ContactInputError
 
 _H_MIN, _H_MAX = -12.0, 10.0
 
@@ -74,7 +76,7 @@ class AsperityModel:
         """The appendix's closure: σ = h_rms, β = 1/h''_rms, η = (ησβ)/(σβ).
 
         Which curvature h''_rms means (mean curvature ½∇²h or ∇²h) changes β by 2; the caller
-        states it (see amontons.surface).
+        states it (docs/models.md §2.5). Units: h_rms in m, curvature in 1/m.
         """
         beta = 1.0 / curvature_rms_per_m
         return cls(h_rms_m, beta, eta_sigma_beta / (h_rms_m * beta))
@@ -124,8 +126,11 @@ def annulus_influence(edges_m: np.ndarray, e_star_pa: float) -> np.ndarray:
     return influence
 
 
-class GreenwoodTrippError(RuntimeError):
-    """The GT iteration did not converge, or the radial domain is too small for the load."""
+class GreenwoodTrippError(ContactError, RuntimeError):
+    """The GT iteration did not converge, or the radial domain is too small for the load.
+
+    Part of the :class:`~amontons.contact.ContactError` tree (and a RuntimeError, as before).
+    """
 
 
 @dataclass(frozen=True)
@@ -219,7 +224,7 @@ def greenwood_tripp(
     below 1e-6 of the peak, else GreenwoodTrippError asks for a larger domain.
     """
     if load_n <= 0 or e_star_pa <= 0 or radius_m <= 0:
-        raise ValueError(
+        raise ContactInputError(
             f"GT needs positive load, E* and radius; got {load_n}, {e_star_pa}, {radius_m}"
         )
     hertz_a = (3 * load_n * radius_m / (4 * e_star_pa)) ** (1 / 3)

@@ -1,4 +1,4 @@
-"""Plastic displacement increments of appendix B.2.3 (eqs. B.2 and B.3).
+"""Plastic displacement increments of appendix B.2.3 (eqs. B.2 and B.3; docs/models.md §2.3).
 
 Sign convention (as the solver's): heights h of the rigid indenter, larger = closer to the
 elastic body; the gap g = u − h − d is negative where the indenter penetrates. A plastic

@@ -7,16 +7,22 @@ Two laws, each with local (eq. B.2) or volume-conserving (eq. B.3) plastic incre
   is lowered by α·Δh_pl; repeat until the gap is non-negative everywhere.
 * :class:`ContactHardening`: p_Y = k·|h_pl| per pixel, so an untouched point yields at once.
 
-Routes (science.md §2.3). Under monotonic loading every contact point of the hardening law sits
-on its yield surface, p = k·|h_pl|, so the converged state is an elastic half-space plus a
-Winkler layer of stiffness k: (K + I/k) p = h + d on the contact set. That linear
-complementarity problem is solved directly, with one extension that keeps it exact when a
-point unloads under a later load: the plastic displacement of earlier steps is a floor, so each
-point either flows (Winkler, on the undeformed heights) or stays elastic on its earlier
-deformation; an active-set loop picks which (it is the convex problem with dissipation
-potential φ'(p) = max(|h_pl,prev|, p/k)). This is the product route for local increments; the
-appendix's iterative scheme (bounded CG, gap, increment, repeat) is kept for volume-conserving
-increments — where pile-up breaks the Winkler picture — and as the test oracle.
+Routes (docs/models.md §2.4; ``method=`` of :func:`amontons.contact.solve`). Under monotonic
+loading every contact point of the hardening law sits on its yield surface, p = k·|h_pl|, so
+the converged state is an elastic half-space plus a Winkler layer of stiffness k:
+(K + I/k) p = h + d on the contact set. That linear complementarity problem is solved
+directly, with one extension that keeps it exact when a point unloads under a later load: the
+plastic displacement of earlier steps is a floor, so each point either flows (Winkler, on the
+undeformed heights) or stays elastic on its earlier deformation; an active-set loop picks
+which (it is the convex problem with dissipation potential φ'(p) = max(|h_pl,prev|, p/k)).
+This is the ``"winkler"`` route, the default for local increments. The appendix's iterative
+scheme (bounded CG, gap, increment, repeat; docs/models.md §2.3) is the ``"appendix"``
+route: taken by penetration hardness, by volume-conserving increments (where pile-up breaks
+the Winkler picture) and on request (``method="appendix"``, the test oracle).
+
+Failures do not raise here: every route returns a :class:`PlasticState` whose ``status``
+(0 converged, 1 iteration cap, 2 stalled) and ``message`` say how it stopped, holding the
+last iterate; :func:`amontons.contact.solve` decides whether to raise.
 
 Load control of the iterative schemes is a root find on the rigid-body approach (the load is a
 continuous, non-decreasing function of it), each trial starting from the previous step's
@@ -27,7 +33,7 @@ SI units: heights, gaps, plastic displacement in m; pressures and p_Y in Pa; k i
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Literal
 
@@ -36,9 +42,15 @@ from scipy import optimize
 
 from .cg import BoundedWall, polonsky_keer
 from .plastic_increments import local_increment, volume_conserving_increment
-from .result import ContactInputError, ConvergenceError
+from .result import CONVERGED, ITERATION_CAP, STALLED, ContactInputError
 
 Increment = Literal["local", "volume"]
+METHODS = ("winkler", "appendix")
+
+# Default caps on the outer loop (max_outer=None): plastic updates per approach of the
+# appendix scheme, and active-set rounds of the Winkler route.
+MAX_PLASTIC_UPDATES = 200
+MAX_ACTIVE_SET_ROUNDS = 50
 
 
 def _check_increment(increment: str, alpha: float) -> None:
@@ -88,7 +100,12 @@ class ContactHardening:
 
 @dataclass
 class PlasticState:
-    """Converged state of one load step (arrays on the solver grid)."""
+    """State of one load step (arrays on the solver grid; SI units).
+
+    ``status`` 0 (converged), 1 (iteration cap) or 2 (stalled), with ``message`` saying why;
+    a failed state holds the last iterate. ``iterations``, ``convolutions`` and ``resets``
+    (steepest-descent restarts) are summed over the conjugate-gradient solves of the step.
+    """
 
     pressure: np.ndarray
     gap: np.ndarray
@@ -98,9 +115,76 @@ class PlasticState:
     iterations: int
     residual: float
     history: np.ndarray
-    converged: bool
     convolutions: int
     outer_iterations: int
+    resets: int = 0
+    status: int = CONVERGED
+    message: str = ""
+
+    @property
+    def converged(self) -> bool:
+        """True when ``status == 0``."""
+        return self.status == CONVERGED
+
+
+@dataclass
+class _Tally:
+    """Work summed over the conjugate-gradient solves of one step."""
+
+    iterations: int = 0
+    convolutions: int = 0
+    resets: int = 0
+    history: list = field(default_factory=list)
+
+    def add(self, out) -> None:
+        self.iterations += out.iterations
+        self.convolutions += out.convolutions
+        self.resets += out.info["steepest_descent_resets"]
+        self.history.extend(out.history)
+
+
+def check_method(method) -> None:
+    """Raise ContactInputError unless ``method`` is None or one of :data:`METHODS`."""
+    if method is not None and (not isinstance(method, str) or method not in METHODS):
+        raise ContactInputError(
+            f"method must be one of {METHODS} (or None: the law's default), got {method!r}"
+        )
+
+
+def resolve_route(law, method) -> str:
+    """The route of a plastic solve, ``"winkler"`` or ``"appendix"``.
+
+    ``method=None`` picks the law's default: ``"winkler"`` for contact hardening with local
+    increments (exact), ``"appendix"`` otherwise (the only route there).
+
+    Raises
+    ------
+    ContactInputError
+        An unknown method; ``"winkler"`` for a law it cannot solve; ``"appendix"`` for
+        contact hardening with ``alpha = 1``.
+    """
+    check_method(method)
+    winkler_ok = isinstance(law, ContactHardening) and law.increment == "local"
+    if method is None:
+        method = "winkler" if winkler_ok else "appendix"
+    if method == "winkler" and not winkler_ok:
+        raise ContactInputError(
+            "method='winkler' (the exact elastic-plus-Winkler route) only solves "
+            f"ContactHardening with local increments, not {law!r}; use method='appendix' or "
+            "None"
+        )
+    if method == "appendix" and isinstance(law, ContactHardening) and law.alpha == 1:
+        # with p_Y = k|h_pl| and α = 1 the first update closes every gap at zero pressure,
+        # a fixed point of the scheme that is not the hardening state
+        raise ContactInputError(
+            "the iterative contact-hardening scheme needs over-relaxation alpha < 1; got 1"
+        )
+    return method
+
+
+def default_max_outer(route: str) -> int:
+    """Cap on the outer loop of a route when ``max_outer`` is None."""
+    return MAX_ACTIVE_SET_ROUNDS if route == "winkler" else MAX_PLASTIC_UPDATES
 
 
 def _increment(gap, increment: Increment, periodic: bool):
@@ -131,8 +215,7 @@ def _plastic_iteration(
     p_max per pixel (Pa)."""
     h_pl = plastic_prev.copy()
     p = p_init
-    iterations = convolutions = 0
-    history = []
+    tally = _Tally()
     for outer in range(1, max_outer + 1):
         p_max = bound(h_pl)
         out = polonsky_keer(
@@ -145,42 +228,66 @@ def _plastic_iteration(
             tol=tol,
             max_iter=max_iter,
             constraint=BoundedWall(p_max),
+            raise_on_failure=False,
         )
         p = out.pressure
-        iterations += out.iterations
-        convolutions += out.convolutions
-        history.extend(out.history)
+        tally.add(out)
+        state = _appendix_state(out, h_pl, displacement, tally, outer)
+        if not out.converged:
+            return state
         # Only points at the bound yield (appendix: "where p = p_Y the material deforms
         # plastically"); a free point's gap is the elastic solver's residual, not flow.
         yielding = np.where((p >= p_max) & (out.gap < 0.0), out.gap, 0.0)
         worst = float(-yielding.min())
         if worst <= tol * h_scale:
-            return PlasticState(
-                pressure=p,
-                gap=out.gap,
-                elastic_displacement=out.displacement_field,
-                plastic_displacement=h_pl,
-                displacement=displacement,
-                iterations=iterations,
-                residual=max(out.residual, worst / h_scale),
-                history=np.asarray(history),
-                converged=True,
-                convolutions=convolutions,
-                outer_iterations=outer,
+            residual = max(out.residual, worst / h_scale)
+            return replace(
+                state,
+                residual=residual,
+                message=f"appendix scheme converged in {outer} round(s) of bounded solve and "
+                f"plastic update, {tally.iterations} CG iterations: residual {residual:.3e} < "
+                f"tol {tol:.1e}",
             )
         h_pl = h_pl + alpha * _increment(yielding, increment, periodic)
-    raise ConvergenceError(
-        f"plastic iteration did not make the gap non-negative in {max_outer} updates: worst "
-        f"penetration {worst:.3e} m > {tol * h_scale:.3e} m (alpha={alpha}, {increment} "
-        "increments); lower alpha or raise max_outer",
-        iterations=iterations,
+    return replace(
+        state,
         residual=worst / h_scale,
-        tol=tol,
-        residual_history=np.asarray(history),
+        status=ITERATION_CAP,
+        message=f"plastic iteration did not make the gap non-negative in {max_outer} updates: "
+        f"worst penetration {worst:.3e} m > {tol * h_scale:.3e} m (alpha={alpha}, "
+        f"{increment} increments, {tally.iterations} CG iterations, residual "
+        f"{worst / h_scale:.3e}); lower alpha or raise max_outer",
+    )
+
+
+def _appendix_state(out, h_pl, displacement, tally, outer):
+    """The state of the appendix scheme after a bounded solve ``out`` on h + ``h_pl``,
+    with the status and message of that solve."""
+    return PlasticState(
+        pressure=out.pressure,
+        gap=out.gap,
+        elastic_displacement=out.displacement_field,
+        plastic_displacement=h_pl,
+        displacement=displacement,
+        iterations=tally.iterations,
+        residual=out.residual,
+        history=np.asarray(tally.history),
+        convolutions=tally.convolutions,
+        outer_iterations=outer,
+        resets=tally.resets,
+        status=out.status,
+        message=out.message,
     )
 
 
 class _Found(Exception):
+    def __init__(self, state):
+        self.state = state
+
+
+class _Failed(Exception):
+    """A trial approach's solve stopped without converging (carries its state)."""
+
     def __init__(self, state):
         self.state = state
 
@@ -197,12 +304,17 @@ def _find_approach(evaluate, load, d_guess, d_step, load_tol, load_atol=0.0):
     Brent's method (scipy), stopping early once the load is within ``load_tol`` (relative).
     Where load(d) is nearly a staircase (a fully plastic contact: one more pixel, p_Y·Δx² more
     load), the closest state found is returned if its load is within ``load_atol`` (N, one
-    pixel's worth); otherwise, or when no bracket or root is found, ConvergenceError.
+    pixel's worth). Otherwise, or when no bracket or root is found, or a trial approach does
+    not converge, the closest state found (else the failed trial) is returned with status 1
+    (a trial or Brent's method hit its iteration cap) or 2 (stalled) and a message.
     """
-    best = {"err": np.inf, "state": None}
+    best = {"err": np.inf, "state": None, "latest": None}
 
     def residual(d):
         f, state = evaluate(d)
+        best["latest"] = state
+        if not state.converged:
+            raise _Failed(state)
         err = abs(f - load)
         if err < best["err"]:
             best.update(err=err, state=state)
@@ -210,15 +322,13 @@ def _find_approach(evaluate, load, d_guess, d_step, load_tol, load_atol=0.0):
             raise _Found(state)
         return f - load
 
-    def failed(why):
-        state = best["state"]
-        return ConvergenceError(
-            f"load control of the plastic solve failed: {why}; closest load is "
+    def failed(why, status=STALLED, fallback=None):
+        state = next(s for s in (best["state"], fallback, best["latest"]) if s is not None)
+        return replace(
+            state,
+            status=status,
+            message=f"load control of the plastic solve failed: {why}; closest load is "
             f"{best['err']:.3e} N from {load:.3e} N",
-            iterations=0 if state is None else state.iterations,
-            residual=np.inf if state is None else state.residual,
-            tol=load_tol,
-            residual_history=np.empty(0) if state is None else state.history,
         )
 
     try:
@@ -236,14 +346,16 @@ def _find_approach(evaluate, load, d_guess, d_step, load_tol, load_atol=0.0):
                     break
             step *= 2
         else:
-            raise failed(f"no approach brackets the load after {MAX_BRACKET_STEPS} doublings")
+            return failed(f"no approach brackets the load after {MAX_BRACKET_STEPS} doublings")
         optimize.brentq(residual, d_lo, d_hi, xtol=1e-13 * d_step, rtol=1e-15, maxiter=200)
     except _Found as found:
         return found.state
+    except _Failed as trial:
+        return failed(trial.state.message, trial.state.status, trial.state)
     except (ValueError, RuntimeError) as error:  # brentq: no sign change / no convergence
-        raise failed(str(error)) from error
+        return failed(str(error), ITERATION_CAP if isinstance(error, RuntimeError) else STALLED)
     if best["err"] > max(load_tol * load, load_atol):
-        raise failed("the load is not a continuous function of the approach here")
+        return failed("the load is not a continuous function of the approach here")
     return best["state"]
 
 
@@ -273,15 +385,14 @@ def _hardening_winkler(
     p_init,
     tol,
     max_iter,
-    max_rounds=50,
+    max_rounds=MAX_ACTIVE_SET_ROUNDS,
 ):
     """Contact hardening with local increments, exact for any load history (module doc)."""
     floor = np.maximum(-plastic_prev, 0.0)  # plastic depth already reached, m
     flowing = np.ones(heights.shape, dtype=bool)
     p = p_init
-    iterations = convolutions = 0
-    history = []
-    for rounds in range(1, max_rounds + 1):  # noqa: B007 (reported after the loop)
+    tally = _Tally()
+    for rounds in range(1, max_rounds + 1):
         compliance = np.where(flowing, 1.0 / k, 0.0)
         effective = np.where(flowing, heights, heights - floor)
         out = polonsky_keer(
@@ -294,24 +405,36 @@ def _hardening_winkler(
             displacement=displacement,
             tol=tol,
             max_iter=max_iter,
+            raise_on_failure=False,
         )
         p = out.pressure
-        iterations += out.iterations
-        convolutions += out.convolutions
-        history.extend(out.history)
+        tally.add(out)
+        state = _winkler_state(out, heights, k, floor, flowing, compliance, tally, rounds)
+        if not out.converged:
+            return state
         now_flowing = (p > k * floor) | (floor == 0)
         if np.array_equal(now_flowing, flowing):
-            break
+            return replace(
+                state,
+                message=f"elastic-plus-Winkler solve converged in {rounds} active-set "
+                f"round(s), {tally.iterations} CG iterations: residual {out.residual:.3e} < "
+                f"tol {tol:.1e}",
+            )
+        switching = int(np.count_nonzero(now_flowing != flowing))
         flowing = now_flowing
-    else:
-        raise ConvergenceError(
-            f"hardening active set did not settle in {max_rounds} rounds "
-            f"({int(np.count_nonzero(now_flowing != flowing))} pixels still switching)",
-            iterations=iterations,
-            residual=out.residual,
-            tol=tol,
-            residual_history=np.asarray(history),
-        )
+    return replace(
+        state,
+        status=ITERATION_CAP,
+        message=f"hardening active set did not settle in {max_rounds} rounds ({switching} "
+        f"pixels still switching; {tally.iterations} CG iterations, residual "
+        f"{out.residual:.3e})",
+    )
+
+
+def _winkler_state(out, heights, k, floor, flowing, compliance, tally, rounds):
+    """The hardening state of a Winkler solve ``out`` with the active set ``flowing``
+    (status and message of that solve)."""
+    p = out.pressure
     depth = np.where(flowing & (p > 0), np.maximum(p / k, floor), floor)
     plastic = -depth
     elastic = out.displacement_field - compliance * p
@@ -322,12 +445,14 @@ def _hardening_winkler(
         elastic_displacement=elastic,
         plastic_displacement=plastic,
         displacement=out.rigid_displacement,
-        iterations=iterations,
+        iterations=tally.iterations,
         residual=out.residual,
-        history=np.asarray(history),
-        converged=out.converged,
-        convolutions=convolutions,
+        history=np.asarray(tally.history),
+        convolutions=tally.convolutions,
         outer_iterations=rounds,
+        resets=tally.resets,
+        status=out.status,
+        message=out.message,
     )
 
 
@@ -344,26 +469,19 @@ def solve_plastic(
     periodic,
     tol,
     max_iter,
-    max_outer=200,
-    iterative=False,
+    max_outer=None,
+    route="winkler",
 ):
     """One load step of a plasticity law, starting from the plastic state ``plastic_prev``.
 
-    ``iterative=True`` forces the appendix scheme for contact hardening with local increments
-    (the oracle); otherwise that case takes the exact Winkler route.
+    ``route`` comes from :func:`resolve_route`: ``"winkler"`` (contact hardening with local
+    increments, exact) or ``"appendix"`` (the appendix's iterative scheme). ``max_outer``
+    caps the active-set rounds or the plastic updates per approach (None:
+    :func:`default_max_outer`). Returns a :class:`PlasticState`, converged or not.
     """
     pixel_area = spacing**2
     h_scale = float(np.std(heights)) or spacing
-    if (
-        isinstance(law, ContactHardening)
-        and law.alpha == 1
-        and (iterative or law.increment != "local")
-    ):
-        # with p_Y = k|h_pl| and α = 1 the first update closes every gap at zero pressure,
-        # a fixed point of the scheme that is not the hardening state
-        raise ContactInputError(
-            "the iterative contact-hardening scheme needs over-relaxation alpha < 1; got 1"
-        )
+    max_outer = default_max_outer(route) if max_outer is None else max_outer
     if isinstance(law, ContactHardening):
         winkler = partial(
             _hardening_winkler,
@@ -377,7 +495,7 @@ def solve_plastic(
             tol=tol,
             max_iter=max_iter,
         )
-        if law.increment == "local" and not iterative:
+        if route == "winkler":
             if (plastic_prev > 0).any():
                 # pile-up only comes from volume-conserving increments, which the Winkler
                 # route does not model
@@ -386,7 +504,7 @@ def solve_plastic(
                     f"{plastic_prev.max():.3e} m), which the exact Winkler route of local "
                     "increments cannot carry; use increment='volume' for pile-up"
                 )
-            return winkler(load=load, displacement=displacement)
+            return winkler(load=load, displacement=displacement, max_rounds=max_outer)
     if isinstance(law, PenetrationHardness):
         p_y = np.broadcast_to(np.asarray(law.p_y, dtype=float), heights.shape)
         capacity = float(p_y.sum()) * pixel_area
@@ -434,7 +552,10 @@ def solve_plastic(
     span = float(np.ptp(heights)) or spacing
     if isinstance(law, ContactHardening):
         # the Winkler state is exact for local increments and close for volume-conserving ones
-        d_guess = winkler(load=load, displacement=None).displacement
+        guess = winkler(load=load, displacement=None)
+        if not guess.converged:
+            return replace(guess, message=f"starting approach (Winkler solve): {guess.message}")
+        d_guess = guess.displacement
     else:
         elastic = polonsky_keer(
             operator,
@@ -445,8 +566,9 @@ def solve_plastic(
             load=load,
             tol=tol,
             max_iter=max_iter,
+            raise_on_failure=False,
         )
-        if np.all(elastic.pressure <= bound(plastic_prev)):
+        if not elastic.converged or np.all(elastic.pressure <= bound(plastic_prev)):
             # the bound is never reached: the elastic solution is the answer
             return _elastic_state(elastic, plastic_prev)
         last["p"] = np.minimum(elastic.pressure, bound(plastic_prev))
@@ -462,7 +584,11 @@ def solve_plastic(
 
 
 def _elastic_state(out, plastic_prev):
-    """A PK outcome that never reached the bound, as the state of a plastic step."""
+    """A PK outcome that never reached the bound, as the state of a plastic step (or the
+    failed elastic starting solve, with its status)."""
+    message = out.message
+    if out.converged:
+        message = f"the hardness is never reached, the elastic solution holds: {message}"
     return PlasticState(
         pressure=out.pressure,
         gap=out.gap,
@@ -472,7 +598,9 @@ def _elastic_state(out, plastic_prev):
         iterations=out.iterations,
         residual=out.residual,
         history=out.history,
-        converged=out.converged,
         convolutions=out.convolutions,
         outer_iterations=0,
+        resets=out.info["steepest_descent_resets"],
+        status=out.status,
+        message=message,
     )

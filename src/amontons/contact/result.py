@@ -1,13 +1,26 @@
-"""Result object and exceptions of the contact solver.
+"""Result objects, status codes, warnings and exceptions of the contact solver.
 
 All fields are in SI units: pressures in Pa, lengths in m, forces in N, areas in m².
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover - annotations only
+    from .plasticity import ContactHardening, PenetrationHardness
+
+# Status codes of a solve (ContactResult.status, ConvergenceError.status).
+CONVERGED = 0  # every convergence criterion below tol
+ITERATION_CAP = 1  # stopped at max_iter (CG) or max_outer (plastic updates, active-set rounds)
+STALLED = 2  # stopped for another reason: singular problem, failed load root find
+
+STATUS_NAMES = {CONVERGED: "converged", ITERATION_CAP: "iteration cap reached", STALLED: "stalled"}
+
+ROUTES = ("elastic", "winkler", "appendix")
 
 
 class ContactError(Exception):
@@ -19,18 +32,21 @@ class ContactInputError(ContactError, ValueError):
 
 
 class ConvergenceError(ContactError, RuntimeError):
-    """The constrained conjugate gradient did not converge within ``max_iter`` iterations.
+    """A solve did not converge (raised unless ``raise_on_failure=False``).
 
     Attributes
     ----------
     iterations : int
-        Iterations performed.
+        Conjugate-gradient iterations performed.
     residual : float
         Last value of the convergence measure (dimensionless).
     tol : float
         Requested tolerance.
     residual_history : numpy.ndarray
         Convergence measure after every iteration.
+    status : int
+        The status a returned result would carry: 1 (iteration cap reached) or 2 (stalled
+        or other failure; see :class:`ContactResult`).
     """
 
     def __init__(
@@ -41,12 +57,14 @@ class ConvergenceError(ContactError, RuntimeError):
         residual: float,
         tol: float,
         residual_history: np.ndarray,
+        status: int = STALLED,
     ):
         super().__init__(message)
         self.iterations = iterations
         self.residual = residual
         self.tol = tol
         self.residual_history = residual_history
+        self.status = status
 
 
 class FreeBoundaryError(ContactError, RuntimeError):
@@ -70,13 +88,114 @@ class FreeBoundaryError(ContactError, RuntimeError):
         self.edge_force = edge_force
 
 
+class IgnoredOptionWarning(UserWarning):
+    """An option was given that has no effect on this solve and is ignored.
+
+    Issued (``warnings.warn``) by :func:`~amontons.contact.solve` and
+    :func:`~amontons.contact.solve_load_series`, once per call; the message names the option
+    and why it has no effect. Options that cannot be honoured at all raise
+    :class:`ContactInputError` instead.
+    """
+
+
 @dataclass(frozen=True)
+class CoarseLevel:
+    """One coarse grid of a coarse-to-fine start (solved loosely, to ``COARSE_TOL``).
+
+    Attributes
+    ----------
+    shape : (int, int)
+        Grid shape of the level, pixels.
+    iterations : int
+        Conjugate-gradient iterations on that level.
+    convolutions : int
+        Convolutions performed on that level.
+    """
+
+    shape: tuple[int, int]
+    iterations: int
+    convolutions: int
+
+
+@dataclass(frozen=True)
+class SolveInfo:
+    """Diagnostics of one solve; the same fields on every route (0/None where not applicable).
+
+    Attributes
+    ----------
+    route : {"elastic", "winkler", "appendix"}
+        How the solve was done: ``"elastic"`` (no plasticity law; one Polonsky–Keer solve),
+        ``"winkler"`` (contact hardening with local increments, solved exactly as an elastic
+        half-space plus a Winkler layer) or ``"appendix"`` (the appendix's iterative scheme:
+        bounded solve, plastic increment, repeat; penetration hardness always takes it).
+    convolutions : int
+        Convolutions on the finest grid. Plastic routes under load control: those of the
+        final approach only (the root find's trial approaches are not counted).
+    steepest_descent_resets : int
+        Conjugate-gradient restarts from steepest descent (see :mod:`amontons.contact.cg`),
+        counted like ``convolutions``.
+    outer_iterations : int
+        Outer rounds of the returned state: active-set rounds (``"winkler"``) or rounds of
+        bounded solve and plastic update at the final approach (``"appendix"``; 0 when the
+        elastic solution never reaches the hardness); 0 for an elastic solve.
+    coarse_levels : tuple of CoarseLevel
+        Coarse grids solved for a coarse-to-fine start, coarsest first; empty when none ran.
+    plasticity : PenetrationHardness or ContactHardening or None
+        The plasticity law, None for an elastic solve.
+    backend : {"pyfftw", "numpy"}
+        FFT backend used.
+    threads : int
+        FFTW threads.
+    planner_effort : str
+        FFTW planner effort of the convolution plans (unused by the numpy backend).
+    tol : float
+        Requested tolerance (dimensionless).
+    max_iter : int
+        Conjugate-gradient iteration cap per solve on the finest grid.
+    max_outer : int or None
+        Cap on ``outer_iterations``; None for an elastic solve.
+    wall_time_s : float
+        Wall time of the solve, s.
+    """
+
+    route: str
+    convolutions: int
+    steepest_descent_resets: int
+    outer_iterations: int
+    coarse_levels: tuple[CoarseLevel, ...]
+    plasticity: PenetrationHardness | ContactHardening | None
+    backend: str
+    threads: int
+    planner_effort: str
+    tol: float
+    max_iter: int
+    max_outer: int | None
+    wall_time_s: float
+
+
+@dataclass(frozen=True, eq=False)
 class ContactResult:
-    """Converged solution of one contact problem.
+    """Solution of one contact problem, converged or (with ``raise_on_failure=False``) not.
 
     Sign convention: elastic displacement ``u`` is positive into the elastic substrate, the
     rigid indenter heights ``h`` are larger where the indenter is closer to the substrate and
     ``displacement`` ``d`` is the rigid-body approach; the gap is ``g = u - h - d``.
+
+    Equality is identity (``r == r`` is True, two results never compare equal): the fields
+    are arrays; compare them with :func:`numpy.array_equal` if needed.
+
+    Status codes (``status``; as in :class:`scipy.optimize.OptimizeResult`):
+
+    * ``0`` converged: every convergence criterion is below ``tol``;
+    * ``1`` iteration cap reached: ``max_iter`` conjugate-gradient iterations, or
+      ``max_outer`` plastic updates / active-set rounds, without convergence;
+    * ``2`` stalled: stopped for another reason, e.g. a periodic displacement-controlled
+      solve reached full contact (the mean pressure is then undetermined) or the load
+      control of a plastic solve found no approach that carries the load.
+
+    A result with ``status != 0`` is only returned when ``raise_on_failure=False``; it holds
+    the last iterate (finite; not checked against the window edge), and ``message`` says
+    why the solve stopped.
 
     Attributes
     ----------
@@ -98,19 +217,25 @@ class ContactResult:
     spacing : float
         Grid spacing, m.
     iterations : int
-        Conjugate-gradient iterations (on the finest grid).
+        Conjugate-gradient iterations on the finest grid (summed over the solves of a
+        plastic step; under load control, those of the final approach).
     residual : float
         Final convergence measure (dimensionless, see :mod:`amontons.contact.cg`).
     residual_history : ndarray
         Convergence measure after every iteration.
-    converged : bool
-        True when ``residual < tol``.
+    success : bool
+        True when the solve converged (``status == 0``).
+    status : int
+        0 converged, 1 iteration cap reached, 2 stalled (see above).
+    message : str
+        Why the solve stopped, with the iterations and the residual.
     periodic : bool
         Whether the problem was solved with periodic boundary conditions.
     heights : ndarray, optional
         The undeformed indenter heights h that were solved for, m.
-    info : dict
-        Further diagnostics (convolutions performed, coarse levels, ...).
+    info : SolveInfo, optional
+        Diagnostics: route, convolutions, coarse levels, backend, timing (see
+        :class:`SolveInfo`).
     """
 
     pressure: np.ndarray
@@ -124,10 +249,23 @@ class ContactResult:
     iterations: int
     residual: float
     residual_history: np.ndarray
-    converged: bool
+    success: bool
+    status: int
+    message: str
     periodic: bool
-    heights: np.ndarray | None = field(default=None, compare=False)
-    info: dict = field(default_factory=dict, compare=False)
+    heights: np.ndarray | None = None
+    info: SolveInfo | None = None
+
+    def __post_init__(self):
+        if self.status not in STATUS_NAMES:
+            raise ValueError(f"status must be one of {sorted(STATUS_NAMES)}, got {self.status!r}")
+        if bool(self.success) != (self.status == CONVERGED):
+            raise ValueError(f"success={self.success!r} contradicts status={self.status!r}")
+
+    @property
+    def converged(self) -> bool:
+        """Alias of :attr:`success` (read-only), kept for existing callers."""
+        return self.success
 
     @property
     def deformed_heights(self) -> np.ndarray:

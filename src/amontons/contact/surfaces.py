@@ -1,4 +1,5 @@
-"""Indenter geometries: spheres and self-affine random surfaces (heights in m).
+"""Indenter geometries: spheres and self-affine random surfaces (heights in m;
+docs/models.md §2.6).
 
 Heights follow the solver's convention: larger = closer to the elastic flat.
 """
