@@ -23,7 +23,7 @@ install: $(STAMP)
 reproduce: $(STAMP)
 	$(BIN)/snakemake --profile profiles/default --cores $(CORES) --configfile config/config.yaml
 	$(BIN)/snakemake --profile profiles/default --cores $(CORES) --configfile config/config.yaml \
-		--report results/report.html
+		--report results/full/report.html
 
 test: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest

@@ -15,7 +15,7 @@ include: "workflow/rules/common.smk"
 
 
 wildcard_constraints:
-    sphere="|".join(map(re.escape, SPHERES.index)),
+    sphere="|".join(map(re.escape, SPHERES)),
     material="|".join(map(re.escape, MATERIALS)),
 
 

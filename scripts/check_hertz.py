@@ -4,8 +4,8 @@ import logging
 
 import pandas as pd
 
-from amontons.images import atomic_path
-from amontons.measurements import hertz_check_table
+from amontons.io.files import write_table
+from amontons.measure.hertz_check import hertz_check_table
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
@@ -16,8 +16,7 @@ def main(area_path: str, table_path: str, diameter_mm: float, e_star_gpa: float)
     log.info(
         "%s: radius ratio measured/Hertz %s", area_path, table["radius_ratio"].round(3).tolist()
     )
-    with atomic_path(table_path) as tmp:
-        table.to_csv(tmp, index=False)
+    write_table(table_path, table)
 
 
 if __name__ == "__main__":

@@ -6,13 +6,10 @@ from pathlib import Path
 if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
-# The same seed must give the same files in every run: FFTW_MEASURE picks its algorithm by
-# timing, so round-off (and the plastic field, and afm_after.tif) changed from run to run;
-# FFTW_ESTIMATE plans the same way every time (measured: byte-identical files).
-os.environ.setdefault("AMONTONS_FFTW_EFFORT", "FFTW_ESTIMATE")
 
 from amontons.runlog import run_logged
-from amontons.virtual.experiment import InstrumentSettings, SurfaceSettings, generate_sphere
+from amontons.virtual.experiment import generate_sphere
+from amontons.virtual.settings import InstrumentSettings, SurfaceSettings
 
 
 def main(
@@ -28,6 +25,7 @@ def main(
     shear_strength_mpa: float,
     pixel_nm: float,
     settings: dict,
+    newton_rings: dict,
     seed: int,
     threads: int,
 ) -> None:
@@ -43,7 +41,7 @@ def main(
         reflection_load_n=reflection_load_mn * 1e-3,
         flim_load_n=None if flim_load_mn is None else flim_load_mn * 1e-3,
         shear_strength_pa=shear_strength_mpa * 1e6,
-        settings=InstrumentSettings.from_config(settings),
+        settings=InstrumentSettings.from_config(settings, newton_rings),
         surface=SurfaceSettings.from_config(settings),
         seed=seed,
         threads=threads,
@@ -67,6 +65,7 @@ if __name__ == "__main__":
         shear_strength_mpa=sm.params.shear_strength_mpa,
         pixel_nm=sm.params.pixel_nm,
         settings=sm.params.settings,
+        newton_rings=sm.params.newton_rings,
         seed=sm.params.seed,
         threads=sm.threads,
     )

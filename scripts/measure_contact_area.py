@@ -2,11 +2,10 @@
 
 import logging
 
-import pandas as pd
-
-from amontons.images import atomic_path, saturated_pixels
-from amontons.measurements import image_contact_area, read_fluorescence_series
-from amontons.optics.area import OtsuSettings
+from amontons.io.files import write_table
+from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.rawdata import read_fluorescence_series
+from amontons.measure.area import OtsuSettings, contact_area_table, image_contact_area
 from amontons.plots import plot_contact_separation
 from amontons.runlog import run_logged
 
@@ -14,7 +13,7 @@ log = logging.getLogger(__name__)
 
 
 def main(
-    fluorescence_dir: str,
+    fluorescence,
     table_path: str,
     figure_paths: list[str],
     loads_mn: list[float],
@@ -24,38 +23,21 @@ def main(
     sphere: str,
 ) -> None:
     settings = OtsuSettings.from_config(otsu)
-    images = read_fluorescence_series(fluorescence_dir, loads_mn, pixel_nm * 1e-9)
-    rows, areas = [], []
-    for load, image in zip(loads_mn, images, strict=True):
-        path = image.path
-        area = image_contact_area(image, settings)
-        if not area.contact_found:
-            log.warning("%s: no contact found: %s", path, area.flag)
-        saturated = saturated_pixels(image.data)
-        if saturated:
+    paths = per_load_files(fluorescence, loads_mn, fluorescence_name)
+    images = read_fluorescence_series(paths, pixel_nm * 1e-9)
+    areas = [image_contact_area(image, settings) for image in images]
+    table = contact_area_table(loads_mn, images, areas)
+    for row in table.itertuples():
+        log.info("%s: %g mN → %.1f µm²", row.image, row.load_mn, row.area_um2)
+        if not row.contact_found:
+            log.warning("%s: no contact found: %s", row.image, row.flag)
+        if row.saturated_pixels:
             # The threshold still separates contact from background, but the brightest
             # contact is clipped: the area stands, the intensities do not (flagged).
-            log.warning("%s: %d saturated pixels; intensities are clipped", path, saturated)
-        rows.append(
-            {
-                "load_mN": load,
-                "area_um2": area.area_m2 * 1e12,
-                "contact_pixels": area.n_contact_pixels,
-                "pixel_nm": image.pixel_m * 1e9,
-                "otsu_threshold_counts": area.threshold,
-                "otsu_separation": area.separation,
-                "contrast_noise_sd": area.contrast,
-                "largest_patch_px": area.largest_patch_px,
-                "contact_found": area.contact_found,
-                "flag": area.flag or "",
-                "saturated_pixels": saturated,
-                "image": str(path),
-            }
-        )
-        log.info("%s: %g mN → %.1f µm²", path, load, area.area_m2 * 1e12)
-        areas.append(area)
-    with atomic_path(table_path) as tmp:
-        pd.DataFrame(rows).to_csv(tmp, index=False)
+            log.warning(
+                "%s: %d saturated pixels; intensities are clipped", row.image, row.saturated_pixels
+            )
+    write_table(table_path, table)
     plot_contact_separation(
         loads_mn,
         [image.data for image in images],
@@ -74,7 +56,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        fluorescence_dir=sm.params.fluorescence_dir,
+        fluorescence=sm.input.fluorescence,
         table_path=sm.output.table,
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,

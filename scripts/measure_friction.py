@@ -2,30 +2,30 @@
 
 import logging
 
-from amontons.images import atomic_path
-from amontons.measurements import measure_friction
+from amontons.io.files import write_table
+from amontons.io.layout import per_load_files, rheometer_name
+from amontons.measure.friction import measure_friction
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
 
 
 def main(
-    rheometer_dir: str,
+    rheometer,
     table_path: str,
     loads_mn: list[float],
     median_window_s: float,
     plateau_fraction: float,
 ) -> None:
     table = measure_friction(
-        rheometer_dir,
+        per_load_files(rheometer, loads_mn, rheometer_name),
         loads_mn,
         median_window_s=median_window_s,
         plateau_fraction=plateau_fraction,
     )
     for row in table.itertuples():
-        log.info("%s: %g mN → static %.4g mN", row.file, row.load_mN, row.static_friction_mN)
-    with atomic_path(table_path) as tmp:
-        table.to_csv(tmp, index=False)
+        log.info("%s: %g mN → static %.4g mN", row.file, row.load_mn, row.static_friction_mn)
+    write_table(table_path, table)
 
 
 if __name__ == "__main__":
@@ -33,7 +33,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        rheometer_dir=sm.params.rheometer_dir,
+        rheometer=sm.input.rheometer,
         table_path=sm.output.table,
         loads_mn=sm.params.loads_mn,
         median_window_s=sm.params.friction["median_window_s"],

@@ -1,18 +1,14 @@
 """Rule measure_grafting_density: probe molecules per µm² from the absorbance spectrum."""
 
-import json
 import logging
 
-from amontons.images import atomic_path
-from amontons.measurements import measure_grafting_density
+from amontons.io.files import write_json
+from amontons.measure.grafting import measure_grafting_density
+from amontons.physics.beer_lambert import M2_PER_MOL_PER_L_PER_MOL_CM
 from amontons.plots import plot_absorbance
-from amontons.rawdata import read_absorbance
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
-
-# 1 L/(mol·cm) = 1e-3 m³ / (mol · 1e-2 m) = 0.1 m²/mol
-M2_PER_MOL_PER_L_PER_MOL_CM = 0.1
 
 
 def main(
@@ -31,26 +27,11 @@ def main(
         n_faces=coated_faces,
         epsilon_m2_per_mol=epsilon_l_per_mol_cm * M2_PER_MOL_PER_L_PER_MOL_CM,
     )
-    summary = {
-        "quantity": "grafting density of the rigidochromic monolayer, molecules per µm² of one "
-        "face: LOWESS maximum of the absorbance / (ε · coated faces) · N_A",
-        "density_per_um2": result.density_per_um2,
-        "peak_absorbance": result.peak_absorbance,
-        "peak_wavelength_nm": result.peak_wavelength_nm,
-        "noise_sd": result.noise_sd,
-        "coated_faces": result.n_faces,
-        "epsilon_l_per_mol_cm": epsilon_l_per_mol_cm,
-        "lowess_frac": result.frac,
-        "n": int(result.wavelength_nm.size),
-        "spectrum": absorbance_path,
-    }
     log.info("%s: %.4g molecules/µm²", absorbance_path, result.density_per_um2)
-    with atomic_path(density_path) as tmp:
-        tmp.write_text(json.dumps(summary, indent=2))
-    _, absorbance = read_absorbance(absorbance_path)
+    write_json(density_path, {**result.to_record(), "spectrum": absorbance_path})
     plot_absorbance(
         result.wavelength_nm,
-        absorbance,
+        result.absorbance,
         result.smoothed,
         result.peak_wavelength_nm,
         result.peak_absorbance,

@@ -1,11 +1,15 @@
 """Rule measure_intensity_pressure: mean contact intensity versus mean contact pressure."""
 
-import json
 import logging
 
-from amontons.images import atomic_path
-from amontons.measurements import measure_intensity_pressure
-from amontons.optics.area import OtsuSettings
+from amontons.io.files import write_json, write_table
+from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.measure.area import OtsuSettings
+from amontons.measure.intensity import (
+    intensity_pressure_record,
+    intensity_pressure_table,
+    measure_intensity_pressure,
+)
 from amontons.plots import plot_intensity_pressure
 from amontons.runlog import run_logged
 
@@ -13,7 +17,7 @@ log = logging.getLogger(__name__)
 
 
 def main(
-    fluorescence_dir: str,
+    fluorescence,
     table_path: str,
     fit_path: str,
     figure_paths: list[str],
@@ -27,7 +31,7 @@ def main(
     sphere: str,
 ) -> None:
     result, backgrounds, excluded = measure_intensity_pressure(
-        fluorescence_dir,
+        per_load_files(fluorescence, loads_mn, fluorescence_name),
         loads_mn,
         pixel_nm * 1e-9,
         otsu=OtsuSettings.from_config(otsu),
@@ -35,32 +39,15 @@ def main(
         pressure_ref_pa=pressure_ref_mpa * 1e6,
         confidence=confidence,
     )
-    table = result.table
-    out = table.assign(
-        load_mN=table["load_N"] * 1e3,
-        area_um2=table["area_m2"] * 1e12,
-        mean_pressure_MPa=table["mean_pressure_Pa"] * 1e-6,
-        background_counts=backgrounds,
-    )[["load_mN", "area_um2", "mean_pressure_MPa", "mean_intensity_counts", "background_counts"]]
-    with atomic_path(table_path) as tmp:
-        out.to_csv(tmp, index=False)
-    fit = {
-        "quantity": "background-subtracted mean contact intensity versus mean contact pressure "
-        "F/A, I = I_ref (p / p_ref)^exponent (appendix Fig. B.4: exponent 1/2)",
-        "units": {"prefactor": "counts (intensity at p_ref)", "x_ref": "Pa"},
-        **result.fit.to_dict(),
-        # images in which no contact stands out have no contact intensity: left out, with why
-        "excluded_loads_mN": list(excluded),
-        "exclusion_flags": list(excluded.values()),
-    }
     for load, why in excluded.items():
         log.warning("%g mN left out of the intensity-pressure fit: %s", load, why)
-    log.info("%s: intensity exponent %.3f", fluorescence_dir, result.fit.exponent.estimate)
-    with atomic_path(fit_path) as tmp:
-        tmp.write_text(json.dumps(fit, indent=2))
+    log.info("%s: intensity exponent %.3f", sphere, result.fit.exponent.estimate)
+    table = intensity_pressure_table(result, backgrounds)
+    write_table(table_path, table)
+    write_json(fit_path, intensity_pressure_record(result, excluded))
     plot_intensity_pressure(
-        out["mean_pressure_MPa"].to_numpy(),
-        out["mean_intensity_counts"].to_numpy(),
+        table["mean_pressure_mpa"].to_numpy(),
+        table["mean_intensity_counts"].to_numpy(),
         result.fit,
         f"{sphere}: contact intensity versus pressure ({data_label})",
         figure_paths,
@@ -72,7 +59,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        fluorescence_dir=sm.params.fluorescence_dir,
+        fluorescence=sm.input.fluorescence,
         table_path=sm.output.table,
         fit_path=sm.output.fit,
         figure_paths=[sm.output.png, sm.output.pdf],

@@ -1,11 +1,10 @@
 """Rule measure_lifetime: mean photon arrival time inside and outside the contact (FLIM)."""
 
-import json
 import logging
 
-from amontons.images import atomic_path
-from amontons.measurements import measure_lifetime
-from amontons.optics.area import OtsuSettings
+from amontons.io.files import write_json
+from amontons.measure.area import OtsuSettings
+from amontons.measure.lifetime import measure_lifetime
 from amontons.runlog import run_logged
 
 log = logging.getLogger(__name__)
@@ -24,32 +23,13 @@ def main(
         otsu=OtsuSettings.from_config(otsu),
         exclude_edge_px=exclude_edge_px,
     )
-    result = {
-        "quantity": "mean photon arrival time, ns, inside and outside the contact (Otsu mask "
-        "of the arrival-time map, edge band excluded)",
-        "inside_ns": {
-            "mean": stats.inside_mean_ns,
-            "sd": stats.inside_sd_ns,
-            "standard_error": float(stats.inside_se_ns),
-            "n": stats.inside_n,
-        },
-        "outside_ns": {
-            "mean": stats.outside_mean_ns,
-            "sd": stats.outside_sd_ns,
-            "standard_error": float(stats.outside_se_ns),
-            "n": stats.outside_n,
-        },
-        "exclude_edge_px": exclude_edge_px,
-        "map": flim_path,
-    }
     log.info(
         "%s: %.3f ns inside, %.3f ns outside",
         flim_path,
         stats.inside_mean_ns,
         stats.outside_mean_ns,
     )
-    with atomic_path(lifetime_path) as tmp:
-        tmp.write_text(json.dumps(result, indent=2))
+    write_json(lifetime_path, {**stats.to_record(exclude_edge_px), "map": flim_path})
 
 
 if __name__ == "__main__":

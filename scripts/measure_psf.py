@@ -1,10 +1,9 @@
 """Rule measure_psf: PSF FWHM from the bead image of one sphere, and its radial profile."""
 
-import json
 import logging
 
-from amontons.images import atomic_path
-from amontons.measurements import measure_bead
+from amontons.io.files import write_json
+from amontons.measure.psf import measure_bead
 from amontons.plots import plot_psf_profile
 from amontons.runlog import run_logged
 
@@ -27,21 +26,8 @@ def main(
         profile_radius_m=profile_radius_nm * 1e-9,
         centroid_radius_m=centroid_radius_nm * 1e-9,
     )
-    result = {
-        "quantity": "PSF FWHM from a 100 nm bead (Gaussian fit of the radial profile, "
-        "pixel-corrected)",
-        "fwhm_nm": {"estimate": psf.fwhm_m * 1e9, "standard_error": psf.fwhm_se_m * 1e9},
-        "fitted_fwhm_nm": psf.fitted_fwhm_m * 1e9,
-        "n": psf.n_pixels_fitted,
-        "peak_counts": psf.peak_counts,
-        "background_counts": psf.background_counts,
-        "noise_sd_counts": psf.noise_sd_counts,
-        "centroid_nm": [c * 1e9 for c in psf.centroid_m],
-        "image": bead_path,
-    }
     log.info("%s: FWHM %.1f ± %.1f nm", bead_path, psf.fwhm_m * 1e9, psf.fwhm_se_m * 1e9)
-    with atomic_path(psf_path) as tmp:
-        tmp.write_text(json.dumps(result, indent=2))
+    write_json(psf_path, {**psf.to_record(), "image": bead_path})
     plot_psf_profile(
         psf.profile_r_m * 1e9,
         psf.profile_counts,

@@ -1,10 +1,9 @@
 """Rule measure_topography: the sphere's AFM scans levelled, their roughness and the flattening."""
 
-import json
 import logging
 
-from amontons.images import atomic_path
-from amontons.measurements import measure_topography
+from amontons.io.files import write_json
+from amontons.measure.topography import measure_topography
 from amontons.plots import plot_topography
 from amontons.runlog import run_logged
 
@@ -27,39 +26,15 @@ def main(
         None if afm_pixel_nm is None else afm_pixel_nm * 1e-9,
         nan_policy=nan_policy,
     )
-
-    def statistics(fit, stats):
-        return {
-            "sphere_radius_mm": fit.radius_m * 1e3,
-            "roughness_rms_nm": stats.h_rms_m * 1e9,
-            "slope_rms": stats.slope_rms,
-            "curvature_rms_per_um": stats.curvature_rms_per_m * 1e-6,
-        }
-
-    result = {
-        "quantity": "AFM topography levelled by a sphere fit and scan-line alignment; "
-        "statistics at the AFM pixel",
-        "pixel_nm": topo.pixel_m * 1e9,
-        "shape_px": list(topo.change_m.shape),
-        "before": statistics(topo.before, topo.before_statistics),
-        "after": statistics(topo.after, topo.after_statistics),
-        # the deepest flattening, robust to single noisy pixels
-        "max_flattening_nm": float(-(topo.change_m.min()) * 1e9),
-        "filled_nan_pixels": topo.filled_pixels,
-        "nan_policy": nan_policy,
-        "before_file": str(before_path),
-        "after_file": str(after_path),
-    }
     log.info(
         "%s: R = %.3f mm, h_rms %.1f nm, h' %.3f, flattening %.1f nm",
         sphere,
         topo.before.radius_m * 1e3,
         topo.before_statistics.h_rms_m * 1e9,
         topo.before_statistics.slope_rms,
-        result["max_flattening_nm"],
+        topo.max_flattening_m * 1e9,
     )
-    with atomic_path(topography_path) as tmp:
-        tmp.write_text(json.dumps(result, indent=2))
+    write_json(topography_path, topo.to_record())
     plot_topography(
         topo.before.roughness * 1e9,
         topo.after.roughness * 1e9,

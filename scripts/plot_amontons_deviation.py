@@ -3,8 +3,8 @@ reference load, for the spheres of one material (appendix Fig. B.13)."""
 
 import pandas as pd
 
-from amontons.images import atomic_path
-from amontons.measurements import amontons_table
+from amontons.io.files import write_table
+from amontons.measure.friction import amontons_table
 from amontons.plots import plot_amontons_deviation
 from amontons.runlog import run_logged
 
@@ -25,8 +25,7 @@ def main(
         [pd.read_csv(p) for p in friction_paths],
         reference_load_mn,
     )
-    with atomic_path(out_table) as tmp:
-        table.to_csv(tmp, index=False)
+    write_table(out_table, table)
     plot_amontons_deviation(
         table,
         f"{material}: deviation from Amontons' law ({data_label})",

@@ -1,10 +1,9 @@
 """Rule plot_load_area: normalised load-area table and figure for one material."""
 
-import json
-
 import pandas as pd
 
-from amontons.images import atomic_path
+from amontons.io.files import read_json, write_table
+from amontons.measure.load_area import normalised_load_area
 from amontons.plots import plot_normalised_load_area
 from amontons.runlog import run_logged
 
@@ -19,27 +18,10 @@ def main(
     material: str,
     reference_load_mn: float,
 ) -> None:
-    frames = []
-    for sphere, table_path, fit_path in zip(spheres, table_paths, fit_paths, strict=True):
-        table = pd.read_csv(table_path)
-        with open(fit_path) as stream:
-            fit = json.load(stream)
-        frames.append(
-            pd.DataFrame(
-                {
-                    "sphere": sphere,
-                    "load_mN": table["load_mN"],
-                    "area_um2": table["area_um2"],
-                    # Normalised by the fitted area at the reference load, defined for any series.
-                    "area_norm": table["area_um2"] / fit["prefactor"]["estimate"],
-                    "fit_exponent": fit["exponent"]["estimate"],
-                    "contact_found": table["contact_found"],
-                }
-            )
-        )
-    combined = pd.concat(frames, ignore_index=True)
-    with atomic_path(out_table) as tmp:
-        combined.to_csv(tmp, index=False)
+    combined = normalised_load_area(
+        spheres, [pd.read_csv(p) for p in table_paths], [read_json(p) for p in fit_paths]
+    )
+    write_table(out_table, combined)
     plot_normalised_load_area(
         combined,
         f"{material}: real contact area vs load ({data_label})",

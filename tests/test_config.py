@@ -2,22 +2,28 @@
 the value and what was allowed."""
 
 import copy
+import re
 
 import pytest
 import yaml
 
 from amontons.config import (
+    RESERVED_NAMES,
     ConfigError,
+    check_selected_materials,
     load_workflow_config,
+    merge_config,
     parse_loads_mn,
+    read_config,
     read_sample_sheet,
     validate,
 )
 
 
 def _config(repo, name="config.yaml"):
-    with open(repo / "config" / name) as stream:
-        return yaml.safe_load(stream)
+    """The configuration a run of ``name`` sees: config.yaml, with test.yaml merged over it."""
+    overlays = [] if name == "config.yaml" else [repo / "config" / name]
+    return read_config(repo / "config" / "config.yaml", *overlays)
 
 
 @pytest.mark.parametrize("name", ["config.yaml", "test.yaml"])
@@ -25,19 +31,35 @@ def test_shipped_configs_are_valid(repo, config_schema, sheet_schema, name, monk
     monkeypatch.chdir(repo)
     config = _config(repo, name)
     spheres = load_workflow_config(config, config_schema, sheet_schema, name)
-    assert set(spheres["material"]) == set(config["materials"])
+    assert {row["material"] for row in spheres.values()} == set(config["materials"])
 
 
-def test_test_config_has_the_same_keys_as_the_full_config(repo):
-    def keys(mapping, prefix=""):
-        out = set()
+def test_test_config_is_an_overlay_of_only_the_keys_it_changes(repo):
+    """config/test.yaml holds only what differs from config/config.yaml (Snakemake merges it
+    over the full config): no key is repeated with the full config's value."""
+
+    def leaves(mapping, prefix=""):
+        out = {}
         for key, value in mapping.items():
-            out.add(prefix + key)
             if isinstance(value, dict):
-                out |= keys(value, prefix + key + ".")
+                out |= leaves(value, prefix + key + ".")
+            else:
+                out[prefix + key] = value
         return out
 
-    assert keys(_config(repo, "test.yaml")) == keys(_config(repo, "config.yaml"))
+    full = leaves(_config(repo))
+    with open(repo / "config" / "test.yaml") as stream:
+        overlay = leaves(yaml.safe_load(stream))
+    assert set(overlay) <= set(full)
+    assert [key for key, value in overlay.items() if full[key] == value] == []
+    assert overlay["run"] != full["run"]
+
+
+def test_merged_config_replaces_values_and_lists_and_merges_sections():
+    base = {"a": 1, "s": {"x": 1, "y": [1, 2]}, "l": [1]}
+    merged = merge_config(base, {"s": {"y": [3]}, "l": [2, 3]})
+    assert merged == {"a": 1, "s": {"x": 1, "y": [3]}, "l": [2, 3]}
+    assert base["s"]["y"] == [1, 2]  # the base is not changed
 
 
 def test_misspelled_key_is_named_with_the_allowed_keys(repo, config_schema):
@@ -135,3 +157,36 @@ def test_every_schema_key_is_described_and_closed(config_schema, sheet_schema):
 
     walk(config_schema, "config")
     walk(sheet_schema, "sheet")
+
+
+def test_material_named_like_a_workflow_target_is_refused(tmp_path, sheet_schema):
+    # `snakemake optics` must stay the optics stage: a material 'optics' would be a second
+    # rule of that name.
+    sheet = tmp_path / "materials.tsv"
+    _write_sheet(sheet, [["optics", "optics", "0.6", "3.7", "true", "25,50", "200", "synthetic"]])
+    records = read_sample_sheet(sheet, sheet_schema)
+    with pytest.raises(ConfigError, match=r"'optics' take the name of a workflow target"):
+        check_selected_materials(["optics"], records, "my.yaml")
+
+
+def test_reserved_names_are_the_workflow_targets(repo):
+    """Every wildcard-free target rule of the workflow is reserved (read from the rule files)."""
+    rules = "\n".join(p.read_text() for p in (repo / "workflow" / "rules").glob("*.smk"))
+    rules += (repo / "Snakefile").read_text()
+    targets = set(re.findall(r"^rule (\w+):\n(?:    .*\n)*?    localrule: True", rules, re.M))
+    assert targets and targets <= RESERVED_NAMES
+
+
+def test_reflection_load_must_be_one_of_the_sphere_loads(tmp_path, sheet_schema):
+    sheet = tmp_path / "materials.tsv"
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "50,100", "200", "synthetic"]])
+    with pytest.raises(ConfigError, match=r"sphere PS: reflection_load_mn = 25 is not one of"):
+        read_sample_sheet(sheet, sheet_schema)
+
+
+def test_sheet_values_take_their_schema_types(tmp_path, sheet_schema):
+    sheet = tmp_path / "materials.tsv"
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "yes", "25,50", "200", "synthetic"]])
+    (record,) = read_sample_sheet(sheet, sheet_schema).values()
+    assert record["diameter_mm"] == 0.6 and record["roughened"] is True
+    assert record["loads"] == [25.0, 50.0] and "flim_load_mn" not in record

@@ -2,17 +2,19 @@
 
 JSON Schema (via ``jsonschema``) checks structure and types; the checks that a schema cannot
 express (strictly increasing loads, unique sphere ids, materials present in the sheet) live here
-too, so that every bad configuration fails before any job runs and names the key, the value and
-what was expected.
+too (the reflection and FLIM loads among the loads, material names that are not target names),
+so that every bad configuration fails before any job runs and names the key, the value and
+what was expected. Standard library, jsonschema and yaml only: the workflow imports it to
+build its DAG.
 """
 
 from __future__ import annotations
 
+import csv
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import jsonschema
-import pandas as pd
 import yaml
 
 
@@ -91,47 +93,96 @@ def parse_loads_mn(text: str, where: str) -> list[float]:
 
 
 _BOOLEAN_WORDS = {"true": True, "false": False, "yes": True, "no": False, "1": True, "0": False}
+# Names of the workflow's wildcard-free target rules: a material of the same name would make a
+# second rule of that name (each material gets its own target, `snakemake PS`).
+RESERVED_NAMES = frozenset(
+    {"all", "optics", "surface", "friction", "fits", "figures", "virtual_experiment"}
+)
 
 
-def _row_record(row: pd.Series) -> dict:
+def _typed(value: str, kind: str | None):
+    """A sheet cell as the schema's type: numbers stay text when they do not parse, so that
+    the schema names the cell rather than this function."""
+    if kind in ("number", "integer"):
+        try:
+            number = float(value)
+        except ValueError:
+            return value
+        return int(number) if kind == "integer" and number.is_integer() else number
+    if kind == "boolean":
+        return _BOOLEAN_WORDS.get(value.strip().lower(), value)
+    return value
+
+
+def _row_record(row: Mapping[str, str], schema: Mapping) -> dict:
+    """A sheet row without its empty cells, each value of the schema's type."""
+    properties = schema.get("properties", {})
     record = {}
     for key, value in row.items():
-        if pd.isna(value):
+        if value is None or value.strip() == "":
             continue
-        record[key] = value.item() if hasattr(value, "item") else value
-    if isinstance(record.get("roughened"), str):
-        word = record["roughened"].strip().lower()
-        record["roughened"] = _BOOLEAN_WORDS.get(word, record["roughened"])
-    if "loads_mn" in record:
-        record["loads_mn"] = str(record["loads_mn"])
+        record[key] = _typed(value.strip(), properties.get(key, {}).get("type"))
     return record
 
 
-def read_sample_sheet(path: str | Path, schema: Mapping) -> pd.DataFrame:
-    """Read and validate the sample sheet (TSV, one row per sphere), indexed by sphere id.
+def _sheet_rows(path: Path) -> list[dict[str, str]]:
+    """The sheet's rows (tab-separated, '#' comment lines skipped) with their line numbers."""
+    with open(path, encoding="utf-8", newline="") as stream:
+        lines = [(n, line) for n, line in enumerate(stream, start=1) if not line.startswith("#")]
+    reader = csv.DictReader((line for _, line in lines), delimiter="\t")
+    rows = []
+    for (number, _), row in zip(lines[1:], reader, strict=False):
+        if None in row:
+            raise ConfigError(f"{path}, line {number}: more cells than columns: {row[None]}")
+        rows.append({"_line": number, **row})
+    return rows
 
-    Adds a ``loads`` column holding each row's loads as a list of floats in mN.
+
+def check_sheet_loads(sphere: str, record: Mapping, where: str) -> None:
+    """The reflection and FLIM loads of a sphere must be among its loads_mn."""
+    for column in ("reflection_load_mn", "flim_load_mn"):
+        value = record.get(column)
+        if value is None:
+            continue
+        if not any(abs(float(value) - load) < 1e-9 for load in record["loads"]):
+            raise ConfigError(
+                f"{where}, sphere {sphere}: {column} = {value:g} is not one of loads_mn "
+                f"{record['loads']}; expected the load of an existing image"
+            )
+
+
+def read_sample_sheet(path: str | Path, schema: Mapping) -> dict[str, dict]:
+    """Read and validate the sample sheet (TSV, one row per sphere): sphere id → its record,
+    in the sheet's order, each value of its schema type.
+
+    Adds ``loads``, each row's loads as a list of floats in mN. Standard library only, so
+    that the workflow builds its DAG without the numerical stack.
     """
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"materials_sheet = {str(path)!r}: no such file")
-    table = pd.read_csv(path, sep="\t", dtype={"loads_mn": str, "sphere": str}, comment="#")
-    records = []
-    for line, (_, row) in enumerate(table.iterrows(), start=2):
-        record = _row_record(row)
+    sheet: dict[str, dict] = {}
+    repeated = []
+    for row in _sheet_rows(path):
+        line = row.pop("_line")
+        record = _row_record(row, schema)
         validate(record, schema, f"{path}, line {line} (sphere {record.get('sphere')!r})")
         record["loads"] = parse_loads_mn(record["loads_mn"], f"{path}, sphere {record['sphere']}")
-        records.append(record)
-    sheet = pd.DataFrame.from_records(records)
-    duplicated = sorted(set(sheet["sphere"][sheet["sphere"].duplicated()]))
-    if duplicated:
-        raise ConfigError(f"{path}: sphere ids must be unique; repeated: {', '.join(duplicated)}")
-    return sheet.set_index("sphere", drop=False)
+        check_sheet_loads(record["sphere"], record, str(path))
+        if record["sphere"] in sheet:
+            repeated.append(record["sphere"])
+        sheet[record["sphere"]] = record
+    if repeated:
+        raise ConfigError(
+            f"{path}: sphere ids must be unique; repeated: {', '.join(sorted(set(repeated)))}"
+        )
+    return sheet
 
 
-def check_selected_materials(selected: Sequence[str], sheet: pd.DataFrame, source: str) -> None:
-    """Every material named in the config's ``materials`` must have a row in the sheet."""
-    known = sorted(set(sheet["material"]))
+def check_selected_materials(selected: Sequence[str], sheet: Mapping[str, dict], source: str):
+    """Every material named in the config's ``materials`` must have a row in the sheet, and
+    none may take the name of a workflow target."""
+    known = sorted({record["material"] for record in sheet.values()})
     unknown = [m for m in selected if m not in known]
     if unknown:
         raise ConfigError(
@@ -139,14 +190,44 @@ def check_selected_materials(selected: Sequence[str], sheet: pd.DataFrame, sourc
             f"{', '.join(repr(m) for m in unknown)}; allowed values (from the sample sheet): "
             f"{', '.join(known)}"
         )
+    reserved = [m for m in selected if m in RESERVED_NAMES]
+    if reserved:
+        raise ConfigError(
+            f"{source}: material(s) {', '.join(repr(m) for m in reserved)} take the name of a "
+            f"workflow target; rename them in the sample sheet (reserved: "
+            f"{', '.join(sorted(RESERVED_NAMES))})"
+        )
 
 
 def load_workflow_config(
     config: Mapping, config_schema: Mapping, sheet_schema: Mapping, source: str
-) -> pd.DataFrame:
-    """Validate a config mapping and its sample sheet; return the sheet rows of the selected
-    materials."""
+) -> dict[str, dict]:
+    """Validate a config mapping and its sample sheet; return the sheet records (sphere id →
+    record) of the selected materials."""
     validate(config, config_schema, source)
     sheet = read_sample_sheet(config["materials_sheet"], sheet_schema)
     check_selected_materials(config["materials"], sheet, source)
-    return sheet[sheet["material"].isin(config["materials"])]
+    return {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
+
+
+def merge_config(base: Mapping, overlay: Mapping) -> dict:
+    """``base`` with ``overlay``'s keys merged over it, nested mappings key by key (lists and
+    values replaced), as Snakemake merges ``--configfile`` over the Snakefile's configfile."""
+    merged = dict(base)
+    for key, value in overlay.items():
+        if isinstance(value, Mapping) and isinstance(merged.get(key), Mapping):
+            merged[key] = merge_config(merged[key], value)
+        else:
+            merged[key] = value
+    return merged
+
+
+def read_config(base: str | Path, *overlays: str | Path) -> dict:
+    """The configuration a run sees: the YAML file ``base`` with each overlay merged over it
+    in turn (e.g. config/config.yaml, then config/test.yaml)."""
+    with open(base, encoding="utf-8") as stream:
+        config = yaml.safe_load(stream)
+    for overlay in overlays:
+        with open(overlay, encoding="utf-8") as stream:
+            config = merge_config(config, yaml.safe_load(stream) or {})
+    return config

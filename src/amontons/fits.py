@@ -28,7 +28,8 @@ class PowerLawFit:
     x_ref: float
     n: int
 
-    def to_dict(self) -> dict:
+    def to_record(self) -> dict:
+        """JSON-ready record: exponent and prefactor with their errors, x_ref and n."""
         return asdict(self)
 
 

@@ -13,20 +13,20 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from amontons.images import atomic_path  # noqa: E402
+from amontons.io.files import atomic_path
 
 
 def plot_normalised_load_area(
     table: pd.DataFrame, title: str, paths: list[str], reference_load_mn: float
 ) -> None:
     """Log–log A/A_ref versus F/F_ref per sphere, with the fitted power law and guides for
-    Amontons (slope 1) and Hertz (slope 2/3). ``table`` has columns sphere, load_mN,
+    Amontons (slope 1) and Hertz (slope 2/3). ``table`` has columns sphere, load_mn,
     area_norm, fit_exponent."""
     fig, ax = plt.subplots(figsize=(4.5, 4.0), constrained_layout=True)
-    ratio = table["load_mN"] / reference_load_mn
+    ratio = table["load_mn"] / reference_load_mn
     span = np.geomspace(ratio.min(), ratio.max(), 50)
     for sphere, rows in table.groupby("sphere", sort=False):
-        x = rows["load_mN"] / reference_load_mn
+        x = rows["load_mn"] / reference_load_mn
         exponent = rows["fit_exponent"].iloc[0]
         (line,) = ax.plot(x, rows["area_norm"], "o", label=f"{sphere}: α = {exponent:.3f}")
         ax.plot(span, span**exponent, "-", color=line.get_color(), lw=1)
@@ -186,10 +186,10 @@ def plot_amontons_deviation(
     table: pd.DataFrame, title: str, paths: list[str], reference_load_mn: float
 ) -> None:
     """Appendix Fig. B.13: (a) A/A_ref and (b) F_s/F_s,ref versus F/F_ref per sphere, log–log,
-    with Amontons' law (slope 1). ``table`` has columns sphere, normal_force_mN,
+    with Amontons' law (slope 1). ``table`` has columns sphere, normal_force_mn,
     area_over_area_ref, friction_over_friction_ref."""
     fig, axes = plt.subplots(1, 2, figsize=(8.0, 3.8), constrained_layout=True)
-    ratio = table["normal_force_mN"] / reference_load_mn
+    ratio = table["normal_force_mn"] / reference_load_mn
     span = np.geomspace(ratio.min(), ratio.max(), 50)
     panels = (
         ("area_over_area_ref", f"A / A({reference_load_mn:g} mN)", "a) contact area"),
@@ -201,7 +201,7 @@ def plot_amontons_deviation(
     )
     for ax, (column, label, name) in zip(axes, panels, strict=True):
         for sphere, rows in table.groupby("sphere", sort=False):
-            ax.plot(rows["normal_force_mN"] / reference_load_mn, rows[column], "o-", label=sphere)
+            ax.plot(rows["normal_force_mn"] / reference_load_mn, rows[column], "o-", label=sphere)
         ax.plot(span, span, "k--", lw=0.8, label="Amontons (∝ F)")
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -227,7 +227,7 @@ def plot_contact_separation(
     """Per load: the fluorescence image with the Otsu contact edge (green, as in appendix
     Fig. B.7a) above the histogram of its pixel counts with the threshold and the Otsu
     separation η, so a reader sees when contact and background overlap. A load whose flag
-    says no contact was found (amontons.optics.area) is titled in red, "no contact"."""
+    says no contact was found (amontons.measure.area) is titled in red, "no contact"."""
     n = len(loads_mn)
     fig, axes = plt.subplots(2, n, figsize=(2.4 * n, 5.0), constrained_layout=True, squeeze=False)
     for column, (load, image, mask, threshold, eta, flag) in enumerate(
@@ -266,7 +266,7 @@ def plot_intensity_pressure(
     pressure_mpa: np.ndarray, intensity_counts: np.ndarray, fit, title: str, paths: list[str]
 ) -> None:
     """Appendix Fig. B.4: background-subtracted mean contact intensity versus mean contact
-    pressure F/A (log–log), the fitted power law (``fit``: amontons.powerlaw.PowerLawFit with
+    pressure F/A (log–log), the fitted power law (``fit``: amontons.fits.PowerLawFit with
     x_ref in Pa) and the appendix's square-root law through the fit at the middle pressure."""
     fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
     ax.plot(pressure_mpa, intensity_counts, "o", label="per load")

@@ -4,18 +4,21 @@ expected, never a silent number."""
 import numpy as np
 import pytest
 
-from amontons.images import read_image, write_image
-from amontons.measurements import NoContact, measure_bead, measure_edge_gap, measure_friction
-from amontons.optics.area import OtsuSettings
-from amontons.rawdata import (
+from amontons.io.layout import (
     RawDataError,
-    fluorescence_image,
-    read_absorbance,
-    read_flim,
-    read_reflection,
-    read_rheometer_traces,
+    fluorescence_name,
+    per_load_files,
     rheometer_files,
+    rheometer_name,
 )
+from amontons.io.rawdata import read_absorbance, read_flim, read_reflection, read_rheometer_traces
+from amontons.io.tiff import read_image, write_image
+from amontons.measure.area import OtsuSettings
+from amontons.measure.edge_gap import measure_edge_gap
+from amontons.measure.errors import NoContact
+from amontons.measure.friction import measure_friction
+from amontons.measure.psf import measure_bead
+from amontons.physics.newton_rings import APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX
 from amontons.virtual.bead import render_bead
 from amontons.virtual.rheometer import rheometer_trace, write_rheometer_trace
 
@@ -37,7 +40,7 @@ def _rheometer_folder(folder, loads_mn=LOADS_MN, recorded_mn=None):
 def test_rheometer_files_follow_the_load_list(tmp_path):
     folder = _rheometer_folder(tmp_path)
     assert [p.name for p in rheometer_files(folder, LOADS_MN)] == ["25.csv", "50.csv"]
-    traces = read_rheometer_traces(folder, LOADS_MN)
+    traces = read_rheometer_traces(rheometer_files(folder, LOADS_MN), LOADS_MN)
     # 0.2 mN noise over 2000 samples: the mean normal force is the load to 0.05 mN.
     assert np.mean(traces[1].normal_force_n) == pytest.approx(0.05, abs=5e-5)
 
@@ -57,7 +60,7 @@ def test_rheometer_file_missing_a_column_names_file_and_column(tmp_path):
     path = folder / "50.csv"
     path.write_text(path.read_text().replace("torque_N_m", "torque"))
     with pytest.raises(RawDataError, match=r"50\.csv: no column 'torque_N_m'"):
-        read_rheometer_traces(folder, LOADS_MN)
+        read_rheometer_traces(rheometer_files(folder, LOADS_MN), LOADS_MN)
 
 
 def test_rheometer_file_without_rotation_radius(tmp_path):
@@ -66,14 +69,16 @@ def test_rheometer_file_without_rotation_radius(tmp_path):
     lines = [line for line in path.read_text().splitlines() if "rotation_radius" not in line]
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(RawDataError, match=r"25\.csv: no '# rotation_radius_mm: <value>'"):
-        measure_friction(folder, LOADS_MN, median_window_s=0.05, plateau_fraction=0.5)
+        measure_friction(
+            rheometer_files(folder, LOADS_MN), LOADS_MN, median_window_s=0.05, plateau_fraction=0.5
+        )
 
 
 def test_rheometer_file_recorded_at_another_load(tmp_path):
     # 50.csv holds a 100 mN test: refused (beyond the 10 % tolerance), not silently used.
     folder = _rheometer_folder(tmp_path, recorded_mn=[25.0, 100.0])
     with pytest.raises(RawDataError, match=r"50\.csv: mean normal force 100 mN.*say 50 mN"):
-        read_rheometer_traces(folder, LOADS_MN)
+        read_rheometer_traces(rheometer_files(folder, LOADS_MN), LOADS_MN)
 
 
 def test_bead_off_the_edge_names_the_file(tmp_path):
@@ -102,9 +107,12 @@ def _edge_gap_of(folder):
         folder / "reflection.tif",
         folder / "25.tif",
         None,
+        load_mn=25.0,
         otsu=OtsuSettings(),
         n_profiles=4,
         edge_model="hertz",
+        wavelength_m=APPENDIX_WAVELENGTH_M,
+        n_medium=FORMAMIDE_REFRACTIVE_INDEX,
     )
 
 
@@ -150,8 +158,21 @@ def test_absorbance_missing_a_column_names_file_and_column(tmp_path):
         read_absorbance(path)
 
 
-def test_fluorescence_image_by_load(tmp_path):
-    write_image(tmp_path / "25mN.tif", np.ones((8, 8), np.uint16), PIXEL)
-    assert fluorescence_image(tmp_path, 25.0).name == "25mN.tif"
-    with pytest.raises(RawDataError, match=r"0 images for 50 mN; expected exactly one"):
-        fluorescence_image(tmp_path, 50.0)
+def test_per_load_files_of_a_folder_are_named_by_load_and_never_searched(tmp_path):
+    # The virtual experiment's folder: files named by the layout (25.tif); a user's 25mN.tif
+    # in it is not looked for (the workflow matches a measured sphere's files itself).
+    write_image(tmp_path / "25.tif", np.ones((8, 8), np.uint16), PIXEL)
+    assert per_load_files(tmp_path, [25.0], fluorescence_name) == [tmp_path / "25.tif"]
+    write_image(tmp_path / "50mN.tif", np.ones((8, 8), np.uint16), PIXEL)
+    with pytest.raises(RawDataError, match=r"50\.tif: no such file"):
+        per_load_files(tmp_path, [25.0, 50.0], fluorescence_name)
+
+
+def test_per_load_files_given_as_files_keep_their_order_and_count(tmp_path):
+    paths = [tmp_path / "50mN.csv", tmp_path / "25mN.csv"]
+    for path in paths:
+        path.write_text("x")
+    assert per_load_files([str(p) for p in paths], [50.0, 25.0], rheometer_name) == paths
+    assert per_load_files(str(paths[0]), [50.0], rheometer_name) == [paths[0]]
+    with pytest.raises(RawDataError, match=r"2 files .* for 1 loads"):
+        per_load_files(paths, [50.0], rheometer_name)

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 import tifffile
 
-from amontons.images import ImageError, atomic_path, read_image, write_image
+from amontons.io.files import atomic_path
+from amontons.io.tiff import ImageError, read_image, write_image
 
 
 def test_pixel_size_round_trips_through_resolution_tags(tmp_path):

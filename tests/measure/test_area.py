@@ -4,7 +4,7 @@ decide whether an image shows a contact at all."""
 import numpy as np
 import pytest
 
-from amontons.optics.area import OtsuSettings, otsu_contact_area
+from amontons.measure.area import OtsuSettings, otsu_contact_area
 
 
 def _disk(side, radius_px, inside, outside):

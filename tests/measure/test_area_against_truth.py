@@ -11,12 +11,15 @@ import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter
 
-from amontons.optics.area import otsu_contact_area
-from amontons.virtual.experiment import hertz_contact_state
-from amontons.virtual.fluorescence import FWHM_PER_SIGMA, render_fluorescence
+from amontons.measure.area import otsu_contact_area
+from amontons.physics.gaussian import FWHM_PER_SIGMA
+from amontons.physics.newton_rings import APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX
+from amontons.virtual.fluorescence import render_fluorescence
+from amontons.virtual.hertz_contact import hertz_contact_state
 from amontons.virtual.rough_contact import (
     SolverSettings,
     image_contact_states,
+    ring_reach_gap,
     simulate_rough_sphere,
 )
 from amontons.virtual.roughness import Roughness
@@ -39,7 +42,7 @@ def rough_solution(request):
         k_pa_per_m=k,
         loads_n=[25e-3, 200e-3],
         reflection_load_n=25e-3,
-        rings=1,
+        ring_reach_gap_m=ring_reach_gap(1, APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX),
         roughness=Roughness(rms, 0.8, 10e-6, 32e-9),
         settings=SolverSettings(256e-9, 512, 1.3),
         rng_seed=2,

@@ -1,10 +1,11 @@
-"""Grafting density from the absorbance spectrum (appendix Fig. B.1, science.md §1)."""
+"""Grafting density from the absorbance spectrum (appendix Fig. B.1, docs/models.md §1.1)."""
 
 import numpy as np
 import pytest
 
-from amontons.optics.absorbance import AbsorbanceError, grafting_density, read_absorbance_csv
-from amontons.virtual.absorbance import absorbance_spectrum, write_absorbance_csv
+from amontons.io.absorbance import AbsorbanceError, read_absorbance_csv, write_absorbance_csv
+from amontons.measure.grafting import grafting_density
+from amontons.virtual.absorbance import absorbance_spectrum
 
 WAVELENGTHS_NM = np.arange(400.0, 600.01, 0.5)  # a 0.5 nm-step scan, 401 points
 TRUE_DENSITY_PER_UM2 = 7.745e4  # see test_appendix_arithmetic

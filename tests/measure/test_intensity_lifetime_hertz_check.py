@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from amontons import hertz
-from amontons.hertz_check import hertz_check
-from amontons.optics.area import otsu_contact_area
-from amontons.optics.intensity import intensity_pressure
-from amontons.optics.lifetime import lifetime_statistics
+from amontons.measure.area import otsu_contact_area
+from amontons.measure.hertz_check import hertz_check
+from amontons.measure.intensity import intensity_pressure
+from amontons.measure.lifetime import lifetime_statistics
+from amontons.physics import hertz
 from amontons.virtual.flim import render_flim
 from amontons.virtual.fluorescence import pixel_averaged, render_fluorescence
 
@@ -45,13 +45,13 @@ def test_square_root_intensity_gives_exponent_one_half():
     result = intensity_pressure(images, masks, LOADS, BACKGROUND, pixel_m=PIXEL)
     assert result.fit.exponent.estimate == pytest.approx(0.5, abs=0.05)
     assert list(result.table.columns) == [
-        "load_N",
+        "load_n",
         "area_m2",
-        "mean_pressure_Pa",
+        "mean_pressure_pa",
         "mean_intensity_counts",
     ]
     # Pressure rises with load (sublinear area), as in Fig. B.4.
-    assert np.all(np.diff(result.table["mean_pressure_Pa"]) > 0)
+    assert np.all(np.diff(result.table["mean_pressure_pa"]) > 0)
 
 
 def test_linear_intensity_gives_exponent_one():

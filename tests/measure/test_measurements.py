@@ -1,21 +1,17 @@
-"""Per-sphere and per-material tables built from measured tables (amontons.measurements)."""
+"""Measurements from raw files, and the per-sphere and per-material tables built from them."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from amontons.images import saturated_pixels, write_image
-from amontons.measurements import (
-    NoContact,
-    amontons_table,
-    background_level,
-    contact_geometry,
-    hertz_check_table,
-    measure_intensity_pressure,
-    measure_lifetime,
-)
-from amontons.optics.area import OtsuSettings
-from amontons.rawdata import RawDataError
+from amontons.io.layout import RawDataError, fluorescence_images
+from amontons.io.tiff import saturated_pixels, write_image
+from amontons.measure.area import OtsuSettings, contact_geometry
+from amontons.measure.errors import NoContact
+from amontons.measure.friction import amontons_table
+from amontons.measure.hertz_check import hertz_check_table
+from amontons.measure.intensity import background_level, measure_intensity_pressure
+from amontons.measure.lifetime import measure_lifetime
 
 LOADS_MN = [25.0, 50.0, 100.0, 200.0]
 
@@ -24,12 +20,12 @@ def _tables(tau_mpa=20.0, alpha=2 / 3, found=(True, True, True, True)):
     """Area ∝ F^alpha and F_s = τ·A exactly, as contact_area.csv and friction.csv hold them."""
     loads = np.array(LOADS_MN)
     area_um2 = 400.0 * (loads / 25.0) ** alpha
-    areas = pd.DataFrame({"load_mN": loads, "area_um2": area_um2, "contact_found": list(found)})
+    areas = pd.DataFrame({"load_mn": loads, "area_um2": area_um2, "contact_found": list(found)})
     friction = pd.DataFrame(
         {
-            "load_mN": loads,
-            "normal_force_mN": loads * 1.001,  # the rheometer's measured force, 0.1 % off
-            "static_friction_mN": tau_mpa * area_um2 * 1e-3,  # MPa·µm² = 1e-6 N = 1e-3 mN
+            "load_mn": loads,
+            "normal_force_mn": loads * 1.001,  # the rheometer's measured force, 0.1 % off
+            "static_friction_mn": tau_mpa * area_um2 * 1e-3,  # MPa·µm² = 1e-6 N = 1e-3 mN
         }
     )
     return areas, friction
@@ -41,7 +37,7 @@ def test_amontons_table_normalises_at_the_reference_load():
     # F_s = τ·A exactly, so both normalised columns agree to round-off and equal (F/25)^(2/3).
     np.testing.assert_allclose(table["friction_over_friction_ref"], table["area_over_area_ref"])
     np.testing.assert_allclose(table["area_over_area_ref"], (np.array(LOADS_MN) / 25) ** (2 / 3))
-    np.testing.assert_allclose(table["shear_strength_MPa"], 20.0)
+    np.testing.assert_allclose(table["shear_strength_mpa"], 20.0)
     # μ/μ_ref = (F/25)^(−1/3) · (1.001/1.001): the deviation from Amontons' law.
     np.testing.assert_allclose(table["mu_over_mu_ref"], (np.array(LOADS_MN) / 25) ** (-1 / 3))
 
@@ -50,7 +46,7 @@ def test_amontons_table_leaves_out_ill_determined_areas_and_keeps_spheres_apart(
     areas, friction = _tables(found=(True, True, False, True))
     other_areas, other_friction = _tables(tau_mpa=5.0, alpha=0.9)
     table = amontons_table(["A", "B"], [areas, other_areas], [friction, other_friction], 25.0)
-    assert table.loc[table["sphere"] == "A", "load_mN"].tolist() == [25.0, 50.0, 200.0]
+    assert table.loc[table["sphere"] == "A", "load_mn"].tolist() == [25.0, 50.0, 200.0]
     assert len(table[table["sphere"] == "B"]) == 4
 
 
@@ -65,7 +61,7 @@ def test_hertz_check_table_units():
     radius, e_star = 2e-3, 32.8e9
     a = np.array([(3 * f * 1e-3 * radius / (4 * e_star)) ** (1 / 3) for f in LOADS_MN])
     areas = pd.DataFrame(
-        {"load_mN": LOADS_MN, "area_um2": np.pi * a**2 * 1e12, "contact_found": True}
+        {"load_mn": LOADS_MN, "area_um2": np.pi * a**2 * 1e12, "contact_found": True}
     )
     table = hertz_check_table(areas, radius, e_star)
     np.testing.assert_allclose(table["radius_ratio"], 1.0, rtol=1e-12)
@@ -107,7 +103,7 @@ def test_saturated_image_is_refused_for_intensity_and_counted(tmp_path):
         assert saturated_pixels(image) == (contact.sum() if level == 65535 else 0)
     with pytest.raises(RawDataError, match=r"50\.tif: 697 saturated pixels"):
         measure_intensity_pressure(
-            folder,
+            fluorescence_images(folder, [25, 50]),
             [25, 50],
             None,
             otsu=OtsuSettings(),
@@ -131,15 +127,17 @@ def test_image_without_contact_is_left_out_of_the_intensity_fit(tmp_path):
     folder = tmp_path / "fluorescence"
     _disc_images(folder, {25.0: 10, 50.0: 0, 100.0: 14, 200.0: 18}, np.random.default_rng(3))
     kwargs = dict(otsu=OtsuSettings(), background_margin_px=5, pressure_ref_pa=1e8)
-    result, backgrounds, excluded = measure_intensity_pressure(folder, LOADS_MN, None, **kwargs)
+    result, backgrounds, excluded = measure_intensity_pressure(
+        fluorescence_images(folder, LOADS_MN), LOADS_MN, None, **kwargs
+    )
     assert list(excluded) == [50.0] and "50.tif: the upper class is only" in excluded[50.0]
     assert result.fit.n == 3 and len(backgrounds) == 3
-    np.testing.assert_allclose(result.table["load_N"], [25e-3, 100e-3, 200e-3])
+    np.testing.assert_allclose(result.table["load_n"], [25e-3, 100e-3, 200e-3])
     # uniform discs: the same mean intensity at every load, so the exponent is ~0
     assert abs(result.fit.exponent.estimate) < 0.05
     _disc_images(folder, {25.0: 0}, np.random.default_rng(4))
     with pytest.raises(RawDataError, match=r"2 of 4 images show a contact .*\[25\.0, 50\.0\]"):
-        measure_intensity_pressure(folder, LOADS_MN, None, **kwargs)
+        measure_intensity_pressure(fluorescence_images(folder, LOADS_MN), LOADS_MN, None, **kwargs)
 
 
 def test_flim_map_without_contact_is_refused(tmp_path):

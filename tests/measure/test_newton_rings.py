@@ -4,15 +4,11 @@ import numpy as np
 import pytest
 from scipy.integrate import dblquad
 
-from amontons import hertz
-from amontons.optics.newton_rings import NewtonRingError, newton_ring_gap
-from amontons.virtual.reflection import (
-    expected_reflection,
-    hertz_gap,
-    radial_gap_map,
-    render_reflection,
-    ring_gap,
-)
+from amontons.measure.newton_rings import NewtonRingError, newton_ring_gap
+from amontons.physics import hertz
+from amontons.physics.hertz import exterior_gap
+from amontons.physics.newton_rings import ring_gap
+from amontons.virtual.reflection import expected_reflection, radial_gap_map, render_reflection
 
 # Smooth glass sphere of 4 mm diameter on glass, E* = 32.8 GPa, 100 mN: a = 16.6 µm.
 RADIUS, E_STAR, LOAD = 2e-3, 32.8e9, 0.1
@@ -31,7 +27,7 @@ def hertz_reflection(
     """
 
     def gap(r):
-        return np.where(r > A, hertz_gap(r, LOAD, RADIUS, E_STAR) + edge_offset_m, 0.0)
+        return np.where(r > A, exterior_gap(r, LOAD, RADIUS, E_STAR) + edge_offset_m, 0.0)
 
     gap_map = radial_gap_map(shape, PIXEL, centre, gap)
     return render_reflection(gap_map, PIXEL, rng=np.random.default_rng(seed))
@@ -42,13 +38,13 @@ def hertz_reflection(
 
 def test_hertz_gap_is_zero_at_and_inside_the_edge():
     r = np.array([0.0, 0.5 * A, A])
-    np.testing.assert_array_equal(hertz_gap(r, LOAD, RADIUS, E_STAR), 0.0)
+    np.testing.assert_array_equal(exterior_gap(r, LOAD, RADIUS, E_STAR), 0.0)
 
 
 def test_hertz_gap_is_continuous_with_zero_slope_at_the_edge():
     # Next to the edge g ≈ C·(r − a)^{3/2}: the gap 1.7 nm outside the edge is below 1 pm and
     # its ratio over two steps is 2^{3/2} to 1 %.
-    g1, g2 = hertz_gap(np.array([A * (1 + 1e-4), A * (1 + 2e-4)]), LOAD, RADIUS, E_STAR)
+    g1, g2 = exterior_gap(np.array([A * (1 + 1e-4), A * (1 + 2e-4)]), LOAD, RADIUS, E_STAR)
     assert 0 < g1 < 1e-12
     assert g2 / g1 == pytest.approx(2**1.5, rel=0.01)
 
@@ -57,7 +53,7 @@ def test_hertz_gap_far_field():
     # g − (r²/2R − d) = u(r) → 4a³/(3πRr) with a relative correction O(a²/r²): 1 % at r = 20a.
     r = 20 * A
     d = hertz.approach(LOAD, RADIUS, E_STAR)
-    excess = hertz_gap(np.array([r]), LOAD, RADIUS, E_STAR)[0] - (r**2 / (2 * RADIUS) - d)
+    excess = exterior_gap(np.array([r]), LOAD, RADIUS, E_STAR)[0] - (r**2 / (2 * RADIUS) - d)
     assert excess == pytest.approx(4 * A**3 / (3 * np.pi * RADIUS * r), rel=0.01)
 
 
@@ -74,7 +70,7 @@ def test_hertz_gap_against_boussinesq_integral():
     integral, _ = dblquad(integrand, 0, A, 0, 2 * np.pi, epsabs=0, epsrel=1e-10)
     u = integral / (np.pi * E_STAR)
     expected = r**2 / (2 * RADIUS) - hertz.approach(LOAD, RADIUS, E_STAR) + u
-    assert hertz_gap(np.array([r]), LOAD, RADIUS, E_STAR)[0] == pytest.approx(expected, rel=1e-6)
+    assert exterior_gap(np.array([r]), LOAD, RADIUS, E_STAR)[0] == pytest.approx(expected, rel=1e-6)
 
 
 # --- eq. B.1 and the phase convention ---------------------------------------------------------

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from amontons.optics.psf import PsfError, measure_psf
+from amontons.measure.psf import PsfError, measure_psf
 from amontons.virtual.bead import expected_bead_counts, render_bead
 
 PIXEL = 200e-9

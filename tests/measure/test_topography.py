@@ -4,10 +4,9 @@ flattening read from two scans of a sphere with a known cut."""
 import numpy as np
 import pytest
 
-from amontons.images import read_image, write_image
-from amontons.measurements import afm_file, measure_topography, unchanged_level
-from amontons.rawdata import RawDataError
-from amontons.surface import sphere_cap
+from amontons.io.layout import RawDataError, afm_file
+from amontons.io.tiff import read_image, write_image
+from amontons.measure.topography import measure_topography, sphere_cap, unchanged_level
 
 PIXEL = 32e-9
 

@@ -1,10 +1,10 @@
 """Analytic Hertz formulas against published regression values (ContactMechanics' Hertz test,
-science.md §2.5): E* = 5, R = 4, F = 7."""
+docs/models.md §2.7): E* = 5, R = 4, F = 7."""
 
 import numpy as np
 import pytest
 
-from amontons import hertz
+from amontons.physics import hertz
 
 
 def test_regression_values():

@@ -9,23 +9,25 @@ import json
 
 import numpy as np
 import pytest
-import yaml
 
-from amontons import hertz
-from amontons.images import read_image
-from amontons.optics.area import otsu_contact_area
-from amontons.powerlaw import fit_power_law
-from amontons.rawdata import (
-    RawDataError,
-    fluorescence_images,
+from amontons.config import read_config
+from amontons.fits import fit_power_law
+from amontons.io.heightmap import read_height_map
+from amontons.io.layout import RawDataError, fluorescence_images, per_load_files, rheometer_name
+from amontons.io.rawdata import (
     read_absorbance,
     read_bead,
     read_flim,
     read_reflection,
     read_rheometer_traces,
 )
-from amontons.surface import level_sphere, read_height_map, roughness_statistics
-from amontons.virtual.experiment import InstrumentSettings, SurfaceSettings, generate_sphere
+from amontons.io.tiff import read_image
+from amontons.measure.area import otsu_contact_area
+from amontons.measure.topography import level_sphere
+from amontons.physics import hertz
+from amontons.physics.roughness import roughness_statistics
+from amontons.virtual.experiment import generate_sphere
+from amontons.virtual.settings import InstrumentSettings, SurfaceSettings
 
 LOADS_MN = [25.0, 50.0, 100.0, 200.0]
 GLASS = {"diameter_m": 4e-3, "e_star_pa": 32.8e9, "roughness_rms_m": 0.0, "k": 1e19}
@@ -34,15 +36,15 @@ PS = {"diameter_m": 0.6e-3, "e_star_pa": 3.7e9, "roughness_rms_m": 80e-9, "k": 5
 
 def _config(repo, **overrides):
     """The virtual experiment of config/test.yaml, with ``overrides`` (config units)."""
-    with open(repo / "config" / "test.yaml") as stream:
-        settings = yaml.safe_load(stream)["virtual_experiment"]
+    config = read_config(repo / "config" / "config.yaml", repo / "config" / "test.yaml")
+    settings = config["virtual_experiment"]
     settings.update(overrides)
-    return settings
+    return settings, config["optics"]["newton_rings"]
 
 
 def _generate(folder, repo, sphere="glass", seed=11, flim_load_n=None, **overrides):
     spec = GLASS if sphere == "glass" else PS
-    settings = _config(repo, **overrides)
+    settings, newton_rings = _config(repo, **overrides)
     return generate_sphere(
         folder,
         sphere=sphere,
@@ -55,7 +57,7 @@ def _generate(folder, repo, sphere="glass", seed=11, flim_load_n=None, **overrid
         reflection_load_n=0.025,
         flim_load_n=flim_load_n,
         shear_strength_pa=30e6,
-        settings=InstrumentSettings.from_config(settings),
+        settings=InstrumentSettings.from_config(settings, newton_rings),
         surface=SurfaceSettings.from_config(settings),
         seed=seed,
     )
@@ -153,7 +155,9 @@ def test_every_raw_file_reads_back_through_the_readers(glass):
     assert arrival.dtype == np.float32 and arrival.min() > 0 and arrival.max() < 2.0
     wavelength, absorbance = read_absorbance(folder / "absorbance.csv")
     assert wavelength[0] == 400 and wavelength[-1] == 600 and absorbance.max() < 0.003
-    traces = read_rheometer_traces(folder / "rheometer", LOADS_MN)
+    traces = read_rheometer_traces(
+        per_load_files(folder / "rheometer", LOADS_MN, rheometer_name), LOADS_MN
+    )
     for trace, load in zip(traces, LOADS_MN, strict=True):
         assert trace.rotation_radius_m == pytest.approx(truth["rotation_radius_mm"] * 1e-3)
         # 0.2 mN normal-force noise averages to < 0.01 mN over 2000 samples.
@@ -245,7 +249,7 @@ def test_saturating_settings_are_refused(tmp_path, repo):
 
 def test_reflection_load_must_be_a_load(tmp_path, repo):
     with pytest.raises(ValueError, match="reflection load 30 mN is not one of the loads"):
-        settings = _config(repo)
+        settings, newton_rings = _config(repo)
         generate_sphere(
             tmp_path,
             sphere="glass",
@@ -258,7 +262,7 @@ def test_reflection_load_must_be_a_load(tmp_path, repo):
             reflection_load_n=0.03,
             flim_load_n=None,
             shear_strength_pa=30e6,
-            settings=InstrumentSettings.from_config(settings),
+            settings=InstrumentSettings.from_config(settings, newton_rings),
             surface=SurfaceSettings.from_config(settings),
             seed=1,
         )

@@ -3,21 +3,22 @@
 import numpy as np
 import pytest
 
-from amontons import hertz
-from amontons.images import read_image, write_image
-from amontons.optics.lifetime import lifetime_statistics
-from amontons.optics.newton_rings import newton_ring_gap
-from amontons.optics.psf import measure_psf
+from amontons.io.tiff import read_image, write_image
+from amontons.measure.lifetime import lifetime_statistics
+from amontons.measure.newton_rings import newton_ring_gap
+from amontons.measure.psf import measure_psf
+from amontons.physics import hertz
+from amontons.physics.emission import confined_emission
+from amontons.physics.hertz import exterior_gap
 from amontons.virtual.bead import render_bead
 from amontons.virtual.flim import render_flim
-from amontons.virtual.fluorescence import confined_emission
-from amontons.virtual.reflection import hertz_gap, radial_gap_map, render_reflection
+from amontons.virtual.reflection import radial_gap_map, render_reflection
 
 PIXEL = 200e-9
 
 
 def test_bead_tif_round_trip(tmp_path):
-    # Same numbers as tests/optics/test_psf_measurement.py: FWHM within 3 % after the file.
+    # Same numbers as tests/measure/test_psf.py: FWHM within 3 % after the file.
     image = render_bead((41, 41), PIXEL, 450e-9, (4e-6, 4e-6), 1000, 50, np.random.default_rng(0))
     write_image(tmp_path / "bead.tif", image, PIXEL)
     read = read_image(tmp_path / "bead.tif")
@@ -30,7 +31,7 @@ def test_reflection_tif_round_trip(tmp_path):
     radius, e_star, load = 2e-3, 32.8e9, 0.1
     a = hertz.contact_radius(load, radius, e_star)
     centre = (299.0, 299.0)
-    gap = radial_gap_map((600, 600), PIXEL, centre, lambda r: hertz_gap(r, load, radius, e_star))
+    gap = radial_gap_map((600, 600), PIXEL, centre, lambda r: exterior_gap(r, load, radius, e_star))
     image = render_reflection(gap, PIXEL, rng=np.random.default_rng(1))
     np.testing.assert_array_equal(
         image, render_reflection(gap, PIXEL, rng=np.random.default_rng(1))
@@ -38,7 +39,7 @@ def test_reflection_tif_round_trip(tmp_path):
     write_image(tmp_path / "reflection.tif", image, PIXEL)
     read = read_image(tmp_path / "reflection.tif")
     assert read.data.dtype == np.uint16
-    # Tolerance as in tests/optics/test_newton_ring_gap.py: 2 nm around the true 0.
+    # Tolerance as in tests/measure/test_newton_rings.py: 2 nm around the true 0.
     result = newton_ring_gap(read.data, read.pixel_m, centre, a)
     assert result.edge_gap_mean_m == pytest.approx(0.0, abs=2e-9)
 

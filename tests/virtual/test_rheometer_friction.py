@@ -6,12 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from amontons.friction import (
-    RheometerError,
-    amontons_deviation,
-    read_rheometer_csv,
-    static_friction,
-)
+from amontons.io.rheometer import RheometerError, read_rheometer_csv
+from amontons.measure.friction import amontons_deviation, static_friction
 from amontons.virtual.rheometer import rheometer_trace, write_rheometer_trace
 
 LOAD, F_STATIC, F_DYNAMIC = 0.025, 0.010, 0.008  # N
@@ -63,7 +59,7 @@ def test_csv_round_trip_keeps_radius_and_values(tmp_path):
     assert path.read_text().startswith("# ")
     read = read_rheometer_csv(path)
     assert read.rotation_radius_m == pytest.approx(RADIUS, rel=1e-9)
-    assert read.metadata["load_mN"] == "25"
+    assert read.metadata["load_mn"] == "25"
     np.testing.assert_allclose(read.torque_n_m, original.torque_n_m, rtol=1e-8)
     assert static_friction(read).static_friction_n == pytest.approx(
         static_friction(original).static_friction_n, rel=1e-6
@@ -91,7 +87,7 @@ def test_missing_column_names_file_and_column(tmp_path):
 def test_missing_radius_metadata_is_refused(tmp_path):
     path = tmp_path / "25.csv"
     rows = "".join(f"{i * 0.01},0,0.025,0\n" for i in range(20))
-    path.write_text("# load_mN: 25\ntime_s,angle_rad,normal_force_N,torque_N_m\n" + rows)
+    path.write_text("# load_mn: 25\ntime_s,angle_rad,normal_force_N,torque_N_m\n" + rows)
     with pytest.raises(RheometerError, match=r"25\.csv: no '# rotation_radius_mm"):
         read_rheometer_csv(path)
 
@@ -103,9 +99,9 @@ def test_amontons_deviation_table():
     friction = 5e6 * area
     table = amontons_deviation(force, area, friction)
     assert isinstance(table, pd.DataFrame)
-    assert list(table["normal_force_N"]) == sorted(force)
+    assert list(table["normal_force_n"]) == sorted(force)
     np.testing.assert_allclose(
-        table["mu_over_mu_ref"], (table["normal_force_N"] / 0.025) ** (-1 / 3)
+        table["mu_over_mu_ref"], (table["normal_force_n"] / 0.025) ** (-1 / 3)
     )
     np.testing.assert_allclose(table["shear_strength_over_ref"], 1.0)
     np.testing.assert_allclose(table["area_per_load_over_ref"], table["mu_over_mu_ref"])

@@ -4,9 +4,11 @@ from the solver grid onto an instrument's pixels."""
 import numpy as np
 import pytest
 
+from amontons.physics.newton_rings import APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX
 from amontons.virtual.rough_contact import (
     SolverSettings,
     image_contact_states,
+    ring_reach_gap,
     simulate_rough_sphere,
     solver_grid,
 )
@@ -60,7 +62,7 @@ def solution():
         k_pa_per_m=5e15,
         loads_n=[25e-3, 100e-3],
         reflection_load_n=25e-3,
-        rings=1,
+        ring_reach_gap_m=ring_reach_gap(1, APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX),
         roughness=Roughness(80e-9, 0.8, 10e-6, 32e-9),
         settings=settings,
         rng_seed=5,

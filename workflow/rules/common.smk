@@ -1,11 +1,17 @@
 # Helpers shared by the workflow files: validated config, the sample sheet and path lookups.
+# They import only amontons.config and amontons.io.layout (no numerical stack), so that
+# building the DAG stays fast.
 import os
 
-import pandas as pd
-
 from amontons.config import load_schema, load_workflow_config
-from amontons.measurements import afm_file
-from amontons.rawdata import AFM_SUFFIXES, fluorescence_images, rheometer_files
+from amontons.io.layout import (
+    FLUORESCENCE_DIR,
+    RHEOMETER_DIR,
+    AFM_SUFFIXES,
+    afm_file,
+    fluorescence_images,
+    rheometer_files,
+)
 
 SCHEMAS = os.path.join(workflow.basedir, "workflow", "schemas")
 CONFIG_SOURCE = ", ".join(
@@ -19,30 +25,24 @@ SPHERES = load_workflow_config(
 )
 MATERIALS = list(config["materials"])
 
-
-def check_sheet_loads(spheres):
-    """The reflection and FLIM loads of each sphere must be among its loads_mn."""
-    for sphere, row in spheres.iterrows():
-        for column in ("reflection_load_mn", "flim_load_mn"):
-            value = row.get(column)
-            if value is None or pd.isna(value):
-                continue
-            if not any(abs(float(value) - load) < 1e-9 for load in row["loads"]):
-                raise ValueError(
-                    f"{config['materials_sheet']}, sphere {sphere}: {column} = {value:g} is not "
-                    f"one of loads_mn {row['loads']}; expected the load of an existing image"
-                )
-
-
-check_sheet_loads(SPHERES)
+# Every run writes under its own name, so that the small data set never overwrites the
+# full reproduction: raw data of the virtual experiment, results and logs.
+RUN = config["run"]
+RESULTS = f"results/{RUN}"
+SYNTHETIC = f"resources/synthetic/{RUN}"
+LOGS = f"logs/{RUN}"
+# One sphere's measurements, and one material's figures and tables.
+MEASURED = f"results/{RUN}/{{material}}/{{sphere}}/measure"
+MATERIAL = f"results/{RUN}/{{material}}"
+SPHERE_LOGS = f"logs/{RUN}/{{material}}/{{sphere}}"
 
 
 def sphere_row(sphere):
-    return SPHERES.loc[sphere]
+    return SPHERES[sphere]
 
 
 def spheres_of(material):
-    return list(SPHERES.index[SPHERES["material"] == material])
+    return [s for s, row in SPHERES.items() if row["material"] == material]
 
 
 def is_synthetic(sphere):
@@ -52,7 +52,7 @@ def is_synthetic(sphere):
 def raw_dir(sphere):
     """Folder of a sphere's raw data: the virtual experiment's, or the one the sheet names."""
     if is_synthetic(sphere):
-        return f"resources/synthetic/{sphere}"
+        return f"{SYNTHETIC}/{sphere}"
     return sphere_row(sphere)["data_source"]
 
 
@@ -63,28 +63,35 @@ def loads_mn(sphere):
 def sheet_value(sphere, column):
     """A numeric sheet value, or None where the cell is empty."""
     value = sphere_row(sphere).get(column)
-    return None if value is None or pd.isna(value) else float(value)
+    return None if value is None else float(value)
 
 
 def pixel_nm(sphere):
     return float(sphere_row(sphere)["fluorescence_pixel_nm"])
 
 
-def per_load_dir(sphere, kind):
-    """A sphere's folder of per-load raw files: 'fluorescence' or 'rheometer'."""
-    return f"{raw_dir(sphere)}/{kind}"
-
-
 def per_load_inputs(sphere, kind):
-    """Inputs of a per-load folder. Measured data: each load's file, so that a replaced file
-    re-runs the jobs that read it (a folder's time does not change when a file in it is
-    overwritten); a folder that does not match the loads stops the run here, naming it.
-    Synthetic data: the folder, which the virtual experiment writes whole."""
-    folder = per_load_dir(sphere, kind)
+    """The per-load raw files of a sphere, 'fluorescence' or 'rheometer', in load order.
+
+    Measured data: each load's file, matched to the sheet's loads here (a folder that does not
+    match them stops the run, naming it), so that a replaced file re-runs the jobs that read
+    it and the script reads exactly these files. Synthetic data: the folder, which the virtual
+    experiment writes whole and names by load (amontons.io.layout.per_load_files)."""
+    folder = f"{raw_dir(sphere)}/{FLUORESCENCE_DIR if kind == 'fluorescence' else RHEOMETER_DIR}"
     if is_synthetic(sphere):
         return folder
     files = fluorescence_images if kind == "fluorescence" else rheometer_files
     return [str(path) for path in files(folder, loads_mn(sphere))]
+
+
+def reflection_fluorescence(sphere):
+    """The one fluorescence image the edge gap reads: the one at the reflection load (for
+    synthetic data, the folder the virtual experiment writes it into)."""
+    load = sheet_value(sphere, "reflection_load_mn")
+    if is_synthetic(sphere):
+        return per_load_inputs(sphere, "fluorescence")
+    images = per_load_inputs(sphere, "fluorescence")
+    return images[[abs(load - f) < 1e-9 for f in loads_mn(sphere)].index(True)]
 
 
 def raw_file(sphere, name):
@@ -104,12 +111,6 @@ def afm_path(sphere, stem):
     return str(afm_file(folder, stem))
 
 
-def reflection_fluorescence(sphere):
-    """The fluorescence image recorded at the sphere's reflection load."""
-    load = sheet_value(sphere, "reflection_load_mn")
-    return f"{raw_dir(sphere)}/fluorescence/{load:g}.tif"
-
-
 def has_flim(sphere):
     """Synthetic spheres get a FLIM map where the sheet gives flim_load_mn; measured spheres
     have one where their folder holds flim.tif."""
@@ -120,29 +121,61 @@ def has_flim(sphere):
 
 def flim_spheres_pattern(with_flim):
     """Regex matching the synthetic spheres with (or without) a FLIM map; never empty-match."""
-    names = [s for s in SPHERES.index if is_synthetic(s) and has_flim(s) == with_flim]
+    names = [s for s in SPHERES if is_synthetic(s) and has_flim(s) == with_flim]
     return "|".join(map(re.escape, names)) or "(?!)"
 
 
-def sphere_result(material, sphere, name):
+def measured(material, sphere, name):
+    """A measurement of one sphere: results/<run>/<material>/<sphere>/measure/<name>."""
     if sphere_row(sphere)["material"] != material:
         raise ValueError(
             f"sphere {sphere!r} is {sphere_row(sphere)['material']}, not {material}"
         )
-    return f"results/{material}/{sphere}/{name}"
+    return f"{MEASURED.format(material=material, sphere=sphere)}/{name}"
 
 
 def material_results(material, name):
-    """One file per sphere of ``material``."""
-    return [sphere_result(material, s, name) for s in spheres_of(material)]
+    """One measurement file per sphere of ``material``."""
+    return [measured(material, s, name) for s in spheres_of(material)]
+
+
+def sorted_keys(mapping):
+    """``mapping`` with its keys (and those of nested mappings) in sorted order. Snakemake
+    compares a job's params as written, key order included: sorted, a config overlay that
+    lists its keys in another order re-runs nothing."""
+    return {
+        key: sorted_keys(value) if isinstance(value, dict) else value
+        for key, value in sorted(mapping.items())
+    }
+
+
+def config_slice(*keys):
+    """The config section at ``keys`` (e.g. "optics", "psf"), as a rule's params: only the
+    slice the rule uses, so that a changed value re-runs exactly the jobs that use it.
+    """
+    section = config
+    for key in keys:
+        section = section[key]
+    return sorted_keys(section)
 
 
 def otsu_settings():
     """The optics keys that decide where a contact is and whether there is one."""
-    return {
-        key: config["optics"][key]
-        for key in ("otsu_bins", "min_separation", "min_contrast", "min_patch_px")
-    }
+    return sorted_keys(
+        {
+            key: config["optics"][key]
+            for key in ("otsu_bins", "min_separation", "min_contrast", "min_patch_px")
+        }
+    )
+
+
+def ring_optics():
+    """The light and the medium of the reflection image: the measurement and the virtual
+    experiment read the same two keys."""
+    rings = config["optics"]["newton_rings"]
+    return sorted_keys(
+        {key: rings[key] for key in ("wavelength_nm", "refractive_index")}
+    )
 
 
 def data_label(spheres):
@@ -178,7 +211,17 @@ FIT_RESULTS = ["load_area_fit.json"]
 
 
 def sphere_outputs(material, names):
-    return [sphere_result(material, s, n) for s in spheres_of(material) for n in names]
+    return [measured(material, s, n) for s in spheres_of(material) for n in names]
+
+
+def material_figures(materials, names):
+    """Per-material figures and tables ``names`` (PNG, PDF and CSV each)."""
+    return [
+        f"{MATERIAL.format(material=m)}/{name}.{ext}"
+        for m in materials
+        for name in names
+        for ext in ("png", "pdf", "csv")
+    ]
 
 
 def optics_outputs(materials):
@@ -187,7 +230,7 @@ def optics_outputs(materials):
     for material in materials:
         out += sphere_outputs(material, OPTICS_RESULTS)
         out += [
-            sphere_result(material, s, "lifetime.json")
+            measured(material, s, "lifetime.json")
             for s in spheres_of(material)
             if has_flim(s)
         ]
@@ -197,21 +240,12 @@ def optics_outputs(materials):
 def friction_outputs(materials):
     """Friction per sphere and the Amontons-deviation figure and table per material."""
     out = [f for m in materials for f in sphere_outputs(m, FRICTION_RESULTS)]
-    return out + expand(
-        "results/{material}/amontons.{ext}",
-        material=materials,
-        ext=["png", "pdf", "csv"],
-    )
+    return out + material_figures(materials, ["amontons"])
 
 
 def figure_outputs(materials):
     """The per-material figures and tables: load-area and Amontons deviation."""
-    return expand(
-        "results/{material}/{name}.{ext}",
-        material=materials,
-        name=["load_area", "amontons"],
-        ext=["png", "pdf", "csv"],
-    )
+    return material_figures(materials, ["load_area", "amontons"])
 
 
 def material_outputs(materials):

@@ -5,11 +5,11 @@ rule measure_friction:
     input:
         rheometer=lambda wc: per_load_inputs(wc.sphere, "rheometer"),
     output:
-        table="results/{material}/{sphere}/friction.csv",
+        table=f"{MEASURED}/friction.csv",
     log:
-        "logs/{material}/{sphere}/measure_friction.log",
+        f"{SPHERE_LOGS}/measure_friction.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_friction.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_friction.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -17,9 +17,8 @@ rule measure_friction:
         mem_mb=1000,
         runtime=5,
     params:
-        rheometer_dir=lambda wc: per_load_dir(wc.sphere, "rheometer"),
         loads_mn=lambda wc: loads_mn(wc.sphere),
-        friction=config["friction"],
+        friction=config_slice("friction"),
     script:
         "../../scripts/measure_friction.py"
 
@@ -30,22 +29,22 @@ rule plot_amontons_deviation:
         friction=lambda wc: material_results(wc.material, "friction.csv"),
     output:
         table=report(
-            "results/{material}/amontons.csv",
+            f"{MATERIAL}/amontons.csv",
             caption="../report/amontons.rst",
             category="Amontons deviation",
             subcategory="{material}",
         ),
         png=report(
-            "results/{material}/amontons.png",
+            f"{MATERIAL}/amontons.png",
             caption="../report/amontons.rst",
             category="Amontons deviation",
             subcategory="{material}",
         ),
-        pdf="results/{material}/amontons.pdf",
+        pdf=f"{MATERIAL}/amontons.pdf",
     log:
-        "logs/{material}/plot_amontons_deviation.log",
+        f"{LOGS}/{{material}}/plot_amontons_deviation.log",
     benchmark:
-        "logs/{material}/plot_amontons_deviation.benchmark.tsv"
+        f"{LOGS}/{{material}}/plot_amontons_deviation.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1

@@ -3,13 +3,13 @@
 
 rule fit_load_area:
     input:
-        table="results/{material}/{sphere}/contact_area.csv",
+        table=f"{MEASURED}/contact_area.csv",
     output:
-        fit="results/{material}/{sphere}/load_area_fit.json",
+        fit=f"{MEASURED}/load_area_fit.json",
     log:
-        "logs/{material}/{sphere}/fit_load_area.log",
+        f"{SPHERE_LOGS}/fit_load_area.log",
     benchmark:
-        "logs/{material}/{sphere}/fit_load_area.benchmark.tsv"
+        f"{SPHERE_LOGS}/fit_load_area.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -17,7 +17,7 @@ rule fit_load_area:
         mem_mb=1000,
         runtime=5,
     params:
-        load_area=config["load_area"],
+        load_area=config_slice("load_area"),
     script:
         "../../scripts/fit_load_area.py"
 
@@ -27,18 +27,18 @@ rule plot_load_area:
         tables=lambda wc: material_results(wc.material, "contact_area.csv"),
         fits=lambda wc: material_results(wc.material, "load_area_fit.json"),
     output:
-        table="results/{material}/load_area.csv",
+        table=f"{MATERIAL}/load_area.csv",
         png=report(
-            "results/{material}/load_area.png",
+            f"{MATERIAL}/load_area.png",
             caption="../report/load_area.rst",
             category="Load-area",
             subcategory="{material}",
         ),
-        pdf="results/{material}/load_area.pdf",
+        pdf=f"{MATERIAL}/load_area.pdf",
     log:
-        "logs/{material}/plot_load_area.log",
+        f"{LOGS}/{{material}}/plot_load_area.log",
     benchmark:
-        "logs/{material}/plot_load_area.benchmark.tsv"
+        f"{LOGS}/{{material}}/plot_load_area.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1

@@ -6,18 +6,18 @@ rule measure_contact_area:
     input:
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
-        table="results/{material}/{sphere}/contact_area.csv",
+        table=f"{MEASURED}/contact_area.csv",
         png=report(
-            "results/{material}/{sphere}/contact_area.png",
+            f"{MEASURED}/contact_area.png",
             caption="../report/contact_area.rst",
             category="Optics",
             subcategory="{material}",
         ),
-        pdf="results/{material}/{sphere}/contact_area.pdf",
+        pdf=f"{MEASURED}/contact_area.pdf",
     log:
-        "logs/{material}/{sphere}/measure_contact_area.log",
+        f"{SPHERE_LOGS}/measure_contact_area.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_contact_area.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_contact_area.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -25,7 +25,6 @@ rule measure_contact_area:
         mem_mb=2000,
         runtime=10,
     params:
-        fluorescence_dir=lambda wc: per_load_dir(wc.sphere, "fluorescence"),
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
@@ -38,18 +37,18 @@ rule measure_psf:
     input:
         bead=lambda wc: raw_file(wc.sphere, "bead.tif"),
     output:
-        psf="results/{material}/{sphere}/psf.json",
+        psf=f"{MEASURED}/psf.json",
         png=report(
-            "results/{material}/{sphere}/psf.png",
+            f"{MEASURED}/psf.png",
             caption="../report/psf.rst",
             category="Optics",
             subcategory="{material}",
         ),
-        pdf="results/{material}/{sphere}/psf.pdf",
+        pdf=f"{MEASURED}/psf.pdf",
     log:
-        "logs/{material}/{sphere}/measure_psf.log",
+        f"{SPHERE_LOGS}/measure_psf.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_psf.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_psf.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -58,7 +57,7 @@ rule measure_psf:
         runtime=5,
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        psf=config["optics"]["psf"],
+        psf=config_slice("optics", "psf"),
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_psf.py"
@@ -68,18 +67,18 @@ rule measure_grafting_density:
     input:
         absorbance=lambda wc: raw_file(wc.sphere, "absorbance.csv"),
     output:
-        density="results/{material}/{sphere}/grafting_density.json",
+        density=f"{MEASURED}/grafting_density.json",
         png=report(
-            "results/{material}/{sphere}/absorbance.png",
+            f"{MEASURED}/absorbance.png",
             caption="../report/absorbance.rst",
             category="Optics",
             subcategory="{material}",
         ),
-        pdf="results/{material}/{sphere}/absorbance.pdf",
+        pdf=f"{MEASURED}/absorbance.pdf",
     log:
-        "logs/{material}/{sphere}/measure_grafting_density.log",
+        f"{SPHERE_LOGS}/measure_grafting_density.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_grafting_density.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_grafting_density.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -87,7 +86,7 @@ rule measure_grafting_density:
         mem_mb=1000,
         runtime=5,
     params:
-        absorbance=config["optics"]["absorbance"],
+        absorbance=config_slice("optics", "absorbance"),
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_grafting_density.py"
@@ -96,20 +95,20 @@ rule measure_grafting_density:
 rule measure_edge_gap:
     input:
         reflection=lambda wc: raw_file(wc.sphere, "reflection.tif"),
-        fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
+        fluorescence=lambda wc: reflection_fluorescence(wc.sphere),
     output:
-        gap="results/{material}/{sphere}/edge_gap.json",
+        gap=f"{MEASURED}/edge_gap.json",
         png=report(
-            "results/{material}/{sphere}/edge_gap.png",
+            f"{MEASURED}/edge_gap.png",
             caption="../report/edge_gap.rst",
             category="Optics",
             subcategory="{material}",
         ),
-        pdf="results/{material}/{sphere}/edge_gap.pdf",
+        pdf=f"{MEASURED}/edge_gap.pdf",
     log:
-        "logs/{material}/{sphere}/measure_edge_gap.log",
+        f"{SPHERE_LOGS}/measure_edge_gap.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_edge_gap.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_edge_gap.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -117,11 +116,10 @@ rule measure_edge_gap:
         mem_mb=2000,
         runtime=10,
     params:
-        fluorescence_dir=lambda wc: per_load_dir(wc.sphere, "fluorescence"),
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
-        newton_rings=config["optics"]["newton_rings"],
+        newton_rings=config_slice("optics", "newton_rings"),
         data_label=lambda wc: data_label([wc.sphere]),
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
         e_star_gpa=lambda wc: float(sphere_row(wc.sphere)["e_star_gpa"]),
@@ -133,19 +131,19 @@ rule measure_intensity_pressure:
     input:
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
-        table="results/{material}/{sphere}/intensity_pressure.csv",
-        fit="results/{material}/{sphere}/intensity_pressure_fit.json",
+        table=f"{MEASURED}/intensity_pressure.csv",
+        fit=f"{MEASURED}/intensity_pressure_fit.json",
         png=report(
-            "results/{material}/{sphere}/intensity_pressure.png",
+            f"{MEASURED}/intensity_pressure.png",
             caption="../report/intensity_pressure.rst",
             category="Optics",
             subcategory="{material}",
         ),
-        pdf="results/{material}/{sphere}/intensity_pressure.pdf",
+        pdf=f"{MEASURED}/intensity_pressure.pdf",
     log:
-        "logs/{material}/{sphere}/measure_intensity_pressure.log",
+        f"{SPHERE_LOGS}/measure_intensity_pressure.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_intensity_pressure.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_intensity_pressure.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -153,11 +151,10 @@ rule measure_intensity_pressure:
         mem_mb=2000,
         runtime=10,
     params:
-        fluorescence_dir=lambda wc: per_load_dir(wc.sphere, "fluorescence"),
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
-        intensity=config["optics"]["intensity"],
+        intensity=config_slice("optics", "intensity"),
         confidence=config["load_area"]["confidence"],
         data_label=lambda wc: data_label([wc.sphere]),
     script:
@@ -168,11 +165,11 @@ rule measure_lifetime:
     input:
         flim=lambda wc: raw_file(wc.sphere, "flim.tif"),
     output:
-        lifetime="results/{material}/{sphere}/lifetime.json",
+        lifetime=f"{MEASURED}/lifetime.json",
     log:
-        "logs/{material}/{sphere}/measure_lifetime.log",
+        f"{SPHERE_LOGS}/measure_lifetime.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_lifetime.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_lifetime.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -182,20 +179,20 @@ rule measure_lifetime:
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
-        lifetime=config["optics"]["lifetime"],
+        lifetime=config_slice("optics", "lifetime"),
     script:
         "../../scripts/measure_lifetime.py"
 
 
 rule check_hertz:
     input:
-        table="results/{material}/{sphere}/contact_area.csv",
+        table=f"{MEASURED}/contact_area.csv",
     output:
-        table="results/{material}/{sphere}/hertz_check.csv",
+        table=f"{MEASURED}/hertz_check.csv",
     log:
-        "logs/{material}/{sphere}/check_hertz.log",
+        f"{SPHERE_LOGS}/check_hertz.log",
     benchmark:
-        "logs/{material}/{sphere}/check_hertz.benchmark.tsv"
+        f"{SPHERE_LOGS}/check_hertz.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1

@@ -6,18 +6,18 @@ rule measure_topography:
         before=lambda wc: afm_path(wc.sphere, "afm_before"),
         after=lambda wc: afm_path(wc.sphere, "afm_after"),
     output:
-        topography="results/{material}/{sphere}/topography.json",
+        topography=f"{MEASURED}/topography.json",
         png=report(
-            "results/{material}/{sphere}/topography.png",
+            f"{MEASURED}/topography.png",
             caption="../report/topography.rst",
             category="Surface",
             subcategory="{material}",
         ),
-        pdf="results/{material}/{sphere}/topography.pdf",
+        pdf=f"{MEASURED}/topography.pdf",
     log:
-        "logs/{material}/{sphere}/measure_topography.log",
+        f"{SPHERE_LOGS}/measure_topography.log",
     benchmark:
-        "logs/{material}/{sphere}/measure_topography.benchmark.tsv"
+        f"{SPHERE_LOGS}/measure_topography.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1

@@ -5,18 +5,18 @@
 
 rule generate_virtual_experiment:
     output:
-        fluorescence=directory("resources/synthetic/{sphere}/fluorescence"),
-        rheometer=directory("resources/synthetic/{sphere}/rheometer"),
-        reflection="resources/synthetic/{sphere}/reflection.tif",
-        bead="resources/synthetic/{sphere}/bead.tif",
-        absorbance="resources/synthetic/{sphere}/absorbance.csv",
-        afm_before="resources/synthetic/{sphere}/afm_before.tif",
-        afm_after="resources/synthetic/{sphere}/afm_after.tif",
-        truth="resources/synthetic/{sphere}/truth.json",
+        fluorescence=directory(f"{SYNTHETIC}/{{sphere}}/fluorescence"),
+        rheometer=directory(f"{SYNTHETIC}/{{sphere}}/rheometer"),
+        reflection=f"{SYNTHETIC}/{{sphere}}/reflection.tif",
+        bead=f"{SYNTHETIC}/{{sphere}}/bead.tif",
+        absorbance=f"{SYNTHETIC}/{{sphere}}/absorbance.csv",
+        afm_before=f"{SYNTHETIC}/{{sphere}}/afm_before.tif",
+        afm_after=f"{SYNTHETIC}/{{sphere}}/afm_after.tif",
+        truth=f"{SYNTHETIC}/{{sphere}}/truth.json",
     log:
-        "logs/virtual_experiment/{sphere}.log",
+        f"{LOGS}/virtual_experiment/{{sphere}}.log",
     benchmark:
-        "logs/virtual_experiment/{sphere}.benchmark.tsv"
+        f"{LOGS}/virtual_experiment/{{sphere}}.benchmark.tsv"
     wildcard_constraints:
         sphere=flim_spheres_pattern(with_flim=False),
     conda:
@@ -38,7 +38,8 @@ rule generate_virtual_experiment:
         flim_load_mn=lambda wc: sheet_value(wc.sphere, "flim_load_mn"),
         shear_strength_mpa=lambda wc: sheet_value(wc.sphere, "shear_strength_mpa"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        settings=config["virtual_experiment"],
+        settings=config_slice("virtual_experiment"),
+        newton_rings=ring_optics(),
         seed=config["seed"],
     script:
         "../../scripts/generate_virtual_experiment.py"
@@ -46,15 +47,15 @@ rule generate_virtual_experiment:
 
 use rule generate_virtual_experiment as generate_virtual_experiment_with_flim with:
     output:
-        fluorescence=directory("resources/synthetic/{sphere}/fluorescence"),
-        rheometer=directory("resources/synthetic/{sphere}/rheometer"),
-        reflection="resources/synthetic/{sphere}/reflection.tif",
-        bead="resources/synthetic/{sphere}/bead.tif",
-        absorbance="resources/synthetic/{sphere}/absorbance.csv",
-        afm_before="resources/synthetic/{sphere}/afm_before.tif",
-        afm_after="resources/synthetic/{sphere}/afm_after.tif",
-        flim="resources/synthetic/{sphere}/flim.tif",
-        truth="resources/synthetic/{sphere}/truth.json",
+        fluorescence=directory(f"{SYNTHETIC}/{{sphere}}/fluorescence"),
+        rheometer=directory(f"{SYNTHETIC}/{{sphere}}/rheometer"),
+        reflection=f"{SYNTHETIC}/{{sphere}}/reflection.tif",
+        bead=f"{SYNTHETIC}/{{sphere}}/bead.tif",
+        absorbance=f"{SYNTHETIC}/{{sphere}}/absorbance.csv",
+        afm_before=f"{SYNTHETIC}/{{sphere}}/afm_before.tif",
+        afm_after=f"{SYNTHETIC}/{{sphere}}/afm_after.tif",
+        flim=f"{SYNTHETIC}/{{sphere}}/flim.tif",
+        truth=f"{SYNTHETIC}/{{sphere}}/truth.json",
     wildcard_constraints:
         sphere=flim_spheres_pattern(with_flim=True),
 
@@ -62,9 +63,5 @@ use rule generate_virtual_experiment as generate_virtual_experiment_with_flim wi
 rule virtual_experiment:
     """Target: the virtual experiment of every synthetic sphere."""
     input:
-        [
-            f"resources/synthetic/{s}/truth.json"
-            for s in SPHERES.index
-            if is_synthetic(s)
-        ],
+        [f"{SYNTHETIC}/{s}/truth.json" for s in SPHERES if is_synthetic(s)],
     localrule: True

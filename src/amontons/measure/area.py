@@ -20,12 +20,16 @@ tests, each of which catches an image that another lets through:
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 from scipy import ndimage
 from skimage.filters import threshold_otsu
+
+from amontons.io.tiff import Image, saturated_pixels
+from amontons.measure.errors import NoContact
 
 
 @dataclass(frozen=True)
@@ -159,3 +163,57 @@ def otsu_contact_area(
         flag=_no_contact_reason(separation, contrast, patch, settings),
         mask=mask,
     )
+
+
+def contact_geometry(mask: np.ndarray, pixel_m: float) -> tuple[tuple[float, float], float]:
+    """Centre (row, col) px of a contact mask and the radius (m) of the circle of its area."""
+    rows, cols = np.nonzero(mask)
+    if rows.size == 0:
+        raise ValueError("the contact mask is empty; expected a contact")
+    radius_m = float(np.sqrt(rows.size / np.pi) * pixel_m)
+    return (float(rows.mean()), float(cols.mean())), radius_m
+
+
+def image_contact_area(image: Image, otsu: OtsuSettings) -> ContactArea:
+    """Otsu contact of ``image``, flagged where no contact stands out; a constant image
+    raises NoContact naming the file."""
+    try:
+        return otsu_contact_area(image.data, image.pixel_m, otsu)
+    except ValueError as error:
+        raise NoContact(f"{image.path}: {error}") from error
+
+
+def separated_contact(image: Image, otsu: OtsuSettings) -> ContactArea:
+    """Otsu contact of ``image``; raises NoContact, naming the file and why, when no contact
+    stands out (:func:`otsu_contact_area`: separation, contrast, patch size)."""
+    area = image_contact_area(image, otsu)
+    if not area.contact_found:
+        raise NoContact(f"{image.path}: {area.flag}; expected a contact brighter than it")
+    return area
+
+
+def contact_area_table(
+    loads_mn: Sequence[float], images: Sequence[Image], areas: Sequence[ContactArea]
+) -> pd.DataFrame:
+    """One row per load: the Otsu area and how well the image shows a contact (units in the
+    column names). A flagged image keeps its row (``contact_found`` False, ``flag`` why);
+    saturated pixels are counted (the area stands, intensities are clipped)."""
+    rows = []
+    for load, image, area in zip(loads_mn, images, areas, strict=True):
+        rows.append(
+            {
+                "load_mn": load,
+                "area_um2": area.area_m2 * 1e12,
+                "contact_pixels": area.n_contact_pixels,
+                "pixel_nm": image.pixel_m * 1e9,
+                "otsu_threshold_counts": area.threshold,
+                "otsu_separation": area.separation,
+                "contrast_noise_sd": area.contrast,
+                "largest_patch_px": area.largest_patch_px,
+                "contact_found": area.contact_found,
+                "flag": area.flag or "",
+                "saturated_pixels": saturated_pixels(image.data),
+                "image": str(image.path),
+            }
+        )
+    return pd.DataFrame(rows)

@@ -5,41 +5,22 @@ the rotation radius R_rot (measured by microscopy to ~1 %). The tangential force
 contact is M/R_rot; the same radius turns the plate angle θ into sliding distance R_rot·Δθ
 and the angular rate into sliding speed R_rot·dθ/dt.
 
-One CSV per normal load (``<folder>/rheometer/<load in mN>.csv``): leading comment lines
-``# key: value`` with at least ``# rotation_radius_mm: <value>``, then the columns
-time_s, angle_rad, normal_force_N, torque_N_m.
+The records are read by amontons.io.rheometer (one CSV per normal load).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from scipy.ndimage import median_filter
 
-from amontons.images import atomic_path
-
-COLUMNS = ("time_s", "angle_rad", "normal_force_N", "torque_N_m")
-RADIUS_KEY = "rotation_radius_mm"
-
-
-class RheometerError(ValueError):
-    """A rheometer file or trace from which no friction force can be read."""
-
-
-@dataclass(frozen=True)
-class RheometerTrace:
-    """One load's record: time (s), plate angle (rad), normal force (N), torque (N·m)."""
-
-    time_s: np.ndarray
-    angle_rad: np.ndarray
-    normal_force_n: np.ndarray
-    torque_n_m: np.ndarray
-    rotation_radius_m: float | None = None
-    metadata: dict[str, str] = field(default_factory=dict)
-    source: str = "<memory>"
+from amontons.io.layout import RawDataError
+from amontons.io.rawdata import read_rheometer_traces
+from amontons.io.rheometer import RheometerError, RheometerTrace
 
 
 @dataclass(frozen=True)
@@ -56,98 +37,6 @@ class FrictionMeasurement:
     sliding_distance_m: float
     peak_time_s: float
     rotation_radius_m: float
-
-
-# --- reading and writing -----------------------------------------------------------------------
-
-
-def _metadata(lines: list[str]) -> dict[str, str]:
-    metadata = {}
-    for line in lines:
-        body = line.lstrip("#").strip()
-        if ":" in body:
-            key, value = body.split(":", 1)
-            metadata[key.strip()] = value.strip()
-    return metadata
-
-
-def read_rheometer_csv(path: str | Path) -> RheometerTrace:
-    """Read one load's rheometer CSV with its '# key: value' header.
-
-    Raises RheometerError naming the file for a missing column, missing or invalid
-    rotation-radius metadata, non-numeric values, or fewer than 10 rows.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise RheometerError(f"{path}: no such rheometer file")
-    with path.open(encoding="utf-8") as handle:
-        header = []
-        for line in handle:
-            if not line.startswith("#"):
-                break
-            header.append(line)
-    metadata = _metadata(header)
-    radius_m = _radius_from_metadata(path, metadata)
-    table = pd.read_csv(path, comment="#")
-    columns = {}
-    for column in COLUMNS:
-        if column not in table.columns:
-            raise RheometerError(
-                f"{path}: no column '{column}'; found {list(table.columns)}, expected "
-                f"{list(COLUMNS)}"
-            )
-        values = pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float)
-        if not np.all(np.isfinite(values)):
-            bad = int(np.count_nonzero(~np.isfinite(values)))
-            raise RheometerError(f"{path}: {bad} non-numeric or missing values in '{column}'")
-        columns[column] = values
-    if len(table) < 10:
-        raise RheometerError(f"{path}: {len(table)} rows; a friction trace needs at least 10")
-    return RheometerTrace(
-        time_s=columns["time_s"],
-        angle_rad=columns["angle_rad"],
-        normal_force_n=columns["normal_force_N"],
-        torque_n_m=columns["torque_N_m"],
-        rotation_radius_m=radius_m,
-        metadata=metadata,
-        source=str(path),
-    )
-
-
-def _radius_from_metadata(path: Path, metadata: dict[str, str]) -> float:
-    if RADIUS_KEY not in metadata:
-        raise RheometerError(
-            f"{path}: no '# {RADIUS_KEY}: <value>' line in the header; the rotation radius "
-            "is needed to turn torque into force"
-        )
-    try:
-        radius_mm = float(metadata[RADIUS_KEY])
-    except ValueError:
-        radius_mm = float("nan")
-    if not np.isfinite(radius_mm) or radius_mm <= 0:
-        raise RheometerError(
-            f"{path}: {RADIUS_KEY} = '{metadata[RADIUS_KEY]}'; expected a positive number of mm"
-        )
-    return radius_mm * 1e-3
-
-
-def write_rheometer_csv(path: str | Path, trace: RheometerTrace) -> None:
-    """Write a trace in the rheometer CSV layout, radius and metadata in the header, atomically."""
-    if trace.rotation_radius_m is None:
-        raise RheometerError(f"{path}: trace has no rotation radius to write")
-    metadata = {**trace.metadata, RADIUS_KEY: f"{trace.rotation_radius_m * 1e3:.6g}"}
-    table = pd.DataFrame(
-        {
-            "time_s": trace.time_s,
-            "angle_rad": trace.angle_rad,
-            "normal_force_N": trace.normal_force_n,
-            "torque_N_m": trace.torque_n_m,
-        }
-    )
-    with atomic_path(path) as tmp, tmp.open("w", encoding="utf-8") as handle:
-        for key, value in metadata.items():
-            handle.write(f"# {key}: {value}\n")
-        table.to_csv(handle, index=False, float_format="%.9g")
 
 
 # --- the measurement ---------------------------------------------------------------------------
@@ -255,8 +144,8 @@ def amontons_deviation(
     """Friction, area and their ratios to the values at the reference load (Fig. 5).
 
     Amontons' law says μ = F_f/F_N is constant; with F_f = τ·A and a sublinear A(F_N) it falls.
-    Columns (units in the names): normal_force_N, area_m2, static_friction_N,
-    friction_coefficient, mean_pressure_Pa (F_N/A), shear_strength_Pa (F_f/A), and the ratios
+    Columns (units in the names): normal_force_N, area_m2, static_friction_n,
+    friction_coefficient, mean_pressure_pa (F_N/A), shear_strength_pa (F_f/A), and the ratios
     mu_over_mu_ref, area_over_area_ref, shear_strength_over_ref and
     area_per_load_over_ref ((A/F_N)/(A/F_N)_ref, which is μ/μ_ref if τ is constant).
     The reference row is the load nearest ``reference_load_n``; it must lie within
@@ -281,19 +170,98 @@ def amontons_deviation(
         )
     table = pd.DataFrame(
         {
-            "normal_force_N": force,
+            "normal_force_n": force,
             "area_m2": area,
-            "static_friction_N": friction,
+            "static_friction_n": friction,
             "friction_coefficient": friction / force,
-            "mean_pressure_Pa": force / area,
-            "shear_strength_Pa": friction / area,
+            "mean_pressure_pa": force / area,
+            "shear_strength_pa": friction / area,
         }
     )
     ref = table.iloc[reference]
     table["mu_over_mu_ref"] = table["friction_coefficient"] / ref["friction_coefficient"]
     table["area_over_area_ref"] = table["area_m2"] / ref["area_m2"]
-    table["shear_strength_over_ref"] = table["shear_strength_Pa"] / ref["shear_strength_Pa"]
-    table["area_per_load_over_ref"] = (table["area_m2"] / table["normal_force_N"]) / (
-        ref["area_m2"] / ref["normal_force_N"]
+    table["shear_strength_over_ref"] = table["shear_strength_pa"] / ref["shear_strength_pa"]
+    table["area_per_load_over_ref"] = (table["area_m2"] / table["normal_force_n"]) / (
+        ref["area_m2"] / ref["normal_force_n"]
     )
-    return table.sort_values("normal_force_N", ignore_index=True)
+    return table.sort_values("normal_force_n", ignore_index=True)
+
+
+def measure_friction(
+    rheometer_paths: Sequence[str | Path],
+    loads_mn: Sequence[float],
+    *,
+    median_window_s: float,
+    plateau_fraction: float,
+) -> pd.DataFrame:
+    """Friction per load from the rheometer records ``rheometer_paths`` (one per load of
+    ``loads_mn``); units in the column names."""
+    rows = []
+    for load, trace in zip(loads_mn, read_rheometer_traces(rheometer_paths, loads_mn), strict=True):
+        try:
+            result = static_friction(
+                trace, median_window_s=median_window_s, plateau_fraction=plateau_fraction
+            )
+        except RheometerError as error:
+            raise RawDataError(str(error)) from error
+        rows.append(
+            {
+                "load_mn": load,
+                "normal_force_mn": result.normal_force_n * 1e3,
+                "static_friction_mn": result.static_friction_n * 1e3,
+                "dynamic_friction_mn": result.dynamic_friction_n * 1e3,
+                "dynamic_friction_se_mn": result.dynamic_friction_se_n * 1e3,
+                "static_coefficient": result.static_coefficient,
+                "dynamic_coefficient": result.dynamic_coefficient,
+                "sliding_speed_um_s": result.sliding_speed_m_s * 1e6,
+                "sliding_distance_um": result.sliding_distance_m * 1e6,
+                "peak_time_s": result.peak_time_s,
+                "rotation_radius_mm": result.rotation_radius_m * 1e3,
+                "file": trace.source,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def amontons_table(
+    spheres: Sequence[str],
+    area_tables: Sequence[pd.DataFrame],
+    friction_tables: Sequence[pd.DataFrame],
+    reference_load_mn: float,
+) -> pd.DataFrame:
+    """Area and static friction per load and sphere, normalised at ``reference_load_mn``
+    (appendix Fig. B.13), from each sphere's contact_area.csv and friction.csv tables.
+
+    Loads whose area is ill-determined (Otsu) are left out. The normal force is the
+    rheometer's measured one.
+    """
+    frames = []
+    for sphere, areas, friction in zip(spheres, area_tables, friction_tables, strict=True):
+        merged = areas[areas["contact_found"]].merge(friction, on="load_mn", how="inner")
+        deviation = amontons_deviation(
+            merged["normal_force_mn"].to_numpy() * 1e-3,
+            merged["area_um2"].to_numpy() * 1e-12,
+            merged["static_friction_mn"].to_numpy() * 1e-3,
+            reference_load_n=reference_load_mn * 1e-3,
+        )
+        # The same reference row as amontons_deviation: the load nearest the reference.
+        reference = int(np.argmin(np.abs(deviation["normal_force_n"] - reference_load_mn * 1e-3)))
+        frames.append(
+            pd.DataFrame(
+                {
+                    "sphere": sphere,
+                    "load_mn": merged.sort_values("normal_force_mn")["load_mn"].to_numpy(),
+                    "normal_force_mn": deviation["normal_force_n"] * 1e3,
+                    "area_um2": deviation["area_m2"] * 1e12,
+                    "static_friction_mn": deviation["static_friction_n"] * 1e3,
+                    "friction_coefficient": deviation["friction_coefficient"],
+                    "shear_strength_mpa": deviation["shear_strength_pa"] * 1e-6,
+                    "area_over_area_ref": deviation["area_over_area_ref"],
+                    "friction_over_friction_ref": deviation["static_friction_n"]
+                    / deviation["static_friction_n"].iloc[reference],
+                    "mu_over_mu_ref": deviation["mu_over_mu_ref"],
+                }
+            )
+        )
+    return pd.concat(frames, ignore_index=True)

@@ -6,7 +6,7 @@ The appendix smooths the noisy spectrum with LOWESS, takes its maximum A_max (0.
 cover slip carry a monolayer and the beam crosses both, so the density per face is
 Γ = A_max / (ε · n_faces) with n_faces = 2: 0.0016 / (6220 m²/mol · 2) · N_A
 = 7.74·10¹⁶ m⁻² = 7.74·10⁴ µm⁻², the appendix's "~80 000 molecules/µm²" (one face would
-give twice that; science.md §1).
+give twice that; docs/models.md §1.1).
 """
 
 from __future__ import annotations
@@ -15,16 +15,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 from statsmodels.nonparametric.smoothers_lowess import lowess
 
-AVOGADRO_PER_MOL = 6.02214076e23
-EPSILON_M2_PER_MOL = 6220.0  # 62 200 M⁻¹cm⁻¹ = 62 200 L/(mol·cm) = 6 220 m²/mol
-_COLUMNS = ("wavelength_nm", "absorbance")
-
-
-class AbsorbanceError(ValueError):
-    """An absorbance spectrum from which no grafting density can be read."""
+from amontons.io.absorbance import AbsorbanceError
+from amontons.io.layout import RawDataError
+from amontons.io.rawdata import read_absorbance
+from amontons.physics.beer_lambert import (
+    EPSILON_M2_PER_MOL,
+    M2_PER_MOL_PER_L_PER_MOL_CM,
+    surface_density_per_m2,
+)
 
 
 @dataclass(frozen=True)
@@ -40,36 +40,23 @@ class GraftingDensity:
     epsilon_m2_per_mol: float
     frac: float
     wavelength_nm: np.ndarray
+    absorbance: np.ndarray  # the measured spectrum, at wavelength_nm
     smoothed: np.ndarray
 
-
-def read_absorbance_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """Wavelengths (nm) and absorbance from a CSV with columns wavelength_nm, absorbance.
-
-    Raises AbsorbanceError naming the file for a missing column, non-numeric or non-finite
-    values, or fewer than 10 rows.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise AbsorbanceError(f"{path}: no such absorbance spectrum")
-    table = pd.read_csv(path, comment="#")
-    for column in _COLUMNS:
-        if column not in table.columns:
-            raise AbsorbanceError(
-                f"{path}: no column '{column}'; found {list(table.columns)}, expected "
-                f"{list(_COLUMNS)}"
-            )
-    values = {}
-    for column in _COLUMNS:
-        numbers = pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float)
-        if not np.all(np.isfinite(numbers)):
-            bad = int(np.count_nonzero(~np.isfinite(numbers)))
-            raise AbsorbanceError(f"{path}: {bad} non-numeric or missing values in '{column}'")
-        values[column] = numbers
-    if len(table) < 10:
-        raise AbsorbanceError(f"{path}: {len(table)} rows; a spectrum needs at least 10")
-    order = np.argsort(values["wavelength_nm"])
-    return values["wavelength_nm"][order], values["absorbance"][order]
+    def to_record(self) -> dict:
+        """JSON-ready record, units in the key names."""
+        return {
+            "quantity": "grafting density of the rigidochromic monolayer, molecules per µm² of "
+            "one face: LOWESS maximum of the absorbance / (ε · coated faces) · N_A",
+            "density_per_um2": self.density_per_um2,
+            "peak_absorbance": self.peak_absorbance,
+            "peak_wavelength_nm": self.peak_wavelength_nm,
+            "noise_sd": self.noise_sd,
+            "coated_faces": self.n_faces,
+            "epsilon_l_per_mol_cm": self.epsilon_m2_per_mol / M2_PER_MOL_PER_L_PER_MOL_CM,
+            "lowess_frac": self.frac,
+            "n": int(self.wavelength_nm.size),
+        }
 
 
 def grafting_density(
@@ -111,7 +98,7 @@ def grafting_density(
             f" nm of {wavelength_nm[0]:g}–{wavelength_nm[-1]:g} nm); expected a band maximum "
             "inside it"
         )
-    density = peak_absorbance / (epsilon_m2_per_mol * n_faces) * AVOGADRO_PER_MOL
+    density = surface_density_per_m2(peak_absorbance, epsilon_m2_per_mol, n_faces)
     return GraftingDensity(
         peak_absorbance=peak_absorbance,
         peak_wavelength_nm=float(wavelength_nm[peak]),
@@ -122,5 +109,23 @@ def grafting_density(
         epsilon_m2_per_mol=epsilon_m2_per_mol,
         frac=frac,
         wavelength_nm=wavelength_nm,
+        absorbance=absorbance,
         smoothed=smoothed,
     )
+
+
+def measure_grafting_density(
+    path: str | Path, *, frac: float, n_faces: int, epsilon_m2_per_mol: float
+) -> GraftingDensity:
+    """Grafting density from the spectrum ``path`` (LOWESS maximum over ε·faces)."""
+    wavelength_nm, absorbance = read_absorbance(path)
+    try:
+        return grafting_density(
+            wavelength_nm,
+            absorbance,
+            frac=frac,
+            n_faces=n_faces,
+            epsilon_m2_per_mol=epsilon_m2_per_mol,
+        )
+    except AbsorbanceError as error:
+        raise RawDataError(f"{path}: {error}") from error

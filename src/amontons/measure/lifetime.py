@@ -9,9 +9,14 @@ that width out on both sides.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.ndimage import binary_erosion
+
+from amontons.io.layout import RawDataError
+from amontons.io.rawdata import read_flim
+from amontons.measure.area import OtsuSettings, separated_contact
 
 
 @dataclass(frozen=True)
@@ -26,6 +31,25 @@ class LifetimeStatistics:
     outside_sd_ns: float
     outside_se_ns: float
     outside_n: int
+
+    def to_record(self, exclude_edge_px: int) -> dict:
+        """JSON-ready record, units in the key names (``exclude_edge_px``: the band left out
+        on both sides of the edge)."""
+
+        def side(mean, sd, se, n):
+            return {"mean": mean, "sd": sd, "standard_error": float(se), "n": n}
+
+        return {
+            "quantity": "mean photon arrival time, ns, inside and outside the contact (Otsu "
+            "mask of the arrival-time map, edge band excluded)",
+            "inside_ns": side(
+                self.inside_mean_ns, self.inside_sd_ns, self.inside_se_ns, self.inside_n
+            ),
+            "outside_ns": side(
+                self.outside_mean_ns, self.outside_sd_ns, self.outside_se_ns, self.outside_n
+            ),
+            "exclude_edge_px": exclude_edge_px,
+        }
 
 
 def _stats(values: np.ndarray) -> tuple[float, float, float, int]:
@@ -60,3 +84,24 @@ def lifetime_statistics(
             )
     in_stats, out_stats = _stats(arrival[inside]), _stats(arrival[outside])
     return LifetimeStatistics(*in_stats, *out_stats)
+
+
+def measure_lifetime(
+    path: str | Path,
+    fallback_pixel_m: float | None,
+    *,
+    otsu: OtsuSettings,
+    exclude_edge_px: int,
+) -> LifetimeStatistics:
+    """Arrival-time statistics inside and outside the contact of the FLIM map ``path``.
+
+    The FLIM map comes from another microscope (appendix Fig. B.3), so its contact mask is
+    found in the map itself: confined molecules emit later, so the contact is the Otsu class of
+    long arrival times. Raises NoContact if no such class stands out.
+    """
+    image = read_flim(path, fallback_pixel_m)
+    mask = separated_contact(image, otsu).mask
+    try:
+        return lifetime_statistics(image.data, mask, exclude_edge_px=exclude_edge_px)
+    except ValueError as error:
+        raise RawDataError(f"{image.path}: {error}") from error

@@ -29,7 +29,11 @@ import numpy as np
 from scipy.ndimage import gaussian_filter, map_coordinates
 from scipy.signal import find_peaks
 
-from amontons.virtual.reflection import N_FORMAMIDE, WAVELENGTH_M, ring_gap
+from amontons.physics.newton_rings import (
+    APPENDIX_WAVELENGTH_M,
+    FORMAMIDE_REFRACTIVE_INDEX,
+    ring_gap,
+)
 
 _EDGE_MODELS = ("hertz", "quadratic")
 _MIN_RINGS = {"hertz": 2, "quadratic": 3}
@@ -220,8 +224,8 @@ def newton_ring_gap(
     centre_px: tuple[float, float],
     contact_radius_m: float,
     n_profiles: int = 20,
-    wavelength_m: float = WAVELENGTH_M,
-    n_medium: float = N_FORMAMIDE,
+    wavelength_m: float = APPENDIX_WAVELENGTH_M,
+    n_medium: float = FORMAMIDE_REFRACTIVE_INDEX,
     *,
     edge_model: str = "hertz",
     max_rings: int | None = None,

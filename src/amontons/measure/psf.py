@@ -19,13 +19,16 @@ Pixel coordinates: the centre of pixel (row i, column j) is at x = j·pixel_m, y
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.ndimage import uniform_filter
 from scipy.optimize import curve_fit
 
-from amontons.images import saturated_pixels
-from amontons.virtual.fluorescence import FWHM_PER_SIGMA
+from amontons.io.layout import RawDataError
+from amontons.io.rawdata import read_bead
+from amontons.io.tiff import saturated_pixels
+from amontons.physics.gaussian import FWHM_PER_SIGMA
 
 _MAD_TO_SD = 1.4826  # σ of a normal population per median absolute deviation
 
@@ -50,6 +53,20 @@ class PsfMeasurement:
     profile_r_m: np.ndarray  # radial average: ring centres
     profile_counts: np.ndarray  # radial average: mean counts per ring
     n_pixels_fitted: int
+
+    def to_record(self) -> dict:
+        """JSON-ready record, units in the key names."""
+        return {
+            "quantity": "PSF FWHM from a 100 nm bead (Gaussian fit of the radial profile, "
+            "pixel-corrected)",
+            "fwhm_nm": {"estimate": self.fwhm_m * 1e9, "standard_error": self.fwhm_se_m * 1e9},
+            "fitted_fwhm_nm": self.fitted_fwhm_m * 1e9,
+            "n": self.n_pixels_fitted,
+            "peak_counts": self.peak_counts,
+            "background_counts": self.background_counts,
+            "noise_sd_counts": self.noise_sd_counts,
+            "centroid_nm": [c * 1e9 for c in self.centroid_m],
+        }
 
 
 def gaussian_with_background(r, amplitude, sigma, background):
@@ -228,3 +245,23 @@ def _pixel_corrected_sigma(sigma_fit: float, pixel_m: float) -> float:
             "the PSF is unresolved at this pixel size"
         )
     return float(np.sqrt(variance))
+
+
+def measure_bead(
+    path: str | Path,
+    fallback_pixel_m: float | None,
+    *,
+    profile_radius_m: float,
+    centroid_radius_m: float,
+) -> PsfMeasurement:
+    """PSF FWHM from the bead image ``path`` (:func:`measure_psf`)."""
+    image = read_bead(path, fallback_pixel_m)
+    try:
+        return measure_psf(
+            image.data,
+            image.pixel_m,
+            profile_radius_m=profile_radius_m,
+            centroid_radius_m=centroid_radius_m,
+        )
+    except PsfError as error:
+        raise RawDataError(f"{image.path}: {error}") from error

@@ -1,136 +1,21 @@
-"""AFM topography of a sphere: reading height maps, levelling, sphere fit, roughness statistics.
+"""AFM topography of a sphere (docs/models.md §1.8): levelling by a sphere fit and scan-line
+alignment, roughness statistics, and the plastic flattening between two scans (Fig. B.9).
 
-Heights are in metres, positive towards the cover slip (the apex of the sphere is the maximum).
-Readers:
-
-* TIFF (float heights in m; pixel size from the resolution tags or the sample sheet),
-* ``.npy`` (float heights in m; pixel size from the sample sheet),
-* the plain-text matrix Gwyddion exports ("Export → Text", with its informational header):
-  ``# Width: 65.54 µm``, ``# Height: …``, ``# Value units: m``, then rows of numbers.
+Heights are in metres, positive towards the cover slip (the apex of the sphere is the maximum);
+the height maps are read by amontons.io.heightmap.
 """
 
 from __future__ import annotations
 
-import logging
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import ndimage, optimize
+from scipy import optimize
 
-from amontons.images import ImageError, read_image
-
-log = logging.getLogger(__name__)
-
-_LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "µm": 1e-6, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
-
-
-class TopographyError(ValueError):
-    """A height map cannot be used as it is."""
-
-
-@dataclass(frozen=True)
-class HeightMap:
-    """Heights (m) on a square grid of ``pixel_m`` metres; ``filled`` NaN pixels were filled."""
-
-    heights: np.ndarray
-    pixel_m: float
-    path: Path
-    filled: int = 0
-
-
-def _length(value: str, unit: str, path: Path, key: str) -> float:
-    unit = unit.strip()
-    if unit not in _LENGTH_UNITS:
-        raise TopographyError(
-            f"{path}: {key} unit {unit!r} is not a length; "
-            f"expected one of {', '.join(_LENGTH_UNITS)}"
-        )
-    return float(value) * _LENGTH_UNITS[unit]
-
-
-def read_gwyddion_text(path: str | Path) -> tuple[np.ndarray, float | None]:
-    """Heights (m) and pixel size (m, or None without a Width line) of a Gwyddion text export."""
-    path = Path(path)
-    header = {}
-    with open(path, encoding="utf-8", errors="replace") as stream:
-        for line in stream:
-            if not line.startswith("#"):
-                break
-            match = re.match(r"#\s*([^:]+):\s*(.*)", line.strip())
-            if match:
-                header[match.group(1).strip().lower()] = match.group(2).strip()
-    data = np.loadtxt(path, comments="#", ndmin=2)
-    z_unit = header.get("value units", "m")
-    if z_unit not in _LENGTH_UNITS:
-        raise TopographyError(
-            f"{path}: value units {z_unit!r} are not a length; expected a height map in "
-            f"one of {', '.join(_LENGTH_UNITS)}"
-        )
-    heights = data * _LENGTH_UNITS[z_unit]
-    pixel = None
-    if "width" in header:
-        value, _, unit = header["width"].partition(" ")
-        pixel = _length(value, unit, path, "Width") / heights.shape[1]
-    return heights, pixel
-
-
-def fill_missing(heights: np.ndarray) -> tuple[np.ndarray, int]:
-    """Replace NaN pixels by their nearest valid neighbour; return the map and the count."""
-    missing = ~np.isfinite(heights)
-    if not missing.any():
-        return heights, 0
-    _, (rows, cols) = ndimage.distance_transform_edt(missing, return_indices=True)
-    return heights[rows, cols], int(missing.sum())
-
-
-def read_height_map(
-    path: str | Path, *, fallback_pixel_m: float | None = None, nan_policy: str = "fail"
-) -> HeightMap:
-    """Read an AFM height map (TIFF, .npy or Gwyddion text), heights in m.
-
-    ``nan_policy`` is 'fail' (raise, naming the number and first position of NaN pixels) or
-    'fill' (nearest valid neighbour, logged).
-    """
-    path = Path(path)
-    if nan_policy not in ("fail", "fill"):
-        raise ValueError(f"nan_policy must be 'fail' or 'fill', got {nan_policy!r}")
-    if not path.is_file():
-        raise TopographyError(f"{path}: no such height map")
-    suffix = path.suffix.lower()
-    if suffix in (".tif", ".tiff"):
-        try:
-            image = read_image(path, fallback_pixel_m, allow_nan=True)
-        except ImageError as error:
-            raise TopographyError(str(error)) from error
-        heights, pixel = image.data.astype(float), image.pixel_m
-    elif suffix == ".npy":
-        heights, pixel = np.load(path).astype(float), fallback_pixel_m
-    elif suffix in (".txt", ".asc", ".dat"):
-        heights, pixel = read_gwyddion_text(path)
-        pixel = pixel if pixel is not None else fallback_pixel_m
-    else:
-        raise TopographyError(
-            f"{path}: unknown height-map format {suffix!r}; expected .tif, .npy or a Gwyddion "
-            "text export (.txt/.asc)"
-        )
-    if heights.ndim != 2 or min(heights.shape) < 8:
-        raise TopographyError(f"{path}: height map of shape {heights.shape}; expected 2-D")
-    if pixel is None:
-        raise TopographyError(f"{path}: no pixel size in the file and none in the sample sheet")
-    missing = ~np.isfinite(heights)
-    if missing.any():
-        first = tuple(int(i) for i in np.argwhere(missing)[0])
-        if nan_policy == "fail":
-            raise TopographyError(
-                f"{path}: {int(missing.sum())} NaN pixels (first at row, column {first}); set "
-                "afm_nan_policy: fill to replace them by their nearest valid neighbour"
-            )
-        heights, count = fill_missing(heights)
-        log.warning("%s: filled %d NaN pixels (first at %s)", path, count, first)
-        return HeightMap(heights, float(pixel), path, count)
-    return HeightMap(heights, float(pixel), path)
+from amontons.io.heightmap import TopographyError, read_height_map
+from amontons.io.layout import RawDataError
+from amontons.physics.roughness import RoughnessStatistics, roughness_statistics
 
 
 @dataclass(frozen=True)
@@ -211,28 +96,111 @@ def level_sphere(heights: np.ndarray, pixel_m: float, *, align_rows: bool = True
 
 
 @dataclass(frozen=True)
-class RoughnessStatistics:
-    """h_rms (m), h'_rms = √⟨|∇h|²⟩ (dimensionless), h''_rms = rms of the mean curvature ½∇²h
-    (1/m; the convention of SurfaceTopography's rms_curvature; rms(∇²h) is twice it)."""
+class Topography:
+    """The sphere's AFM scans before and after the load series, levelled (lengths in m)."""
 
-    h_rms_m: float
-    slope_rms: float
-    curvature_rms_per_m: float
+    before: SphereFit
+    after: SphereFit
+    before_statistics: RoughnessStatistics
+    after_statistics: RoughnessStatistics
+    change_m: np.ndarray  # after − before, the unchanged points at 0, m
+    pixel_m: float
+    filled_pixels: int
+    nan_policy: str
+    before_path: Path
+    after_path: Path
+
+    @property
+    def max_flattening_m(self) -> float:
+        """The deepest flattening, m: the largest drop of after below before."""
+        return float(-self.change_m.min())
+
+    def to_record(self) -> dict:
+        """JSON-ready record, units in the key names."""
+
+        def statistics(fit: SphereFit, stats: RoughnessStatistics) -> dict:
+            return {
+                "sphere_radius_mm": fit.radius_m * 1e3,
+                "roughness_rms_nm": stats.h_rms_m * 1e9,
+                "slope_rms": stats.slope_rms,
+                "curvature_rms_per_um": stats.curvature_rms_per_m * 1e-6,
+            }
+
+        return {
+            "quantity": "AFM topography levelled by a sphere fit and scan-line alignment; "
+            "statistics at the AFM pixel",
+            "pixel_nm": self.pixel_m * 1e9,
+            "shape_px": list(self.change_m.shape),
+            "before": statistics(self.before, self.before_statistics),
+            "after": statistics(self.after, self.after_statistics),
+            "max_flattening_nm": self.max_flattening_m * 1e9,
+            "filled_nan_pixels": self.filled_pixels,
+            "nan_policy": self.nan_policy,
+            "before_file": str(self.before_path),
+            "after_file": str(self.after_path),
+        }
 
 
-def roughness_statistics(roughness: np.ndarray, pixel_m: float) -> RoughnessStatistics:
-    """Statistics of a roughness map by finite differences at its own pixel (the value of h'
-    and h'' depends on the pixel: report it with them)."""
-    gy, gx = np.gradient(roughness, pixel_m)
-    laplacian = (
-        roughness[2:, 1:-1]
-        + roughness[:-2, 1:-1]
-        + roughness[1:-1, 2:]
-        + roughness[1:-1, :-2]
-        - 4 * roughness[1:-1, 1:-1]
-    ) / pixel_m**2
-    return RoughnessStatistics(
-        h_rms_m=float(np.std(roughness)),
-        slope_rms=float(np.sqrt(np.mean(gx**2 + gy**2))),
-        curvature_rms_per_m=float(np.sqrt(np.mean((0.5 * laplacian) ** 2))),
+def unchanged_level(change_m: np.ndarray, bin_m: float = 0.25e-9) -> float:
+    """The height change (m) of the points that did not flow: the mode of after − before.
+
+    Two AFM scans share no absolute height, and flattened points are not a minority near a
+    large contact, so neither 0 nor the median is the reference; the points that never
+    touched (most of a rough sphere, even inside the contact) form a peak as narrow as the
+    scan noise.
+    """
+    low, high = np.percentile(change_m, [0.5, 99.5])
+    if high - low < bin_m:
+        return float(np.median(change_m))  # nothing flowed: one narrow population
+    bins = int(np.ceil((high - low) / bin_m))
+    counts, edges = np.histogram(change_m, bins=bins, range=(low, high))
+    peak = int(np.argmax(counts))
+    # the peak bin locates the population; its median places it to better than a bin
+    inside = change_m[(change_m >= edges[peak] - bin_m) & (change_m <= edges[peak + 1] + bin_m)]
+    return float(np.median(inside))
+
+
+def measure_topography(
+    before_path: str | Path,
+    after_path: str | Path,
+    fallback_pixel_m: float | None,
+    *,
+    nan_policy: str,
+) -> Topography:
+    """Level both scans (sphere fit, scan-line offsets) and take their roughness statistics and
+    their difference, the plastic flattening (appendix Fig. B.9). Both scans must cover the
+    same field on the same grid (a repeated scan of the same area)."""
+    maps = []
+    for path in (before_path, after_path):
+        try:
+            maps.append(
+                read_height_map(path, fallback_pixel_m=fallback_pixel_m, nan_policy=nan_policy)
+            )
+        except TopographyError as error:
+            raise RawDataError(str(error)) from error
+    before, after = maps
+    if before.heights.shape != after.heights.shape or not np.isclose(
+        before.pixel_m, after.pixel_m, rtol=1e-6
+    ):
+        raise RawDataError(
+            f"{after.path}: {after.heights.shape} px of {after.pixel_m * 1e9:.4g} nm; expected "
+            f"the field of {before.path} ({before.heights.shape} px of "
+            f"{before.pixel_m * 1e9:.4g} nm)"
+        )
+    fits = [level_sphere(m.heights, m.pixel_m) for m in maps]
+    # No row alignment of the difference: near a large contact most of a row may have flowed,
+    # so row statistics would eat the flattening; the scan-line offsets (a few nm on a few
+    # rows) stay in it, which the report's tolerance allows for.
+    change = after.heights - before.heights
+    return Topography(
+        before=fits[0],
+        after=fits[1],
+        before_statistics=roughness_statistics(fits[0].roughness, before.pixel_m),
+        after_statistics=roughness_statistics(fits[1].roughness, after.pixel_m),
+        change_m=change - unchanged_level(change),
+        pixel_m=before.pixel_m,
+        filled_pixels=before.filled + after.filled,
+        nan_policy=nan_policy,
+        before_path=Path(before_path),
+        after_path=Path(after_path),
     )

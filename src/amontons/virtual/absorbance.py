@@ -7,13 +7,9 @@ a CSV with columns wavelength_nm, absorbance (decadic, dimensionless).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
-import pandas as pd
 
-from amontons.images import atomic_path
-from amontons.virtual.fluorescence import FWHM_PER_SIGMA
+from amontons.physics.gaussian import FWHM_PER_SIGMA
 
 
 def absorbance_spectrum(
@@ -36,10 +32,3 @@ def absorbance_spectrum(
     sigma_nm = width_nm / FWHM_PER_SIGMA
     band = peak_absorbance * np.exp(-0.5 * ((wavelengths_nm - peak_nm) / sigma_nm) ** 2)
     return band + rng.normal(0.0, noise_sd, size=wavelengths_nm.shape)
-
-
-def write_absorbance_csv(path: str | Path, wavelengths_nm: np.ndarray, absorbance: np.ndarray):
-    """Write the spectrum as CSV (wavelength_nm, absorbance), atomically."""
-    table = pd.DataFrame({"wavelength_nm": wavelengths_nm, "absorbance": absorbance})
-    with atomic_path(path) as tmp:
-        table.to_csv(tmp, index=False, float_format="%.7g")

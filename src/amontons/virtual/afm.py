@@ -13,8 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from amontons.images import write_image
-
 
 @dataclass(frozen=True)
 class AfmSettings:
@@ -34,11 +32,3 @@ def scan_artefacts(shape, settings: AfmSettings, rng: np.random.Generator) -> np
     signs = rng.choice([-1.0, 1.0], size=lines.size)
     artefacts[lines] += signs[:, None] * settings.line_offset_m
     return artefacts
-
-
-def write_afm(path, heights_m: np.ndarray, pixel_m: float) -> None:
-    """Write a height map (m) as a float32 TIFF with its pixel size in the resolution tags."""
-    heights = np.asarray(heights_m)
-    if not np.all(np.isfinite(heights)):
-        raise ValueError(f"{path}: refusing to write a height map with NaN or inf")
-    write_image(path, heights.astype(np.float32), pixel_m)

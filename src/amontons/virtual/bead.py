@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import erf
 
-from amontons.virtual.fluorescence import FWHM_PER_SIGMA, UINT16_MAX
+from amontons.physics.gaussian import FWHM_PER_SIGMA
+from amontons.virtual.fluorescence import UINT16_MAX
 
 # Poisson draws reach a few standard deviations above their mean; refuse expected counts this
 # many standard deviations below the 16-bit ceiling, so the written image is never clipped.

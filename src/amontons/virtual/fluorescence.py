@@ -16,15 +16,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.ndimage import gaussian_filter
 
-FWHM_PER_SIGMA = 2 * np.sqrt(2 * np.log(2))  # 2.3548
+from amontons.physics.gaussian import FWHM_PER_SIGMA
+
 UINT16_MAX = np.iinfo(np.uint16).max
-
-
-def confined_emission(pressure_pa: np.ndarray, contact: np.ndarray, floor_pa: float) -> np.ndarray:
-    """Emission (√Pa) of the probe layer: √max(p, ``floor_pa``) where ``contact``, else 0."""
-    if floor_pa < 0:
-        raise ValueError(f"confinement floor {floor_pa:g} Pa is negative; expected >= 0")
-    return np.where(contact, np.sqrt(np.maximum(pressure_pa, floor_pa)), 0.0)
 
 
 def pixel_averaged(field, shape: tuple[int, int], pixel_m: float, supersample: int = 4):

@@ -16,31 +16,9 @@ from collections.abc import Callable
 import numpy as np
 from scipy.ndimage import gaussian_filter
 
-from amontons import hertz
-from amontons.virtual.fluorescence import FWHM_PER_SIGMA, UINT16_MAX
-
-WAVELENGTH_M = 488e-9
-N_FORMAMIDE = 1.447
-
-
-def hertz_gap(r_m: np.ndarray, load_n: float, radius_m: float, e_star_pa: float) -> np.ndarray:
-    """Gap (m) between a Hertz sphere and the flat at distance ``r_m`` from the centre.
-
-    Outside the contact (r > a; the surface displacement outside a Hertz pressure distribution,
-    Johnson 1985 §3.9, with d = a²/R and p0 = 2aE*/πR as in §4.2):
-        g(r) = r²/2R − d + u(r),  u(r) = [(2a² − r²)·asin(a/r) + a·√(r² − a²)] / πR,
-    and with asin = π/2 − acos this simplifies to
-        g(r) = [a·√(r² − a²) − (2a² − r²)·acos(a/r)] / πR,
-    which is 0 at r = a, rises as (r − a)^{3/2} next to the edge, and tends to r²/2R − d far
-    away (u → 4a³/3πRr). Inside the contact the gap is 0.
-    """
-    a = hertz.contact_radius(load_n, radius_m, e_star_pa)
-    r = np.asarray(r_m, dtype=float)
-    outside = np.maximum(r, a)  # keeps acos and the root real; the result is masked below
-    gap = (a * np.sqrt(outside**2 - a**2) - (2 * a**2 - outside**2) * np.arccos(a / outside)) / (
-        np.pi * radius_m
-    )
-    return np.where(r > a, gap, 0.0)
+from amontons.physics.gaussian import FWHM_PER_SIGMA
+from amontons.physics.newton_rings import APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX
+from amontons.virtual.fluorescence import UINT16_MAX
 
 
 def radial_gap_map(
@@ -53,11 +31,6 @@ def radial_gap_map(
     rows, cols = np.indices(shape)
     r_m = np.hypot(rows - centre_px[0], cols - centre_px[1]) * pixel_m
     return gap_of_r(r_m)
-
-
-def ring_gap(order: np.ndarray, wavelength_m: float, n_medium: float) -> np.ndarray:
-    """Gap (m) of the bright ring of order m (eq. B.1): d_m = (m + ½)·λ/2n."""
-    return (np.asarray(order, dtype=float) + 0.5) * wavelength_m / (2 * n_medium)
 
 
 def expected_reflection(
@@ -82,8 +55,8 @@ def expected_reflection(
 def render_reflection(
     gap_m: np.ndarray,
     pixel_m: float,
-    wavelength_m: float = WAVELENGTH_M,
-    n_medium: float = N_FORMAMIDE,
+    wavelength_m: float = APPENDIX_WAVELENGTH_M,
+    n_medium: float = FORMAMIDE_REFRACTIVE_INDEX,
     background: float = 400.0,
     contrast: float = 0.6,
     psf_fwhm_m: float = 450e-9,

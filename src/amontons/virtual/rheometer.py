@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from amontons.friction import RheometerTrace, write_rheometer_csv
+from amontons.io.rheometer import RheometerTrace, write_rheometer_csv
 
 
 def tangential_force(
@@ -82,7 +82,7 @@ def rheometer_trace(
         normal_force_n=load_n + rng.normal(0, normal_noise_n, n),
         torque_n_m=force * rotation_radius_m + rng.normal(0, torque_noise_n_m, n),
         rotation_radius_m=rotation_radius_m,
-        metadata={"load_mN": f"{load_n * 1e3:g}", "source": "virtual experiment"},
+        metadata={"load_mn": f"{load_n * 1e3:g}", "source": "virtual experiment"},
     )
 
 

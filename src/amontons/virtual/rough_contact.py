@@ -1,6 +1,6 @@
 """The virtual experiment's contact: a rough sphere with contact hardening, solved per load.
 
-Forward model (DESIGN.md, "The virtual experiment"): the sphere is a paraboloid of radius R
+Forward model (docs/models.md §3): the sphere is a paraboloid of radius R
 plus self-affine roughness (:mod:`amontons.virtual.roughness`) on the solver grid; it is
 pressed onto the glass (elastic half-space of contact modulus E*) with the contact-hardening
 law p = k·|h_pl| (appendix B.2.3), the loads stepping upward and each step carrying the
@@ -24,12 +24,12 @@ import numpy as np
 import scipy.fft
 from scipy import ndimage
 
-from amontons import hertz
 from amontons.contact import ContactHardening, ContactResult, FreeBoundaryError, solve_load_series
 from amontons.contact.surfaces import sphere as sphere_cap
-from amontons.virtual.fluorescence import confined_emission
+from amontons.physics import hertz
+from amontons.physics.emission import confined_emission
+from amontons.physics.newton_rings import ring_gap
 from amontons.virtual.grid import PixelAverager, resample
-from amontons.virtual.reflection import N_FORMAMIDE, WAVELENGTH_M, ring_gap
 from amontons.virtual.roughness import Roughness, synthesize
 from amontons.virtual.state import ContactState, load_index
 
@@ -78,9 +78,10 @@ class RoughSphereSolution:
         return self.heights.shape[0] * self.spacing_m
 
 
-def ring_reach_gap(rings: int) -> float:
-    """Gap (m) half-way between the last bright ring an image must hold and the next one."""
-    gaps = ring_gap(np.arange(rings + 1), WAVELENGTH_M, N_FORMAMIDE)
+def ring_reach_gap(rings: int, wavelength_m: float, n_medium: float) -> float:
+    """Gap (m) half-way between the last bright ring an image must hold and the next one
+    (light of ``wavelength_m`` in a medium of refractive index ``n_medium``)."""
+    gaps = ring_gap(np.arange(rings + 1), wavelength_m, n_medium)
     return float(0.5 * (gaps[-2] + gaps[-1]))
 
 
@@ -92,12 +93,13 @@ def hertz_reach_radius(gap_m: float, load_n: float, radius_m: float, e_star_pa: 
 
 
 def initial_window_m(
-    loads_n, radius_m, e_star_pa, reflection_load_n, rings, settings: SolverSettings
+    loads_n, radius_m, e_star_pa, reflection_load_n, reach_gap_m, settings: SolverSettings
 ) -> float:
-    """First solver window (m): the larger of the hardened contact diameter and the Newton
-    rings' reach at the reflection load, times ``window_factor``."""
+    """First solver window (m): the larger of the hardened contact diameter and the reach
+    of the Newton rings (the radius where the gap is ``reach_gap_m``) at the reflection
+    load, times ``window_factor``."""
     a_max = hertz.contact_radius(max(loads_n), radius_m, e_star_pa) * HARDENING_RADIUS_GUESS
-    reach = hertz_reach_radius(ring_reach_gap(rings), reflection_load_n, radius_m, e_star_pa)
+    reach = hertz_reach_radius(reach_gap_m, reflection_load_n, radius_m, e_star_pa)
     return settings.window_factor * 2 * max(a_max, reach)
 
 
@@ -164,16 +166,19 @@ def simulate_rough_sphere(
     k_pa_per_m: float,
     loads_n: list[float],
     reflection_load_n: float,
-    rings: int,
+    ring_reach_gap_m: float,
     roughness: Roughness,
     settings: SolverSettings,
     rng_seed,
     threads: int = 1,
 ) -> RoughSphereSolution:
     """Solve the contact-hardening load series of a rough sphere on a window that holds the
-    largest contact and the reflection load's Newton rings (grown and re-solved if not)."""
-    window = initial_window_m(loads_n, radius_m, e_star_pa, reflection_load_n, rings, settings)
-    reach_gap = ring_reach_gap(rings)
+    largest contact and the reflection load's Newton rings, out to the radius where the gap is
+    ``ring_reach_gap_m`` (:func:`ring_reach_gap`), grown and re-solved if not."""
+    window = initial_window_m(
+        loads_n, radius_m, e_star_pa, reflection_load_n, ring_reach_gap_m, settings
+    )
+    reach_gap = ring_reach_gap_m
     law = ContactHardening(k_pa_per_m)
     for attempt in range(1, MAX_WINDOW_ATTEMPTS + 1):
         n, dx = solver_grid(window, settings)

@@ -1,0 +1,145 @@
+"""The raw-data layout a sphere's folder follows, whether real or virtual, and its file names.
+
+<folder>/fluorescence/<load in mN>.tif   one confocal image per load (e.g. 25.tif or 25mN.tif)
+<folder>/rheometer/<load in mN>.csv      one friction test per load (amontons.io.rheometer)
+<folder>/reflection.tif                  Newton rings, same field and pixel grid as the
+                                         fluorescence image at the sheet's reflection_load_mn
+<folder>/bead.tif                        a 100 nm fluorescent bead, imaged like the contacts
+<folder>/absorbance.csv                  wavelength_nm, absorbance of the probe cover slip
+<folder>/flim.tif                        optional: mean photon arrival time map, ns (float)
+<folder>/afm_before.<tif|npy|txt>        AFM height map of the sphere before contact (m)
+<folder>/afm_after.<tif|npy|txt>         the same after the load series (m)
+<folder>/truth.json                      virtual experiment only; the analysis never reads it
+
+Standard library only: the workflow matches a measured sphere's files to its loads here
+when it builds the DAG, so the scripts are handed exact paths and never look into a folder.
+Every lookup raises RawDataError naming the folder and what was expected.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+REFLECTION_NAME = "reflection.tif"
+BEAD_NAME = "bead.tif"
+ABSORBANCE_NAME = "absorbance.csv"
+FLIM_NAME = "flim.tif"
+AFM_BEFORE_NAME = "afm_before.tif"
+AFM_AFTER_NAME = "afm_after.tif"
+FLUORESCENCE_DIR = "fluorescence"
+RHEOMETER_DIR = "rheometer"
+# Height-map formats amontons.io.heightmap reads (TIFF, numpy, Gwyddion text export).
+AFM_SUFFIXES = (".tif", ".tiff", ".npy", ".txt", ".asc")
+# Loads in file names and in the sheet are the same number when they agree to this (mN).
+LOAD_MATCH_MN = 1e-9
+
+
+class RawDataError(ValueError):
+    """A raw-data folder or file does not match what the sample sheet promises."""
+
+
+def fluorescence_name(load_mn: float) -> str:
+    """File name of the fluorescence image at ``load_mn`` (e.g. 25 → '25.tif')."""
+    return f"{load_mn:g}.tif"
+
+
+def rheometer_name(load_mn: float) -> str:
+    """File name of the rheometer record at ``load_mn`` (e.g. 25 → '25.csv')."""
+    return f"{load_mn:g}.csv"
+
+
+def same_load(a_mn: float, b_mn: float) -> bool:
+    """Whether two loads (mN) are the same load."""
+    return abs(a_mn - b_mn) < LOAD_MATCH_MN
+
+
+def load_of(path: Path) -> float | None:
+    """The load in mN a per-load file is named by (``25.tif``, ``25mN.csv``), or None."""
+    stem = path.stem.removesuffix("mN").removesuffix("mn")
+    try:
+        return float(stem)
+    except ValueError:
+        return None
+
+
+def files_by_load(
+    folder: str | Path, loads_mn: Sequence[float], pattern: str, kind: str, example: str
+) -> list[Path]:
+    """Paths of the files matching ``pattern`` in ``folder``, one per load, in the order of
+    ``loads_mn``.
+
+    Files are named by their load in mN (``25.<ext>`` or ``25mN.<ext>``). Raises RawDataError
+    naming the folder when a load has no file, a file's load is not in the list, or a file
+    name is not a load.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise RawDataError(f"{folder}: no {kind} folder (expected one {example} per load)")
+    found = {}
+    for path in sorted(folder.glob(pattern)):
+        load = load_of(path)
+        if load is None:
+            raise RawDataError(f"{path}: file name is not a load in mN (expected e.g. {example})")
+        found[load] = path
+    missing = [load for load in loads_mn if not any(same_load(load, f) for f in found)]
+    extra = [f for f in found if not any(same_load(load, f) for load in loads_mn)]
+    if missing or extra:
+        noun = "images" if kind == "fluorescence" else f"{kind} files"
+        raise RawDataError(
+            f"{folder}: the load list {list(loads_mn)} mN does not match the {noun} "
+            f"(no {'image' if kind == 'fluorescence' else 'file'} for {missing or 'none'}; "
+            f"{noun} not in the list: {extra or 'none'})"
+        )
+    return [next(found[f] for f in found if same_load(load, f)) for load in loads_mn]
+
+
+def fluorescence_images(folder: str | Path, loads_mn: Sequence[float]) -> list[Path]:
+    """Paths of the fluorescence images (``<load>.tif``), in the order of ``loads_mn``."""
+    return files_by_load(folder, loads_mn, "*.tif*", "fluorescence", "25.tif")
+
+
+def rheometer_files(folder: str | Path, loads_mn: Sequence[float]) -> list[Path]:
+    """Paths of the rheometer records (``<load>.csv``), in the order of ``loads_mn``."""
+    return files_by_load(folder, loads_mn, "*.csv", "rheometer", "25.csv")
+
+
+def per_load_files(
+    given: str | Path | Sequence[str | Path], loads_mn: Sequence[float], name_of
+) -> list[Path]:
+    """The per-load files a rule was given, in the order of ``loads_mn``.
+
+    ``given`` is either the files themselves (measured data: the workflow matched them to
+    the loads; one file may be given as a plain path) or the one folder the virtual
+    experiment writes whole, whose files are named by ``name_of(load)``
+    (:func:`fluorescence_name`, :func:`rheometer_name`). No folder is searched: a missing
+    file is an error naming it.
+    """
+    if isinstance(given, str | Path) and Path(given).is_dir():
+        paths = [Path(given) / name_of(load) for load in loads_mn]
+    elif isinstance(given, str | Path):
+        paths = [Path(given)]
+    else:
+        paths = [Path(p) for p in given]
+    if len(paths) != len(loads_mn):
+        raise RawDataError(
+            f"{len(paths)} files {[str(p) for p in paths]} for {len(loads_mn)} loads "
+            f"{list(loads_mn)} mN; expected one file per load"
+        )
+    for path in paths:
+        if not path.is_file():
+            raise RawDataError(f"{path}: no such file (expected one file per load)")
+    return paths
+
+
+def afm_file(folder: str | Path, stem: str) -> Path:
+    """The AFM height map ``stem`` (afm_before / afm_after) in ``folder``, in whichever of the
+    readable formats it is; RawDataError naming the folder if none or several."""
+    folder = Path(folder)
+    found = [folder / f"{stem}{ext}" for ext in AFM_SUFFIXES if (folder / f"{stem}{ext}").is_file()]
+    if len(found) != 1:
+        raise RawDataError(
+            f"{folder}: expected exactly one {stem} height map "
+            f"({', '.join(stem + s for s in AFM_SUFFIXES)}), found {len(found)}"
+        )
+    return found[0]
