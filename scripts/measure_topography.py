@@ -17,6 +17,7 @@ def main(
     figure_paths: list[str],
     afm_pixel_nm: float | None,
     nan_policy: str,
+    channel: str | None,
     data_label: str,
     sphere: str,
 ) -> None:
@@ -25,6 +26,7 @@ def main(
         after_path,
         None if afm_pixel_nm is None else afm_pixel_nm * 1e-9,
         nan_policy=nan_policy,
+        channel=channel,
     )
     log.info(
         "%s: R = %.3f mm, h_rms %.1f nm, h' %.3f, flattening %.1f nm",
@@ -56,6 +58,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         afm_pixel_nm=sm.params.afm_pixel_nm,
         nan_policy=sm.params.nan_policy,
+        channel=sm.params.channel,
         data_label=sm.params.data_label,
         sphere=sm.wildcards.sphere,
     )

@@ -19,18 +19,21 @@ def test_gwyddion_text_export_is_read_with_units(tmp_path):
 def test_non_length_value_units_are_refused(tmp_path):
     path = tmp_path / "phase.txt"
     path.write_text("# Width: 1 µm\n# Value units: deg\n" + "\n".join(["1 2 3 4 5 6 7 8"] * 8))
-    with pytest.raises(TopographyError, match="'deg' are not a length"):
+    with pytest.raises(
+        TopographyError, match=r"phase\.txt: Value units in 'deg', which is not a length"
+    ):
         read_height_map(path)
 
 
 def test_nan_pixels_fail_or_are_filled(tmp_path):
-    heights = np.ones((16, 16))
+    heights = np.full((16, 16), 1e-9)
+    heights[0, 0] = 2e-9
     heights[3, 4] = np.nan
     np.save(tmp_path / "h.npy", heights)
     with pytest.raises(TopographyError, match=r"1 NaN pixels \(first at row, column \(3, 4\)\)"):
         read_height_map(tmp_path / "h.npy", fallback_pixel_m=32e-9)
     filled = read_height_map(tmp_path / "h.npy", fallback_pixel_m=32e-9, nan_policy="fill")
-    assert filled.filled == 1 and np.all(filled.heights == 1.0)
+    assert filled.filled == 1 and filled.heights[3, 4] == 1e-9
 
 
 def test_unknown_format_is_named(tmp_path):

@@ -421,3 +421,37 @@ def test_readme_shows_the_current_rule_graph():
 
     assert named_edges(shown) == named_edges(graph.stdout)
     assert named_edges(shown)
+
+
+def test_own_afm_maps_in_vendor_formats_are_measured(small_run, tmp_path):
+    """A measured sphere whose AFM scans come as an ISO 25178 x3p file (before) and a
+    Gwyddion file (after), written from the virtual PS sphere's float TIFF scans: the topography
+    rule reads them through SurfaceTopography and gives the TIFF scans' numbers (to 1e-9
+    relative: the same float32 heights, the same pixel)."""
+    from SurfaceTopography import Topography
+
+    own = tmp_path / "my_data" / "PS-afm"
+    shutil.copytree(small_run / "resources" / "synthetic" / SMALL / "PS", own)
+    for stem, writer in (("afm_before", "to_x3p"), ("afm_after", "to_gwy")):
+        scan = read_image(own / f"{stem}.tif", allow_nan=True)
+        ny, nx = scan.data.shape
+        topography = Topography(
+            scan.data.astype(float).T, (nx * scan.pixel_m, ny * scan.pixel_m), unit="m"
+        )
+        getattr(topography, writer)(str(own / f"{stem}.{writer[3:]}"))
+        (own / f"{stem}.tif").unlink()
+    shutil.copytree(REPO / "config", tmp_path / "config")
+    sheet = pd.read_csv(tmp_path / "config" / "materials.tsv", sep="\t", dtype=str)
+    row = sheet[sheet["sphere"] == "PS"].assign(sphere="PS-afm", data_source=str(own))
+    row.to_csv(tmp_path / "config" / "own.tsv", sep="\t", index=False)
+    _edit_config(tmp_path, lambda c: c.update(materials=["PS"], materials_sheet="config/own.tsv"))
+    target = "results/small/PS/PS-afm/measure/topography.json"
+    result = snakemake(tmp_path, target, "--cores", "2", "--configfile", "config/test.yaml")
+    assert result.returncode == 0, result.stderr[-3000:]
+    found = json.loads((tmp_path / target).read_text())
+    reference = json.loads(measured(small_run, "PS", "PS", "topography.json").read_text())
+    assert found["channel"] == "Default" and reference["channel"] is None
+    for scan in ("before", "after"):
+        for key, value in reference[scan].items():
+            assert found[scan][key] == pytest.approx(value, rel=1e-9), (scan, key)
+    assert found["max_flattening_nm"] == pytest.approx(reference["max_flattening_nm"], rel=1e-9)

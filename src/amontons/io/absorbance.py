@@ -28,7 +28,7 @@ def read_absorbance_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     if not path.is_file():
         raise AbsorbanceError(f"{path}: no such absorbance spectrum")
     values = read_numeric_columns(
-        path, COLUMNS, min_rows=10, record="a spectrum", error=AbsorbanceError
+        path, COLUMNS, min_rows=10, record="a spectrum", error_type=AbsorbanceError
     )
     order = np.argsort(values["wavelength_nm"])
     return values["wavelength_nm"][order], values["absorbance"][order]

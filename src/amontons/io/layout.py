@@ -29,8 +29,16 @@ AFM_BEFORE_NAME = "afm_before.tif"
 AFM_AFTER_NAME = "afm_after.tif"
 FLUORESCENCE_DIR = "fluorescence"
 RHEOMETER_DIR = "rheometer"
-# Height-map formats amontons.io.heightmap reads (TIFF, numpy, Gwyddion text export).
-AFM_SUFFIXES = (".tif", ".tiff", ".npy", ".txt", ".asc")
+# Height-map formats amontons.io.heightmap reads: float TIFF, numpy, and the vendor formats
+# SurfaceTopography reads (its readers detect the format from the content).
+AFM_TIFF_SUFFIXES = (".tif", ".tiff")
+AFM_VENDOR_SUFFIXES = (
+    ".spm", ".001", ".002", ".003", ".004", ".005", ".di", ".ibw", ".nid", ".ezd", ".mi",
+    ".top", ".stp", ".tom", ".cur", ".sur", ".mnt", ".x3p", ".sdf", ".dat", ".datx", ".gwy",
+    ".mdt", ".jpk", ".opd", ".opdx", ".vk3", ".vk4", ".vk6", ".vk7", ".plu", ".plux", ".frt",
+    ".lext", ".al3d", ".zon", ".nc", ".txt", ".asc",
+)  # fmt: skip
+AFM_SUFFIXES = (*AFM_TIFF_SUFFIXES, ".npy", *AFM_VENDOR_SUFFIXES)
 # Loads in file names and in the sheet are the same number when they agree to this (mN).
 LOAD_MATCH_MN = 1e-9
 

@@ -55,16 +55,24 @@ def read_rheometer_csv(path: str | Path) -> RheometerTrace:
     path = Path(path)
     if not path.is_file():
         raise RheometerError(f"{path}: no such rheometer file")
-    with path.open(encoding="utf-8") as handle:
-        header = []
-        for line in handle:
-            if not line.startswith("#"):
-                break
-            header.append(line)
+    if path.stat().st_size == 0:
+        raise RheometerError(f"{path}: empty file; expected a rheometer CSV ({', '.join(COLUMNS)})")
+    header = []
+    try:
+        with path.open(encoding="utf-8") as handle:
+            for line in handle:
+                if not line.startswith("#"):
+                    break
+                header.append(line)
+    except UnicodeDecodeError as error:
+        raise RheometerError(
+            f"{path}: not UTF-8 text ({error.reason} at byte {error.start}); expected a "
+            "rheometer CSV saved as UTF-8"
+        ) from error
     metadata = _metadata(header)
     radius_m = _radius_from_metadata(path, metadata)
     columns = read_numeric_columns(
-        path, COLUMNS, min_rows=10, record="a friction trace", error=RheometerError
+        path, COLUMNS, min_rows=10, record="a friction trace", error_type=RheometerError
     )
     return RheometerTrace(
         time_s=columns["time_s"],

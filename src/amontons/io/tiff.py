@@ -19,6 +19,11 @@ from amontons.io.files import atomic_path
 log = logging.getLogger(__name__)
 
 _METRES_PER_UNIT = {2: 0.0254, 3: 0.01}  # TIFF ResolutionUnit: 2 = inch, 3 = centimetre
+_INCH = 2
+# Image software writes 72, 96, 150, 300 or 600 dots per inch whatever the image shows: an
+# inch resolution this coarse (a pixel of 21 µm or more) is a display default, never the pixel
+# of a microscope or an AFM (their pixels are nm to a few µm), so it is not a pixel size.
+_DISPLAY_DPI_MAX = 1200.0
 
 
 class ImageError(ValueError):
@@ -34,17 +39,59 @@ class Image:
     path: Path
 
 
-def _pixel_from_tags(page: tifffile.TiffPage) -> float | None:
-    tags = page.tags
-    if "XResolution" not in tags or "ResolutionUnit" not in tags:
+@dataclass(frozen=True)
+class TiffPixels:
+    """The image of a TIFF (its first series) and the pixel size its resolution tags give
+    (m; None where the tags give none, or only a display default such as 72 dpi)."""
+
+    data: np.ndarray
+    pixel_x_m: float | None
+    pixel_y_m: float | None
+
+
+def _tag_pixel(tags, name: str, unit: int) -> float | None:
+    """Pixel (m) along one axis from a resolution tag, or None."""
+    if name not in tags:
         return None
+    numerator, denominator = tags[name].value
+    if numerator <= 0 or denominator <= 0:
+        return None
+    per_unit = numerator / denominator
+    if unit == _INCH and per_unit <= _DISPLAY_DPI_MAX:
+        log.info("%s of %g dpi is a display default, not a pixel size; ignored", name, per_unit)
+        return None
+    return _METRES_PER_UNIT[unit] / per_unit
+
+
+def _pixels_from_tags(page: tifffile.TiffPage) -> tuple[float | None, float | None]:
+    tags = page.tags
+    if "ResolutionUnit" not in tags:
+        return None, None
     unit = int(tags["ResolutionUnit"].value)
     if unit not in _METRES_PER_UNIT:
-        return None
-    numerator, denominator = tags["XResolution"].value
-    if numerator <= 0:
-        return None
-    return _METRES_PER_UNIT[unit] * denominator / numerator
+        return None, None
+    return _tag_pixel(tags, "XResolution", unit), _tag_pixel(tags, "YResolution", unit)
+
+
+def read_tiff(path: str | Path) -> TiffPixels:
+    """The image of the TIFF ``path`` (its first series), squeezed, with the pixel size of its tags.
+
+    Raises ImageError naming the file when it is missing or tifffile cannot read it (empty,
+    truncated, not a TIFF).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ImageError(f"{path}: no such image")
+    try:
+        with tifffile.TiffFile(path) as tif:
+            data = tif.asarray()
+            pixel_x, pixel_y = _pixels_from_tags(tif.pages[0])
+    except (tifffile.TiffFileError, ValueError, OSError, EOFError, IndexError) as error:
+        raise ImageError(
+            f"{path}: not a readable TIFF ({type(error).__name__}: {error}); expected a "
+            "complete single-page TIFF file"
+        ) from error
+    return TiffPixels(np.squeeze(data), pixel_x, pixel_y)
 
 
 def read_image(
@@ -52,17 +99,15 @@ def read_image(
 ) -> Image:
     """Read a single-channel 2-D TIFF of unsigned integer or float pixels.
 
-    Raises ImageError naming the file when the image is not 2-D, has a signed-integer, boolean
-    or complex dtype, contains NaN or infinite pixels, or has no pixel size from either its tags
-    or ``fallback_pixel_m``. ``allow_nan`` leaves NaN pixels to the caller (height maps).
+    Raises ImageError naming the file when it cannot be read, the image is not 2-D, has a
+    signed-integer, boolean or complex dtype, contains NaN or infinite pixels, or has no pixel
+    size from either its tags or ``fallback_pixel_m``; resolution tags of a display default
+    (inch resolutions of 1200 dpi and below, e.g. 72 dpi) give none. ``allow_nan`` leaves NaN
+    pixels to the caller.
     """
     path = Path(path)
-    if not path.is_file():
-        raise ImageError(f"{path}: no such image")
-    with tifffile.TiffFile(path) as tif:
-        data = tif.asarray()
-        tag_pixel = _pixel_from_tags(tif.pages[0])
-    data = np.squeeze(data)
+    tiff = read_tiff(path)
+    data, tag_pixel = tiff.data, tiff.pixel_x_m
     if data.ndim != 2:
         raise ImageError(
             f"{path}: image has shape {data.shape}; expected one 2-D single-channel frame"

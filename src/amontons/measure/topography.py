@@ -7,13 +7,13 @@ the height maps are read by amontons.io.heightmap.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-from scipy import optimize
+from scipy import ndimage, optimize
 
-from amontons.io.heightmap import TopographyError, read_height_map
+from amontons.io.heightmap import HeightMap, TopographyError, read_height_map
 from amontons.io.layout import RawDataError
 from amontons.physics.roughness import RoughnessStatistics, roughness_statistics
 
@@ -109,6 +109,8 @@ class Topography:
     nan_policy: str
     before_path: Path
     after_path: Path
+    file_pixel_m: tuple[float, float]  # the files' pixel along x and y, before squaring
+    channel: str | None  # the files' height channel read (None: a file of one channel)
 
     @property
     def max_flattening_m(self) -> float:
@@ -131,6 +133,9 @@ class Topography:
             "statistics at the AFM pixel",
             "pixel_nm": self.pixel_m * 1e9,
             "shape_px": list(self.change_m.shape),
+            "file_pixel_nm": {"x": self.file_pixel_m[0] * 1e9, "y": self.file_pixel_m[1] * 1e9},
+            "resampled_to_square_pixels": self.file_pixel_m[0] != self.file_pixel_m[1],
+            "channel": self.channel,
             "before": statistics(self.before, self.before_statistics),
             "after": statistics(self.after, self.after_statistics),
             "max_flattening_nm": self.max_flattening_m * 1e9,
@@ -139,6 +144,22 @@ class Topography:
             "before_file": str(self.before_path),
             "after_file": str(self.after_path),
         }
+
+
+def square_pixels(height_map: HeightMap) -> HeightMap:
+    """The map on square pixels of its finer spacing: the coarser axis is resampled by linear
+    interpolation over the same extent (no new extrema, nothing lost along the finer axis).
+    A map whose pixels are square already is returned as it is."""
+    if height_map.square:
+        return height_map
+    dx, dy = height_map.pixel_m, height_map.pixel_y_m
+    pixel = min(dx, dy)
+    ny, nx = height_map.heights.shape
+    rows = np.arange(int(np.floor((ny - 1) * dy / pixel + 1e-9)) + 1) * pixel / dy
+    cols = np.arange(int(np.floor((nx - 1) * dx / pixel + 1e-9)) + 1) * pixel / dx
+    grid = np.meshgrid(rows, cols, indexing="ij")
+    heights = ndimage.map_coordinates(height_map.heights, grid, order=1, mode="nearest")
+    return replace(height_map, heights=heights, pixel_m=pixel, pixel_y_m=pixel)
 
 
 def unchanged_level(change_m: np.ndarray, bin_m: float = 0.25e-9) -> float:
@@ -166,18 +187,34 @@ def measure_topography(
     fallback_pixel_m: float | None,
     *,
     nan_policy: str,
+    channel: str | None = None,
 ) -> Topography:
     """Level both scans (sphere fit, scan-line offsets) and take their roughness statistics and
     their difference, the plastic flattening (appendix Fig. B.9). Both scans must cover the
-    same field on the same grid (a repeated scan of the same area)."""
-    maps = []
+    same field on the same grid (a repeated scan of the same area). ``channel`` names the
+    height channel of a vendor file (None: the format's default). Scans with non-square pixels
+    are resampled to square ones first (:func:`square_pixels`)."""
+    files = []
     for path in (before_path, after_path):
         try:
-            maps.append(
-                read_height_map(path, fallback_pixel_m=fallback_pixel_m, nan_policy=nan_policy)
+            files.append(
+                read_height_map(
+                    path, fallback_pixel_m=fallback_pixel_m, nan_policy=nan_policy, channel=channel
+                )
             )
         except TopographyError as error:
             raise RawDataError(str(error)) from error
+    same_grid = files[0].heights.shape == files[1].heights.shape and all(
+        np.isclose(getattr(files[0], a), getattr(files[1], a), rtol=1e-6)
+        for a in ("pixel_m", "pixel_y_m")
+    )
+    if not same_grid:
+        raise RawDataError(
+            f"{files[1].path}: {files[1].heights.shape} px of {files[1].pixel_m * 1e9:.4g} nm; "
+            f"expected the field of {files[0].path} ({files[0].heights.shape} px of "
+            f"{files[0].pixel_m * 1e9:.4g} nm)"
+        )
+    maps = [square_pixels(m) for m in files]
     before, after = maps
     if before.heights.shape != after.heights.shape or not np.isclose(
         before.pixel_m, after.pixel_m, rtol=1e-6
@@ -193,6 +230,8 @@ def measure_topography(
     # rows) stay in it, which the report's tolerance allows for.
     change = after.heights - before.heights
     return Topography(
+        file_pixel_m=(files[0].pixel_m, files[0].pixel_y_m),
+        channel=files[0].channel,
         before=fits[0],
         after=fits[1],
         before_statistics=roughness_statistics(fits[0].roughness, before.pixel_m),
