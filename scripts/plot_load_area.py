@@ -19,7 +19,10 @@ def main(
     reference_load_mn: float,
 ) -> None:
     combined = normalised_load_area(
-        spheres, [pd.read_csv(p) for p in table_paths], [read_json(p) for p in fit_paths]
+        spheres,
+        [pd.read_csv(p) for p in table_paths],
+        [read_json(p) for p in fit_paths],
+        reference_load_mn,
     )
     write_table(out_table, combined)
     plot_normalised_load_area(

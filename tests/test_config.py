@@ -132,7 +132,7 @@ def test_sheet_with_non_increasing_loads_names_file_and_sphere(tmp_path, sheet_s
 
 def test_sheet_with_unknown_column_names_it(tmp_path, sheet_schema):
     sheet = tmp_path / "materials.tsv"
-    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "25,50", "200", "synthetic"]])
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "25,50,100", "200", "synthetic"]])
     text = sheet.read_text().replace("data_source\n", "data_source\tcolour\n")
     sheet.write_text(text.replace("synthetic\n", "synthetic\tred\n"))
     with pytest.raises(ConfigError, match="'colour'"):
@@ -141,7 +141,7 @@ def test_sheet_with_unknown_column_names_it(tmp_path, sheet_schema):
 
 def test_sheet_with_duplicate_sphere_ids(tmp_path, sheet_schema):
     sheet = tmp_path / "materials.tsv"
-    row = ["PS", "PS", "0.6", "3.7", "true", "25,50", "200", "synthetic"]
+    row = ["PS", "PS", "0.6", "3.7", "true", "25,50,100", "200", "synthetic"]
     _write_sheet(sheet, [row, copy.copy(row)])
     with pytest.raises(ConfigError, match="unique; repeated: PS"):
         read_sample_sheet(sheet, sheet_schema)
@@ -163,7 +163,9 @@ def test_material_named_like_a_workflow_target_is_refused(tmp_path, sheet_schema
     # `snakemake optics` must stay the optics stage: a material 'optics' would be a second
     # rule of that name.
     sheet = tmp_path / "materials.tsv"
-    _write_sheet(sheet, [["optics", "optics", "0.6", "3.7", "true", "25,50", "200", "synthetic"]])
+    _write_sheet(
+        sheet, [["optics", "optics", "0.6", "3.7", "true", "25,50,100", "200", "synthetic"]]
+    )
     records = read_sample_sheet(sheet, sheet_schema)
     with pytest.raises(ConfigError, match=r"'optics' take the name of a workflow target"):
         check_selected_materials(["optics"], records, "my.yaml")
@@ -179,14 +181,35 @@ def test_reserved_names_are_the_workflow_targets(repo):
 
 def test_reflection_load_must_be_one_of_the_sphere_loads(tmp_path, sheet_schema):
     sheet = tmp_path / "materials.tsv"
-    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "50,100", "200", "synthetic"]])
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "50,100,200", "200", "synthetic"]])
     with pytest.raises(ConfigError, match=r"sphere PS: reflection_load_mn = 25 is not one of"):
         read_sample_sheet(sheet, sheet_schema)
 
 
 def test_sheet_values_take_their_schema_types(tmp_path, sheet_schema):
     sheet = tmp_path / "materials.tsv"
-    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "yes", "25,50", "200", "synthetic"]])
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "yes", "25,50,100", "200", "synthetic"]])
     (record,) = read_sample_sheet(sheet, sheet_schema).values()
     assert record["diameter_mm"] == 0.6 and record["roughened"] is True
-    assert record["loads"] == [25.0, 50.0] and "flim_load_mn" not in record
+    assert record["loads"] == [25.0, 50.0, 100.0] and "flim_load_mn" not in record
+
+
+def test_reference_load_must_be_a_load_of_every_sphere(
+    repo, config_schema, sheet_schema, monkeypatch
+):
+    """A reference load no sphere was measured at stops the run before any job, in mN, naming
+    the key and the sphere (it used to surface only in the last figure, in N)."""
+    monkeypatch.chdir(repo)
+    config = _config(repo, "test.yaml")
+    config["load_area"]["reference_load_mn"] = 10.0
+    with pytest.raises(
+        ConfigError, match=r"load_area\.reference_load_mn = 10 mN is not one of sphere PS's loads"
+    ):
+        load_workflow_config(config, config_schema, sheet_schema, "my.yaml")
+
+
+def test_a_sphere_needs_three_loads_for_its_power_laws(tmp_path, sheet_schema):
+    sheet = tmp_path / "materials.tsv"
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "25,50", "200", "synthetic"]])
+    with pytest.raises(ConfigError, match=r"sphere PS: loads_mn = '25,50' holds 2 load\(s\)"):
+        read_sample_sheet(sheet, sheet_schema)

@@ -92,6 +92,8 @@ def parse_loads_mn(text: str, where: str) -> list[float]:
     return loads
 
 
+# A power-law fit with standard errors (load-area, intensity-pressure) needs this many loads.
+MIN_LOADS = 3
 _BOOLEAN_WORDS = {"true": True, "false": False, "yes": True, "no": False, "1": True, "0": False}
 # Names of the workflow's wildcard-free target rules: a material of the same name would make a
 # second rule of that name (each material gets its own target, `snakemake PS`).
@@ -151,6 +153,29 @@ def check_sheet_loads(sphere: str, record: Mapping, where: str) -> None:
             )
 
 
+def check_enough_loads(sphere: str, record: Mapping, where: str) -> None:
+    """A sphere needs at least MIN_LOADS loads: its load-area and intensity-pressure power
+    laws are fitted with standard errors."""
+    if len(record["loads"]) < MIN_LOADS:
+        raise ConfigError(
+            f"{where}, sphere {sphere}: loads_mn = {record['loads_mn']!r} holds "
+            f"{len(record['loads'])} load(s); expected at least {MIN_LOADS}, since the "
+            "load-area and intensity-pressure power laws are fitted with standard errors"
+        )
+
+
+def check_reference_load(reference_mn: float, spheres: Mapping[str, dict], source: str) -> None:
+    """The load at which areas and friction are normalised must be one of every selected
+    sphere's loads (the figures divide by the area and friction measured there)."""
+    for sphere, record in spheres.items():
+        if not any(abs(reference_mn - load) < 1e-9 for load in record["loads"]):
+            raise ConfigError(
+                f"{source}: load_area.reference_load_mn = {reference_mn:g} mN is not one of "
+                f"sphere {sphere}'s loads_mn {record['loads']} mN; expected a load that every "
+                "selected sphere was measured at"
+            )
+
+
 def read_sample_sheet(path: str | Path, schema: Mapping) -> dict[str, dict]:
     """Read and validate the sample sheet (TSV, one row per sphere): sphere id → its record,
     in the sheet's order, each value of its schema type.
@@ -169,6 +194,7 @@ def read_sample_sheet(path: str | Path, schema: Mapping) -> dict[str, dict]:
         validate(record, schema, f"{path}, line {line} (sphere {record.get('sphere')!r})")
         record["loads"] = parse_loads_mn(record["loads_mn"], f"{path}, sphere {record['sphere']}")
         check_sheet_loads(record["sphere"], record, str(path))
+        check_enough_loads(record["sphere"], record, str(path))
         if record["sphere"] in sheet:
             repeated.append(record["sphere"])
         sheet[record["sphere"]] = record
@@ -207,7 +233,9 @@ def load_workflow_config(
     validate(config, config_schema, source)
     sheet = read_sample_sheet(config["materials_sheet"], sheet_schema)
     check_selected_materials(config["materials"], sheet, source)
-    return {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
+    selected = {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
+    check_reference_load(config["load_area"]["reference_load_mn"], selected, source)
+    return selected
 
 
 def merge_config(base: Mapping, overlay: Mapping) -> dict:

@@ -21,15 +21,16 @@ def plot_normalised_load_area(
 ) -> None:
     """Log–log A/A_ref versus F/F_ref per sphere, with the fitted power law and guides for
     Amontons (slope 1) and Hertz (slope 2/3). ``table`` has columns sphere, load_mn,
-    area_norm, fit_exponent."""
+    area_norm (area over the area measured at the reference load), fit_exponent and fit_norm
+    (the fit's area at the reference load on that scale)."""
     fig, ax = plt.subplots(figsize=(4.5, 4.0), constrained_layout=True)
     ratio = table["load_mn"] / reference_load_mn
     span = np.geomspace(ratio.min(), ratio.max(), 50)
     for sphere, rows in table.groupby("sphere", sort=False):
         x = rows["load_mn"] / reference_load_mn
-        exponent = rows["fit_exponent"].iloc[0]
+        exponent, scale = rows["fit_exponent"].iloc[0], rows["fit_norm"].iloc[0]
         (line,) = ax.plot(x, rows["area_norm"], "o", label=f"{sphere}: α = {exponent:.3f}")
-        ax.plot(span, span**exponent, "-", color=line.get_color(), lw=1)
+        ax.plot(span, scale * span**exponent, "-", color=line.get_color(), lw=1)
     ax.plot(span, span, "k--", lw=0.8, label="Amontons (A ∝ F)")
     ax.plot(span, span ** (2 / 3), "k:", lw=0.8, label="Hertz (A ∝ F^2/3)")
     ax.set_xscale("log")

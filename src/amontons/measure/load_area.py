@@ -39,21 +39,40 @@ def fit_load_area(table: pd.DataFrame, reference_load_mn: float, confidence: flo
     }
 
 
+def reference_area_um2(table: pd.DataFrame, reference_load_mn: float, sphere: str) -> float:
+    """The area measured at the reference load (µm²), from a contact_area table; ValueError
+    naming the sphere when that load was not measured or its image shows no contact."""
+    rows = table[(table["load_mn"] - reference_load_mn).abs() < 1e-9]
+    if rows.empty or not bool(rows["contact_found"].iloc[0]):
+        why = "was not measured" if rows.empty else f"shows no contact ({rows['flag'].iloc[0]})"
+        raise ValueError(
+            f"sphere {sphere}: the reference load {reference_load_mn:g} mN "
+            f"(load_area.reference_load_mn) {why}; expected a measured contact to normalise by"
+        )
+    return float(rows["area_um2"].iloc[0])
+
+
 def normalised_load_area(
-    spheres: Sequence[str], tables: Sequence[pd.DataFrame], fits: Sequence[dict]
+    spheres: Sequence[str],
+    tables: Sequence[pd.DataFrame],
+    fits: Sequence[dict],
+    reference_load_mn: float,
 ) -> pd.DataFrame:
-    """Every sphere's areas next to the area its fit gives at the reference load (the
-    normalisation is defined for any load series, whether or not it holds that load)."""
+    """Every sphere's areas divided by the area measured at the reference load, as the
+    Amontons-deviation table normalises them (appendix Fig. B.13), with the fitted power law
+    on the same scale (``fit_norm``: the fit's area at the reference over the measured one)."""
     frames = []
     for sphere, table, fit in zip(spheres, tables, fits, strict=True):
+        reference = reference_area_um2(table, reference_load_mn, sphere)
         frames.append(
             pd.DataFrame(
                 {
                     "sphere": sphere,
                     "load_mn": table["load_mn"],
                     "area_um2": table["area_um2"],
-                    "area_norm": table["area_um2"] / fit["prefactor"]["estimate"],
+                    "area_norm": table["area_um2"] / reference,
                     "fit_exponent": fit["exponent"]["estimate"],
+                    "fit_norm": fit["prefactor"]["estimate"] / reference,
                     "contact_found": table["contact_found"],
                 }
             )
