@@ -17,6 +17,7 @@ include: "workflow/rules/common.smk"
 wildcard_constraints:
     sphere="|".join(map(re.escape, SPHERES)),
     material="|".join(map(re.escape, MATERIALS)),
+    scene=names_pattern(list(SCENES)),
 
 
 include: "workflow/rules/virtual_experiment.smk"
@@ -24,6 +25,7 @@ include: "workflow/rules/optics.smk"
 include: "workflow/rules/load_area.smk"
 include: "workflow/rules/friction.smk"
 include: "workflow/rules/surface.smk"
+include: "workflow/rules/simulate.smk"
 
 
 # Default target: every output of every selected material.

@@ -69,10 +69,23 @@ def test_the_import_graph_is_read():
     [
         ("amontons.measure", "amontons.virtual"),
         ("amontons.virtual", "amontons.measure"),
+        ("amontons.simulate", "amontons.virtual"),
+        ("amontons.measure", "amontons.simulate"),
     ],
 )
 def test_the_analysis_and_the_generator_never_import_each_other(source, target):
     assert _edges(source, target) == []
+
+
+def test_the_generator_takes_from_simulate_only_what_knows_nothing_of_the_analysis():
+    """The virtual experiment shares the simulation's grid tools (docs/simulate.md), but
+    simulate imports the analysis (Otsu, levelling): the virtual experiment may import only
+    simulate modules that import no measurement."""
+    used = {name for _, name in _edges("amontons.virtual", "amontons.simulate")}
+    assert used, "the virtual experiment no longer uses simulate; drop this test"
+    for module in used:
+        module = module if module in IMPORTS else module.rsplit(".", 1)[0]
+        assert not [n for n in IMPORTS[module] if n.startswith("amontons.measure")], module
 
 
 @pytest.mark.parametrize("source", ["amontons.io", "amontons.physics"])

@@ -150,7 +150,13 @@ def test_sheet_with_duplicate_sphere_ids(tmp_path, sheet_schema):
 def test_every_schema_key_is_described_and_closed(config_schema, sheet_schema):
     def walk(node, where):
         if node.get("type") == "object":
-            assert node.get("additionalProperties") is False, f"{where} is open"
+            extra = node.get("additionalProperties")
+            # a mapping of named entries (scenes) is closed by the schema of each entry
+            if isinstance(extra, dict):
+                assert extra.get("description"), f"{where}.* has no description"
+                walk(extra, f"{where}.*")
+                return
+            assert extra is False, f"{where} is open"
             for key, child in node.get("properties", {}).items():
                 assert child.get("description"), f"{where}.{key} has no description"
                 walk(child, f"{where}.{key}")
@@ -213,3 +219,89 @@ def test_a_sphere_needs_three_loads_for_its_power_laws(tmp_path, sheet_schema):
     _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "25,50", "200", "synthetic"]])
     with pytest.raises(ConfigError, match=r"sphere PS: loads_mn = '25,50' holds 2 load\(s\)"):
         read_sample_sheet(sheet, sheet_schema)
+
+
+def _scene_config(repo, edit):
+    config = _config(repo, "test.yaml")
+    edit(config["scenes"])
+    return config
+
+
+@pytest.mark.parametrize(
+    ("edit", "expected"),
+    [
+        (
+            lambda s: s["elastic"].update(model="plastic"),
+            r"scenes\.elastic\.model = 'plastic' is not allowed",
+        ),
+        (
+            lambda s: s["penetration_hardness"].update(p_y_mpa=0.0),
+            r"scenes\.penetration_hardness\.p_y_mpa = 0\.0",
+        ),
+        (
+            lambda s: s["penetration_hardness"].update(p_y_mpa=-5.0),
+            r"scenes\.penetration_hardness\.p_y_mpa = -5\.0",
+        ),
+        (
+            lambda s: s["elastic"].update(
+                surface="synthetic",
+                loads=[1.0, 2.0, 4.0],
+                synthetic={"hurst": 0.8, "rms_slope": 0.1, "seed": 1, "e_star_gpa": 3.0},
+                geometry="flat_periodic",
+                side_px=128,
+            ),
+            r"scene elastic: optics = 'microscope' on a synthetic surface",
+        ),
+        (
+            lambda s: s["hardening"].update(window_factor=0.8),
+            r"scene hardening: the solver window \(window_factor\) is .* µm, smaller than sphere "
+            r"PS's Hertz contact diameter",
+        ),
+        (
+            lambda s: s["elastic"].update(side_px=64),
+            r"scene elastic: the solver window \(side_px\) is 16\.4 µm, smaller",
+        ),
+        (
+            lambda s: s["greenwood_tripp"].update(optics="microscope"),
+            r"scene greenwood_tripp: optics = 'microscope' with model greenwood_tripp",
+        ),
+        (
+            lambda s: s["hardening"].update(increment="volume_conserving"),
+            r"scene hardening: increment = 'volume_conserving' with alpha = 1",
+        ),
+    ],
+)
+def test_bad_scenes_stop_before_any_job_naming_scene_and_key(
+    repo, config_schema, sheet_schema, monkeypatch, edit, expected
+):
+    monkeypatch.chdir(repo)
+    config = _scene_config(repo, edit)
+    with pytest.raises(ConfigError, match=expected):
+        load_workflow_config(config, config_schema, sheet_schema, "my.yaml")
+
+
+def test_a_scene_without_its_model_parameter_anywhere_names_the_sphere(
+    repo, config_schema, sheet_schema, monkeypatch, tmp_path
+):
+    monkeypatch.chdir(repo)
+    sheet = (repo / "config" / "materials.tsv").read_text().splitlines()
+    column = sheet[0].split("\t").index("hardness_mpa")
+    rows = [line.split("\t") for line in sheet]
+    for row in rows[1:]:
+        row[column] = ""
+    path = tmp_path / "materials.tsv"
+    path.write_text("\n".join("\t".join(row) for row in rows) + "\n")
+    config = _config(repo, "test.yaml")
+    config["materials_sheet"] = str(path)
+    with pytest.raises(
+        ConfigError, match=r"scene penetration_hardness: p_y_mpa is null, and sphere PS has no"
+    ):
+        load_workflow_config(config, config_schema, sheet_schema, "my.yaml")
+
+
+def test_run_scenes_must_name_defined_scenes(repo, config_schema, sheet_schema, monkeypatch):
+    monkeypatch.chdir(repo)
+    config = _config(repo, "test.yaml")
+    config["run_scenes"] = ["elastic", "plastic"]
+    with pytest.raises(ConfigError, match=r"run_scenes names 'plastic', not in scenes"):
+        load_workflow_config(config, config_schema, sheet_schema, "my.yaml")

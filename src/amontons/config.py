@@ -37,8 +37,11 @@ def _schema_at(schema: Mapping, error: jsonschema.ValidationError) -> Mapping:
     for part in error.absolute_path:
         if isinstance(part, int):
             node = node.get("items", {})
+        elif part in node.get("properties", {}):
+            node = node["properties"][part]
         else:
-            node = node.get("properties", {}).get(part, {})
+            extra = node.get("additionalProperties")
+            node = extra if isinstance(extra, Mapping) else {}
     return node
 
 
@@ -98,7 +101,8 @@ _BOOLEAN_WORDS = {"true": True, "false": False, "yes": True, "no": False, "1": T
 # Names of the workflow's wildcard-free target rules: a material of the same name would make a
 # second rule of that name (each material gets its own target, `snakemake PS`).
 RESERVED_NAMES = frozenset(
-    {"all", "optics", "surface", "friction", "fits", "figures", "virtual_experiment"}
+    {"all", "optics", "surface", "friction", "fits", "figures", "virtual_experiment", "scenes"}
+    | {"synthetic"}  # the folder of the synthetic scenes, results/<run>/synthetic/
 )
 
 
@@ -235,7 +239,113 @@ def load_workflow_config(
     check_selected_materials(config["materials"], sheet, source)
     selected = {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
     check_reference_load(config["load_area"]["reference_load_mn"], selected, source)
+    check_scenes(config, selected, source)
     return selected
+
+
+def hertz_diameter_um(load_mn: float, diameter_mm: float, e_star_gpa: float) -> float:
+    """Hertz contact diameter (µm) of a sphere at ``load_mn``: 2·(3FR/4E*)^(1/3)."""
+    radius_m = diameter_mm * 0.5e-3
+    return 2e6 * (3 * load_mn * 1e-3 * radius_m / (4 * e_star_gpa * 1e9)) ** (1 / 3)
+
+
+def _scene_window_um(scene: Mapping, diameter_mm: float, e_star_gpa: float, loads) -> float:
+    if scene["side_px"] is not None:
+        return scene["side_px"] * scene["pixel_nm"] * 1e-3
+    return scene["window_factor"] * hertz_diameter_um(max(loads), diameter_mm, e_star_gpa)
+
+
+def _check_scene_window(name: str, scene: Mapping, spheres: Mapping[str, dict], source: str):
+    """The window must hold the largest contact the sheet predicts: the Hertz contact at the
+    largest load (a rough or hardened contact is larger still; the solver's free-boundary
+    check catches what this cannot)."""
+    for sphere, record in spheres.items():
+        loads = record["loads"] if scene["loads"] == "measured" else scene["loads"]
+        contact = hertz_diameter_um(max(loads), record["diameter_mm"], record["e_star_gpa"])
+        window = _scene_window_um(scene, record["diameter_mm"], record["e_star_gpa"], loads)
+        if window <= contact:
+            key = "side_px" if scene["side_px"] is not None else "window_factor"
+            raise ConfigError(
+                f"{source}: scene {name}: the solver window ({key}) is {window:.1f} µm, smaller "
+                f"than sphere {sphere}'s Hertz contact diameter {contact:.1f} µm at "
+                f"{max(loads):g} mN; expected a window larger than the largest contact"
+            )
+
+
+def _check_scene_parameters(name: str, scene: Mapping, spheres: Mapping[str, dict], source):
+    """Model parameters that are null must come from every sphere's sheet row."""
+    needs = {
+        "penetration_hardness": ("p_y_mpa", "hardness_mpa"),
+        "hardening": ("k_mpa_per_nm", "hardening_k_mpa_per_nm"),
+    }
+    if scene["model"] not in needs or scene["surface"] == "synthetic":
+        return
+    key, column = needs[scene["model"]]
+    if scene[key] is not None:
+        return
+    for sphere, record in spheres.items():
+        if record.get(column) is None:
+            raise ConfigError(
+                f"{source}: scene {name}: {key} is null, and sphere {sphere} has no {column} in "
+                f"the sheet; expected a value in one of them"
+            )
+
+
+def _check_one_scene(name: str, scene: Mapping, spheres: Mapping[str, dict], source: str):
+    where = f"{source}: scene {name}"
+    synthetic = scene["surface"] == "synthetic"
+    if synthetic and scene["optics"] == "microscope":
+        raise ConfigError(
+            f"{where}: optics = 'microscope' on a synthetic surface; expected 'none' (there is "
+            "no measured image of a synthetic surface to render like or compare with)"
+        )
+    if scene["model"] == "greenwood_tripp" and scene["optics"] == "microscope":
+        raise ConfigError(
+            f"{where}: optics = 'microscope' with model greenwood_tripp; expected 'none' "
+            "(Greenwood-Tripp gives a mean area fraction, not a contact map to render)"
+        )
+    if synthetic and "synthetic" not in scene:
+        raise ConfigError(f"{where}: surface = 'synthetic' needs the key synthetic")
+    if synthetic and scene["loads"] == "measured":
+        raise ConfigError(f"{where}: loads = 'measured' needs a sphere; expected a list (mN)")
+    if scene["geometry"] == "flat_periodic" and not synthetic:
+        raise ConfigError(
+            f"{where}: geometry = 'flat_periodic' with surface afm_before; expected a "
+            "synthetic surface (a sphere's map is neither flat nor periodic)"
+        )
+    if scene["geometry"] == "flat_periodic" and scene["side_px"] is None:
+        raise ConfigError(f"{where}: geometry = 'flat_periodic' needs side_px (no Hertz window)")
+    if scene["increment"] == "volume_conserving" and scene["alpha"] >= 1:
+        raise ConfigError(
+            f"{where}: increment = 'volume_conserving' with alpha = {scene['alpha']:g}; "
+            "expected alpha < 1 (eq. B.3 needs over-relaxation)"
+        )
+    if synthetic and scene["geometry"] == "sphere":
+        if "radius_mm" not in scene["synthetic"]:
+            raise ConfigError(f"{where}: geometry 'sphere' needs synthetic.radius_mm")
+        radius = scene["synthetic"]["radius_mm"]
+        record = {"diameter_mm": 2 * radius, "e_star_gpa": scene["synthetic"]["e_star_gpa"]}
+        _check_scene_window(
+            name, scene, {"(synthetic)": {**record, "loads": scene["loads"]}}, source
+        )
+    if synthetic and ("rms_slope" in scene["synthetic"]) == ("rms_height_nm" in scene["synthetic"]):
+        raise ConfigError(f"{where}: synthetic needs exactly one of rms_slope and rms_height_nm")
+    if not synthetic:
+        _check_scene_window(name, scene, spheres, source)
+        _check_scene_parameters(name, scene, spheres, source)
+
+
+def check_scenes(config: Mapping, spheres: Mapping[str, dict], source: str) -> None:
+    """Scenes that cannot run stop the run before any job: each message names the scene and
+    the key (docs/simulate.md)."""
+    unknown = [name for name in config["run_scenes"] if name not in config["scenes"]]
+    if unknown:
+        raise ConfigError(
+            f"{source}: run_scenes names {', '.join(map(repr, unknown))}, not in scenes; "
+            f"expected one of {', '.join(config['scenes'])}"
+        )
+    for name in config["run_scenes"]:
+        _check_one_scene(name, config["scenes"][name], spheres, source)
 
 
 def merge_config(base: Mapping, overlay: Mapping) -> dict:

@@ -71,7 +71,8 @@ def glass(tmp_path_factory, repo):
 
 @pytest.fixture(scope="module")
 def rough(tmp_path_factory, repo):
-    """A rough PS sphere with a 33 µm AFM scan (1024 px), enough sag to fit the sphere."""
+    """A rough PS sphere with a 1024 px AFM scan of two Hertz diameters, enough sag to fit the
+    sphere."""
     folder = tmp_path_factory.mktemp("ps")
     return folder, _generate(folder, repo, sphere="PS", afm_side_px=1024)
 
@@ -168,7 +169,11 @@ def test_afm_scans_read_back_with_their_pixel_curvature_and_roughness(rough):
     folder, truth = rough
     afm = truth["afm"]
     before = read_height_map(folder / "afm_before.tif")
-    assert before.pixel_m == pytest.approx(32e-9, rel=1e-6)
+    # The scan covers afm_field_factor (2) Hertz diameters at the largest load; 1024 px of
+    # 32 nm cannot, so the pixel grows to that field over 1024 px.
+    a_max = hertz.contact_radius(max(truth["loads_mn"]) * 1e-3, 0.3e-3, 3.7e9)
+    assert before.pixel_m == pytest.approx(max(32e-9, 2 * 2 * a_max / 1024), rel=1e-6)
+    assert afm["pixel_nm"] == pytest.approx(before.pixel_m * 1e9, rel=1e-6)
     assert before.heights.shape == (1024, 1024)
     fit = level_sphere(before.heights, before.pixel_m)
     # A 33 µm scan of a 0.3 mm sphere sags by ~450 nm, against 80 nm rms roughness whose long

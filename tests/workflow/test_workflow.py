@@ -455,3 +455,137 @@ def test_own_afm_maps_in_vendor_formats_are_measured(small_run, tmp_path):
         for key, value in reference[scan].items():
             assert found[scan][key] == pytest.approx(value, rel=1e-9), (scan, key)
     assert found["max_flattening_nm"] == pytest.approx(reference["max_flattening_nm"], rel=1e-9)
+
+
+PROBE_SCENE = {
+    "surface": "afm_before",
+    "geometry": "sphere",
+    "model": "elastic",
+    "loads": "measured",
+    "pixel_nm": 256.0,
+    "window_factor": 1.5,
+    "side_px": None,
+    "tol": 1.0e-6,
+    "optics": "none",
+    "rendering": "emission",
+    "confinement_floor_mpa": 0.0,
+    "p_y_mpa": None,
+    "k_mpa_per_nm": None,
+    "increment": "local",
+    "alpha": 1.0,
+}
+
+
+def _scene_jobs(project, target, **changes):
+    """Jobs (rule → count) of a dry run of ``target`` with one scene, 'probe', selected."""
+
+    def edit(config):
+        config["run_scenes"] = ["probe"]
+        config["scenes"] = {"probe": {**PROBE_SCENE, **changes}}
+
+    _edit_config(project, edit)
+    result = snakemake(project, target, "-n", "--configfile", "config/test.yaml")
+    assert result.returncode == 0, result.stderr
+    rules = re.findall(r"^(?:local)?rule (\w+):", result.stdout, re.M)
+    return {rule: rules.count(rule) for rule in rules}, result.stdout
+
+
+def test_an_elastic_scene_without_optics_schedules_no_psf_rendering_or_plastic_job(project):
+    target = "results/small/PS/PS/scenes/probe/scene_fit.json"
+    jobs, _ = _scene_jobs(project, target)
+    assert set(jobs) == {"generate_virtual_experiment_with_flim", "simulate_scene", "fit_scene"}
+
+
+def test_switching_a_scene_to_the_microscope_adds_exactly_its_psf_and_rendering_jobs(project):
+    target = "results/small/PS/PS/scenes/probe/comparison.csv"
+    without, _ = _scene_jobs(project, "results/small/PS/PS/scenes/probe/scene_fit.json")
+    fit_with, _ = _scene_jobs(
+        project, "results/small/PS/PS/scenes/probe/scene_fit.json", optics="microscope"
+    )
+    compare_with, _ = _scene_jobs(project, target, optics="microscope")
+    added = {rule: n for rule, n in (fit_with | compare_with).items() if rule not in without}
+    assert added == {"measure_psf": 1, "render_scene": 1, "compare_scene": 1}
+
+
+def test_a_synthetic_scene_reads_nothing_of_the_experiment(project):
+    synthetic = {
+        "hurst": 0.8,
+        "rms_slope": 0.1,
+        "short_cutoff_um": None,
+        "long_cutoff_um": None,
+        "seed": 3,
+        "e_star_gpa": 3.0,
+    }
+    jobs, stdout = _scene_jobs(
+        project,
+        "results/small/synthetic/scenes/probe/scene_fit.json",
+        surface="synthetic",
+        geometry="flat_periodic",
+        side_px=128,
+        loads=[1.0, 2.0, 4.0],
+        synthetic=synthetic,
+    )
+    assert set(jobs) == {"simulate_synthetic_scene", "fit_synthetic_scene"}
+    assert "resources/" not in stdout
+
+
+def test_material_target_builds_only_its_scenes(project):
+    result = snakemake(project, "PS", "-n", "--configfile", "config/test.yaml")
+    assert result.returncode == 0, result.stderr
+    assert "results/small/PS/PS/scenes/hardening/comparison.csv" in result.stdout
+    assert "results/small/PS/scenes.csv" in result.stdout
+    assert "glass/scenes/" not in result.stdout and "results/small/glass" not in result.stdout
+
+
+def scene_file(project, sphere, scene, name, run=SMALL):
+    return project / "results" / run / sphere / sphere / "scenes" / scene / name
+
+
+@pytest.mark.parametrize("sphere", ["PS", "glass"])
+def test_registration_recovers_the_virtual_afm_frame(small_run, sphere):
+    """The virtual AFM scans are mirrored, rotated by 8° and centred off the apex: the hardening
+    scene's registration finds the mirror, the rotation within 1° and the scan centre in the
+    image within one fluorescence pixel (the issue's targets)."""
+    truth = truth_of(small_run, sphere)
+    frame = truth["afm"]["frame"]
+    found = json.loads(scene_file(small_run, sphere, "hardening", "registration.json").read_text())
+    assert found["mirrored"] is frame["mirrored"]
+    assert found["rotation_deg"] == pytest.approx(frame["rotation_deg"], abs=1.0)
+    error_um = np.subtract(found["afm_scan_centre_in_image_um"], frame["scan_centre_um"])
+    assert np.hypot(*error_um) < truth["pixel_nm"] * 1e-3
+
+
+def test_hardening_scene_at_the_true_k_matches_the_measured_contact(small_run):
+    """The virtual PS sphere was made with contact hardening at the sheet's k; the hardening
+    scene (AFM map before contact, the sheet's k, the measured PSF) rendered and thresholded
+    gives the measured Otsu area within 3 % at every load, and the masks overlap with IoU
+    ≥ 0.8 at the largest load (the issue's targets)."""
+    table = pd.read_csv(scene_file(small_run, "PS", "hardening", "comparison.csv"))
+    assert table["area_ratio"].to_numpy() == pytest.approx(1.0, abs=0.03)
+    assert table["iou"].iloc[-1] >= 0.8
+
+
+def test_elastic_scene_runs_no_plastic_loop_and_undershoots_the_hardened_contact(small_run):
+    """Elastic scenes log zero plastic rounds; on PS, whose virtual contact hardens, the elastic
+    scene's area lies below the measured one at every load (appendix Fig. B.12)."""
+    solve = json.loads(scene_file(small_run, "PS", "elastic", "solve.json").read_text())
+    assert [row["outer_iterations"] for row in solve["loads"]] == [0] * 5
+    assert {row["route"] for row in solve["loads"]} == {"elastic"}
+    table = pd.read_csv(scene_file(small_run, "PS", "elastic", "comparison.csv"))
+    assert (table["area_ratio"] < 0.9).all()
+
+
+def test_scene_table_lists_every_scene_beside_the_measured_exponent(small_run):
+    table = pd.read_csv(small_run / "results" / SMALL / "PS" / "scenes.csv")
+    assert list(table["scene"]) == [
+        "elastic",
+        "penetration_hardness",
+        "hardening",
+        "greenwood_tripp",
+    ]
+    measured_fit = json.loads(measured(small_run, "PS", "PS", "load_area_fit.json").read_text())
+    assert table["measured_exponent"].iloc[0] == measured_fit["exponent"]["estimate"]
+    hardening = table.set_index("scene").loc["hardening"]
+    # the hardening scene's exponent is the measured one's within their intervals
+    assert hardening["exponent_ci_low"] <= hardening["measured_ci_high"]
+    assert hardening["measured_ci_low"] <= hardening["exponent_ci_high"]

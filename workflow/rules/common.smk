@@ -258,5 +258,101 @@ def material_outputs(materials):
         + friction_outputs(materials)
         + fits
         + figure_outputs(materials)
+        + scene_outputs(materials)
     )
     return list(dict.fromkeys(everything))  # once each, in order
+
+
+# Scenes (workflow/rules/simulate.smk): a scene on a sphere's AFM map runs for every sphere of
+# every selected material; a synthetic scene runs once and reads nothing of the experiment.
+SCENES = {name: config["scenes"][name] for name in config["run_scenes"]}
+SCENE = f"results/{RUN}/{{material}}/{{sphere}}/scenes/{{scene}}"
+SCENE_LOGS = f"logs/{RUN}/{{material}}/{{sphere}}/scenes/{{scene}}"
+SYNTHETIC_SCENE = f"results/{RUN}/synthetic/scenes/{{scene}}"
+SYNTHETIC_SCENE_LOGS = f"logs/{RUN}/synthetic/scenes/{{scene}}"
+
+
+def scene_names(surface=None, model=None, optics=None, field=None):
+    """Names of the scenes with the given surface, model and optics; ``field``: True for
+    the scenes whose solver gives fields (every model but Greenwood-Tripp), False for GT.
+    """
+    names = []
+    for name, scene in SCENES.items():
+        if surface is not None and scene["surface"] != surface:
+            continue
+        if optics is not None and scene["optics"] != optics:
+            continue
+        if field is not None and (scene["model"] != "greenwood_tripp") != field:
+            continue
+        names.append(name)
+    return names
+
+
+def names_pattern(names):
+    """Regex matching exactly ``names``; never empty-match."""
+    return "|".join(map(re.escape, names)) or "(?!)"
+
+
+def scene_config(scene):
+    """A scene's config entry, as a rule's params (a changed scene re-runs only its jobs)."""
+    return sorted_keys(SCENES[scene])
+
+
+def scene_sphere_record(sphere):
+    """The sheet values a scene takes from its sphere."""
+    row = sphere_row(sphere)
+    keys = (
+        "diameter_mm",
+        "e_star_gpa",
+        "loads",
+        "hardness_mpa",
+        "hardening_k_mpa_per_nm",
+    )
+    return {key: row.get(key) for key in keys}
+
+
+def afm_reading():
+    """How the AFM maps are read: the surface keys the topography step uses too."""
+    return sorted_keys(
+        {
+            "nan_policy": config["surface"]["afm_nan_policy"],
+            "channel": config["surface"]["afm_channel"],
+        }
+    )
+
+
+def scene_dir(material, sphere, scene):
+    return SCENE.format(material=material, sphere=sphere, scene=scene)
+
+
+def sphere_scene_outputs(material, sphere, scene):
+    """What a scene of one sphere delivers: its fit and, with optics, its comparison."""
+    folder = scene_dir(material, sphere, scene)
+    out = [f"{folder}/scene_fit.json"]
+    if SCENES[scene]["optics"] == "microscope":
+        out += [
+            f"{folder}/comparison.csv",
+            f"{folder}/registration.json",
+            f"{folder}/comparison.png",
+            f"{folder}/comparison.pdf",
+        ]
+    return out
+
+
+def scene_outputs(materials):
+    """Every AFM scene of every sphere of ``materials`` and each material's scene table."""
+    out = []
+    for material in materials:
+        for sphere in spheres_of(material):
+            for scene in scene_names(surface="afm_before"):
+                out += sphere_scene_outputs(material, sphere, scene)
+        if scene_names(surface="afm_before"):
+            out.append(f"{MATERIAL.format(material=material)}/scenes.csv")
+    return out
+
+
+def synthetic_scene_outputs():
+    return [
+        f"{SYNTHETIC_SCENE.format(scene=s)}/scene_fit.json"
+        for s in scene_names(surface="synthetic")
+    ]

@@ -30,6 +30,23 @@ def resample(
     return ndimage.map_coordinates(field, [rr, cc], order=order, mode=mode, cval=0.0)
 
 
+def resample_points(
+    field: np.ndarray,
+    spacing_m: float,
+    rows_m: np.ndarray,
+    cols_m: np.ndarray,
+    order: int,
+    mode: str = "nearest",
+) -> np.ndarray:
+    """``field`` (on a grid of ``spacing_m`` about its centre) at the positions (m) of the
+    arrays ``rows_m`` and ``cols_m`` (broadcast together): a rotated scan's pixels."""
+    n0, n1 = field.shape
+    rows, cols = np.broadcast_arrays(np.asarray(rows_m), np.asarray(cols_m))
+    r = (n0 - 1) / 2 + rows / spacing_m
+    c = (n1 - 1) / 2 + cols / spacing_m
+    return ndimage.map_coordinates(field, [r, c], order=order, mode=mode, cval=0.0)
+
+
 class PixelAverager:
     """Average solver-grid fields over the pixels of an image grid.
 

@@ -105,6 +105,7 @@ def generate_sphere(
     _check_load_listed(sphere, "reflection", reflection_load_n, loads_n)
     _check_load_listed(sphere, "FLIM", flim_load_n, loads_n)
     roughness = Roughness(roughness_rms_m, surface.hurst, surface.rolloff_m, surface.afm.pixel_m)
+    scan_pixel = surface.afm.scan_pixel_m(hertz.contact_radius(max(loads_n), radius_m, e_star_pa))
     solution = simulate_rough_sphere(
         radius_m=radius_m,
         e_star_pa=e_star_pa,
@@ -117,6 +118,8 @@ def generate_sphere(
         roughness=roughness,
         settings=surface.solver,
         rng_seed=[seed, zlib.crc32(sphere.encode()), zlib.crc32(b"roughness")],
+        # the AFM scans sample the solver's surface: its window holds their footprint
+        min_window_m=surface.afm.footprint_m(scan_pixel),
         threads=threads,
     )
     dx = solution.spacing_m
@@ -148,7 +151,13 @@ def generate_sphere(
         seed=seed,
     )
     afm_truth = write_afm_scans(
-        out_dir, solution, radius_m, roughness, surface.afm, instrument_rng(seed, sphere, "afm")
+        out_dir,
+        solution,
+        radius_m,
+        roughness,
+        surface.afm,
+        scan_pixel,
+        instrument_rng(seed, sphere, "afm"),
     )
     areas = np.array([r.area for r in solution.results])
     fit = fit_power_law(np.array(loads_n), areas, x_ref=loads_n[0])

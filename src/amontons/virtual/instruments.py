@@ -20,12 +20,12 @@ from amontons.io.layout import AFM_AFTER_NAME, AFM_BEFORE_NAME
 from amontons.io.tiff import write_image
 from amontons.physics.beer_lambert import EPSILON_M2_PER_MOL, surface_density_per_m2
 from amontons.physics.roughness import roughness_statistics
+from amontons.simulate.grid import resample_points
 from amontons.virtual.absorbance import absorbance_spectrum
-from amontons.virtual.afm import AfmSettings, scan_artefacts
+from amontons.virtual.afm import MAX_APEX_OFFSET, AfmSettings, afm_to_microscope, scan_artefacts
 from amontons.virtual.bead import render_bead
 from amontons.virtual.flim import render_flim
 from amontons.virtual.fluorescence import render_fluorescence
-from amontons.virtual.grid import resample
 from amontons.virtual.reflection import render_reflection
 from amontons.virtual.rheometer import rheometer_trace, write_rheometer_trace
 from amontons.virtual.rough_contact import RoughSphereSolution
@@ -192,11 +192,13 @@ def write_afm_scans(
     radius_m: float,
     roughness: Roughness,
     afm: AfmSettings,
+    scan_pixel_m: float,
     rng: np.random.Generator,
 ) -> dict:
     """Write ``afm_before.tif`` and ``afm_after.tif`` (the sphere near its apex before the
-    load series and after it); return their truth. The scan centre is off the apex by up to
-    a tenth of the window, as a real scan is.
+    load series and after it, ``scan_pixel_m`` pixels); return their truth. The scan is
+    mirrored and rotated against the microscope frame (:func:`afm_to_microscope`), and its
+    centre is off the apex by up to ``MAX_APEX_OFFSET`` of its side, as a real scan is.
 
     After: where the solve made the surface flow (h_pl < 0 on the solver grid, nearest
     pixel), the scan sees the deformed surface h + h_pl of the solver where it lies below the
@@ -204,28 +206,35 @@ def write_afm_scans(
     solver grid does not carry kept below the cut.
     """
     side = afm.side_px
-    offset = rng.uniform(-0.1, 0.1, size=2) * side * afm.pixel_m
-    axis = (np.arange(side) - (side - 1) / 2) * afm.pixel_m
-    rows_m, cols_m = axis + offset[0], axis + offset[1]
+    centre = rng.uniform(-MAX_APEX_OFFSET, MAX_APEX_OFFSET, size=2) * side * scan_pixel_m
+    axis = (np.arange(side) - (side - 1) / 2) * scan_pixel_m
+    rows, cols = afm_to_microscope(axis[:, None], axis[None, :], afm, centre)
     dx = solution.spacing_m
-    fine = synthesize((side, side), afm.pixel_m, roughness, rng, above_m=dx)
-    coarse = resample(solution.roughness, dx, rows_m, cols_m, order=3)
-    cap = -(rows_m[:, None] ** 2 + cols_m[None, :] ** 2) / (2 * radius_m)
+    fine = synthesize((side, side), scan_pixel_m, roughness, rng, above_m=dx)
+    coarse = resample_points(solution.roughness, dx, rows, cols, order=3)
+    cap = -(rows**2 + cols**2) / (2 * radius_m)
     before = cap + coarse + fine
     plastic = solution.results[-1].plastic_displacement
-    deformed = cap + resample(solution.roughness + plastic, dx, rows_m, cols_m, order=3)
-    flowed = resample((plastic < 0).astype(float), dx, rows_m, cols_m, order=0) > 0.5
+    deformed = cap + resample_points(solution.roughness + plastic, dx, rows, cols, order=3)
+    flowed = resample_points((plastic < 0).astype(float), dx, rows, cols, order=0) > 0.5
     after = np.where(flowed, np.minimum(before, deformed), before)
     before_scan = before + scan_artefacts(before.shape, afm, rng)
     after_scan = after + scan_artefacts(before.shape, afm, rng)
-    write_height_map(out_dir / AFM_BEFORE_NAME, before_scan, afm.pixel_m)
-    write_height_map(out_dir / AFM_AFTER_NAME, after_scan, afm.pixel_m)
+    write_height_map(out_dir / AFM_BEFORE_NAME, before_scan, scan_pixel_m)
+    write_height_map(out_dir / AFM_AFTER_NAME, after_scan, scan_pixel_m)
     rough = coarse + fine
-    stats = roughness_statistics(rough - rough.mean(), afm.pixel_m)
+    stats = roughness_statistics(rough - rough.mean(), scan_pixel_m)
     return {
-        "pixel_nm": afm.pixel_m * 1e9,
+        "pixel_nm": scan_pixel_m * 1e9,
         "side_px": side,
-        "apex_offset_um": [float(-o * 1e6) for o in offset],
+        "frame": {
+            "definition": "microscope position (row, col about the apex) = rotate(mirror("
+            "AFM position about the scan centre)) + scan centre; mirror flips the column "
+            "axis, rotation is counter-clockwise as displayed",
+            "mirrored": afm.mirrored,
+            "rotation_deg": afm.rotation_deg,
+            "scan_centre_um": [float(c * 1e6) for c in centre],
+        },
         "noise_nm": afm.noise_m * 1e9,
         "line_offsets": afm.line_offsets,
         "line_offset_nm": afm.line_offset_m * 1e9,

@@ -29,7 +29,7 @@ from amontons.contact.surfaces import sphere as sphere_cap
 from amontons.physics import hertz
 from amontons.physics.emission import confined_emission
 from amontons.physics.newton_rings import ring_gap
-from amontons.virtual.grid import PixelAverager, resample
+from amontons.simulate.grid import PixelAverager, resample
 from amontons.virtual.roughness import Roughness, synthesize
 from amontons.virtual.state import ContactState, load_index
 
@@ -171,12 +171,17 @@ def simulate_rough_sphere(
     settings: SolverSettings,
     rng_seed,
     threads: int = 1,
+    min_window_m: float = 0.0,
 ) -> RoughSphereSolution:
     """Solve the contact-hardening load series of a rough sphere on a window that holds the
     largest contact and the reflection load's Newton rings, out to the radius where the gap is
-    ``ring_reach_gap_m`` (:func:`ring_reach_gap`), grown and re-solved if not."""
-    window = initial_window_m(
-        loads_n, radius_m, e_star_pa, reflection_load_n, ring_reach_gap_m, settings
+    ``ring_reach_gap_m`` (:func:`ring_reach_gap`), grown and re-solved if not; the window is
+    at least ``min_window_m`` wide (the footprint of the AFM scans that sample it)."""
+    window = max(
+        min_window_m,
+        initial_window_m(
+            loads_n, radius_m, e_star_pa, reflection_load_n, ring_reach_gap_m, settings
+        ),
     )
     reach_gap = ring_reach_gap_m
     law = ContactHardening(k_pa_per_m)
@@ -202,7 +207,7 @@ def simulate_rough_sphere(
             continue
         reach = reach_radius_m(results[load_index(loads_n, reflection_load_n)], reach_gap)
         largest = contact_radius_m(results[-1].contact, dx)
-        needed = settings.window_factor * 2 * max(reach, largest)
+        needed = max(min_window_m, settings.window_factor * 2 * max(reach, largest))
         if needed <= n * dx:
             return RoughSphereSolution(heights, rough, dx, results, reach)
         log.info("rings or contact reach %.1f µm beyond the window; growing it", needed * 1e6)

@@ -94,5 +94,8 @@ class SurfaceSettings:
                 noise_m=settings["afm_noise_nm"] * 1e-9,
                 line_offsets=settings["afm_line_offsets"],
                 line_offset_m=settings["afm_line_offset_nm"] * 1e-9,
+                field_factor=settings["afm_field_factor"],
+                rotation_deg=settings["afm_rotation_deg"],
+                mirrored=settings["afm_mirrored"],
             ),
         )

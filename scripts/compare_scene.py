@@ -1,0 +1,119 @@
+"""Rule compare_scene: a scene's rendered contact registered on the sphere's measured
+fluorescence images, and compared load by load (areas, their ratio, IoU, pixel agreement)."""
+
+import logging
+
+import pandas as pd
+
+from amontons.io.fields import read_load_series
+from amontons.io.files import read_json, write_json, write_table
+from amontons.io.layout import RawDataError, fluorescence_name, per_load_files
+from amontons.io.rawdata import read_fluorescence_series
+from amontons.measure.area import OtsuSettings, image_contact_area, otsu_contact_area
+from amontons.plots import plot_scene_comparison
+from amontons.runlog import run_logged
+from amontons.simulate.compare import (
+    afm_scan_centre_in_image_m,
+    compare_loads,
+    register_at_largest_load,
+    warped_mask,
+)
+from amontons.simulate.render import Rendered
+
+log = logging.getLogger(__name__)
+
+
+def main(
+    rendered_path: str,
+    solve_path: str,
+    fluorescence,
+    table_path: str,
+    registration_path: str,
+    figure_paths: list[str],
+    loads_mn: list[float],
+    pixel_nm: float,
+    otsu: dict,
+    data_label: str,
+    label: str,
+) -> None:
+    settings = OtsuSettings.from_config(otsu)
+    fields, _, attrs = read_load_series(rendered_path)
+    pixel_m = attrs["image_pixel_nm"] * 1e-9
+    images = read_fluorescence_series(
+        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
+    )
+    if abs(images[0].pixel_m - pixel_m) > 1e-6 * pixel_m:
+        raise RawDataError(
+            f"{images[0].path}: pixel {images[0].pixel_m * 1e9:.4g} nm, but the scene was "
+            f"rendered at {pixel_m * 1e9:.4g} nm (the sheet's fluorescence_pixel_nm); expected "
+            "one pixel size"
+        )
+    rendered = [
+        Rendered(f["image"], pixel_m, otsu_contact_area(f["image"], pixel_m, settings))
+        for f in fields
+    ]
+    measured = [image_contact_area(image, settings) for image in images]
+    registration = register_at_largest_load(rendered, [image.data for image in images])
+    solve = read_json(solve_path)
+    solver_areas = [row["area_um2"] * 1e-12 for row in solve["loads"]]
+    rows = compare_loads(
+        [f * 1e-3 for f in loads_mn], rendered, measured, solver_areas, registration, pixel_m
+    )
+    for row in rows:
+        log.info(
+            "%g mN: measured %.1f µm², simulated %.1f µm² (ratio %.3f), IoU %.3f",
+            row.load_n * 1e3,
+            row.measured_area_m2 * 1e12,
+            row.simulated_area_m2 * 1e12,
+            row.area_ratio,
+            row.iou,
+        )
+    scan_centre = afm_scan_centre_in_image_m(
+        registration, [c * 1e-6 for c in solve["window_centre_in_scan_um"]], pixel_m
+    )
+    write_json(
+        registration_path,
+        {
+            **registration.to_record(),
+            "registered_at_load_mn": loads_mn[-1],
+            "definition": "measured position = rotate(mirror(simulated position about the "
+            "rendered image's centre)) + measured image centre + shift; mirror flips columns, "
+            "rotation counter-clockwise as displayed",
+            "afm_scan_centre_in_image_um": [c * 1e6 for c in scan_centre],
+            "image_pixel_nm": pixel_m * 1e9,
+        },
+    )
+    write_table(table_path, pd.DataFrame([row.to_record() for row in rows]))
+    plot_scene_comparison(
+        loads_mn,
+        [image.data for image in images],
+        [m.mask for m in measured],
+        [
+            warped_mask(r, registration, m.mask.shape)
+            for r, m in zip(rendered, measured, strict=True)
+        ],
+        [row.iou for row in rows],
+        [row.area_ratio for row in rows],
+        pixel_m * 1e6,
+        f"{label}: simulated against measured contact ({data_label})",
+        figure_paths,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        rendered_path=sm.input.rendered,
+        solve_path=sm.input.solve,
+        fluorescence=sm.input.fluorescence,
+        table_path=sm.output.table,
+        registration_path=sm.output.registration,
+        figure_paths=[sm.output.png, sm.output.pdf],
+        loads_mn=sm.params.loads_mn,
+        pixel_nm=sm.params.pixel_nm,
+        otsu=sm.params.otsu,
+        data_label=sm.params.data_label,
+        label=f"{sm.wildcards.sphere}, scene {sm.wildcards.scene}",
+    )

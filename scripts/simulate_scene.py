@@ -1,0 +1,88 @@
+"""Rule simulate_scene: one scene's load series on its surface, fields to HDF5."""
+
+import logging
+import os
+
+if "snakemake" in globals():
+    # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
+
+from amontons.io.fields import write_load_series
+from amontons.io.files import write_json
+from amontons.io.heightmap import read_height_map
+from amontons.measure.topography import square_pixels
+from amontons.runlog import run_logged
+from amontons.simulate.scene import scene_for_sphere, synthetic_scene
+from amontons.simulate.solve import solve_scene
+from amontons.simulate.surface import afm_indenter, synthetic_indenter
+
+log = logging.getLogger(__name__)
+
+
+def main(
+    afm_before: str | None,
+    fields_path: str,
+    solve_path: str,
+    scene_name: str,
+    scene_config: dict,
+    sphere: str | None,
+    sphere_record: dict | None,
+    afm: dict,
+    threads: int,
+) -> None:
+    if sphere is None:
+        scene = synthetic_scene(scene_name, scene_config)
+        indenter = synthetic_indenter(scene)
+    else:
+        scene = scene_for_sphere(scene_name, scene_config, sphere, sphere_record)
+        height_map = square_pixels(
+            read_height_map(
+                afm_before,
+                fallback_pixel_m=None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
+                nan_policy=afm["nan_policy"],
+                channel=afm["channel"],
+            )
+        )
+        indenter = afm_indenter(height_map.heights, height_map.pixel_m, scene, afm_before)
+    log.info(
+        "%s: %d² solver grid of %.1f nm (window %.1f µm); surface rms %.1f nm, slope %.3f "
+        "at the solver pixel (%.1f nm, slope %.3f at the map's)",
+        scene.name,
+        scene.side_px,
+        scene.pixel_m * 1e9,
+        scene.window_m * 1e6,
+        indenter.solver_statistics["roughness_rms_nm"],
+        indenter.solver_statistics["slope_rms"],
+        indenter.afm_statistics["roughness_rms_nm"],
+        indenter.afm_statistics["slope_rms"],
+    )
+    solution = solve_scene(scene, indenter, threads=threads)
+    settings = {
+        **scene.to_record(),
+        "sphere": sphere,
+        "window_centre_in_scan_um": [c * 1e6 for c in indenter.centre_in_scan_m],
+        "surface_at_map_pixel": indenter.afm_statistics,
+        "surface_at_solver_pixel": indenter.solver_statistics,
+    }
+    write_load_series(fields_path, solution.fields, solution.per_load, settings)
+    write_json(
+        solve_path,
+        {**settings, "wall_time_s": solution.wall_time_s, "loads": solution.per_load},
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        afm_before=sm.input.get("afm_before"),
+        fields_path=sm.output.fields,
+        solve_path=sm.output.solve,
+        scene_name=sm.wildcards.scene,
+        scene_config=sm.params.scene,
+        sphere=sm.params.sphere,
+        sphere_record=sm.params.sphere_record,
+        afm=sm.params.afm,
+        threads=sm.threads,
+    )

@@ -1,0 +1,82 @@
+"""Fields of a simulation in HDF5 (h5py): one group per load, one dataset per field, units and
+settings as attributes (docs/simulate.md, "Outputs")."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from amontons.io.files import atomic_path
+
+# Field name → unit, in the order written.
+FIELD_UNITS = {
+    "pressure": "Pa",
+    "gap": "m",
+    "plastic_displacement": "m",
+    "deformed_heights": "m",
+    "contact": "1",
+    "image": "arbitrary (rendered fluorescence)",
+}
+
+
+def _attribute(value):
+    """HDF5 attributes hold numbers and strings; nested or None values go as JSON text."""
+    if value is None or isinstance(value, Mapping | list | tuple):
+        return json.dumps(value)
+    return value
+
+
+def write_load_series(
+    path: str | Path,
+    fields: Sequence[Mapping[str, np.ndarray]],
+    per_load: Sequence[Mapping],
+    settings: Mapping,
+) -> None:
+    """Write one group ``load_<i>`` per load with the fields of FIELD_UNITS (each with its
+    ``unit`` attribute) and that load's diagnostics as group attributes; ``settings`` (scene
+    and grid) go to the file's attributes. Written atomically: no half-written file."""
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+        for key, value in settings.items():
+            h5.attrs[key] = _attribute(value)
+        for index, (load_fields, info) in enumerate(zip(fields, per_load, strict=True)):
+            group = h5.create_group(f"load_{index}")
+            for key, value in info.items():
+                group.attrs[key] = _attribute(value)
+            for name, unit in FIELD_UNITS.items():
+                if name not in load_fields:
+                    continue
+                data = np.asarray(load_fields[name])
+                data = data.astype(np.uint8) if data.dtype == bool else data
+                dataset = group.create_dataset(name, data=data, compression="gzip")
+                dataset.attrs["unit"] = unit
+
+
+def read_load_series(path: str | Path) -> tuple[list[dict], list[dict], dict]:
+    """(fields per load, diagnostics per load, settings) as written by write_load_series."""
+    with h5py.File(path, "r") as h5:
+        settings = {key: _decoded(value) for key, value in h5.attrs.items()}
+        groups = sorted(h5, key=lambda name: int(name.split("_")[1]))
+        fields, per_load = [], []
+        for name in groups:
+            group = h5[name]
+            per_load.append({key: _decoded(value) for key, value in group.attrs.items()})
+            fields.append(
+                {
+                    key: group[key][()].astype(bool) if key == "contact" else group[key][()]
+                    for key in group
+                }
+            )
+    return fields, per_load, settings
+
+
+def _decoded(value):
+    if isinstance(value, str) and value[:1] in "[{n":
+        try:
+            return json.loads(value)
+        except json.JSONDecodeError:
+            return value
+    return value.item() if isinstance(value, np.generic) else value

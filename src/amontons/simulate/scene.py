@@ -1,0 +1,237 @@
+"""A scene: one simulation the config names (docs/simulate.md), in SI units.
+
+A scene names its surface (a sphere's ``afm_before`` map, or a synthetic self-affine
+surface), its geometry (the sphere, non-periodic; or nominally flat, periodic), its contact
+model and parameters, its loads, its solver grid and tolerance, and its optics. Only what it
+names is computed: :attr:`Scene.plasticity` is None for an elastic scene (no plastic loop),
+:attr:`Scene.periodic` drops the Hockney padding, and ``optics: none`` schedules no
+rendering job (workflow/rules/simulate.smk).
+
+:func:`scene_for_sphere` resolves a scene's config entry against one sphere's sheet record
+(``null`` parameters take the sheet's value: E*, k, p_Y, loads); :func:`synthetic_scene`
+resolves a synthetic scene, which names all of them itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from amontons.contact import ContactHardening, PenetrationHardness
+
+MODELS = ("greenwood_tripp", "elastic", "penetration_hardness", "hardening")
+INCREMENTS = {"local": "local", "volume_conserving": "volume"}
+
+
+class SceneError(ValueError):
+    """A scene that cannot be simulated as configured (names the scene and the key)."""
+
+
+@dataclass(frozen=True)
+class SyntheticSurface:
+    """Self-affine surface (docs/models.md §2.6): Hurst exponent, rms slope or rms height (m),
+    short and long cut-off wavelengths (m), seed, grid side (px)."""
+
+    hurst: float
+    rms_slope: float | None
+    rms_height_m: float | None
+    short_cutoff_m: float | None
+    long_cutoff_m: float | None
+    seed: int
+    side_px: int
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One simulation, SI units: E* (Pa), sphere radius (m; None for a flat surface), loads
+    (N, increasing), solver pixel (m), window side (m), tolerance, model and its law, optics
+    and rendering."""
+
+    name: str
+    surface: str  # 'afm_before' or 'synthetic'
+    geometry: str  # 'sphere' or 'flat_periodic'
+    model: str
+    e_star_pa: float
+    radius_m: float | None
+    loads_n: tuple[float, ...]
+    pixel_m: float
+    window_m: float
+    tol: float
+    optics: str  # 'none' or 'microscope'
+    rendering: str  # 'emission' or 'binary'
+    p_y_pa: float | None = None
+    k_pa_per_m: float | None = None
+    increment: str = "local"
+    alpha: float = 1.0
+    synthetic: SyntheticSurface | None = None
+
+    @property
+    def periodic(self) -> bool:
+        return self.geometry == "flat_periodic"
+
+    @property
+    def side_px(self) -> int:
+        """Solver grid side, px (even)."""
+        n = int(round(self.window_m / self.pixel_m))
+        return n + n % 2
+
+    @property
+    def plasticity(self) -> PenetrationHardness | ContactHardening | None:
+        """The plasticity law, None for an elastic (or Greenwood-Tripp) scene: no plastic loop."""
+        increment = INCREMENTS[self.increment]
+        if self.model == "penetration_hardness":
+            return PenetrationHardness(self.p_y_pa, increment=increment, alpha=self.alpha)
+        if self.model == "hardening":
+            return ContactHardening(self.k_pa_per_m, increment=increment, alpha=self.alpha)
+        return None
+
+    def to_record(self) -> dict:
+        """JSON/HDF5-attribute-ready settings, units in the key names."""
+        record = {
+            "scene": self.name,
+            "surface": self.surface,
+            "geometry": self.geometry,
+            "model": self.model,
+            "e_star_gpa": self.e_star_pa * 1e-9,
+            "radius_mm": None if self.radius_m is None else self.radius_m * 1e3,
+            "loads_mn": [f * 1e3 for f in self.loads_n],
+            "pixel_nm": self.pixel_m * 1e9,
+            "window_um": self.window_m * 1e6,
+            "side_px": self.side_px,
+            "tol": self.tol,
+            "optics": self.optics,
+            "rendering": self.rendering,
+            "p_y_mpa": None if self.p_y_pa is None else self.p_y_pa * 1e-6,
+            "k_mpa_per_nm": None if self.k_pa_per_m is None else self.k_pa_per_m * 1e-15,
+            "increment": self.increment,
+            "alpha": self.alpha,
+        }
+        if self.synthetic is not None:
+            s = self.synthetic
+            record["synthetic"] = {
+                "hurst": s.hurst,
+                "rms_slope": s.rms_slope,
+                "rms_height_nm": None if s.rms_height_m is None else s.rms_height_m * 1e9,
+                "short_cutoff_um": None if s.short_cutoff_m is None else s.short_cutoff_m * 1e6,
+                "long_cutoff_um": None if s.long_cutoff_m is None else s.long_cutoff_m * 1e6,
+                "seed": s.seed,
+                "side_px": s.side_px,
+            }
+        return record
+
+
+def hertz_diameter_m(load_n: float, radius_m: float, e_star_pa: float) -> float:
+    """Hertz contact diameter (m) at ``load_n``: 2·(3FR/4E*)^(1/3)."""
+    return 2 * (3 * load_n * radius_m / (4 * e_star_pa)) ** (1 / 3)
+
+
+def _window_m(name: str, config: Mapping, loads_n, radius_m, e_star_pa) -> float:
+    """Window side (m): ``side_px`` × pixel, or ``window_factor`` × the Hertz contact diameter
+    at the largest load."""
+    pixel_m = config["pixel_nm"] * 1e-9
+    if config.get("side_px") is not None:
+        return config["side_px"] * pixel_m
+    if radius_m is None:
+        raise SceneError(f"scene {name}: a flat surface needs side_px (no Hertz diameter)")
+    return config["window_factor"] * hertz_diameter_m(max(loads_n), radius_m, e_star_pa)
+
+
+def _sheet_or(name: str, config: Mapping, key: str, record: Mapping, column: str, scale: float):
+    """The scene's own value of ``key`` or, where it is null, the sheet's ``column``."""
+    value = config.get(key)
+    if value is None:
+        value = record.get(column)
+    if value is None:
+        raise SceneError(
+            f"scene {name}: {key} is null and sphere {record.get('sphere', '?')} has no "
+            f"{column} in the sheet; expected a value in one of them"
+        )
+    return float(value) * scale
+
+
+def _model_parameters(name: str, config: Mapping, record: Mapping) -> dict:
+    model = config["model"]
+    if model not in MODELS:
+        raise SceneError(f"scene {name}: model = {model!r}; expected one of {MODELS}")
+    out = {"increment": config.get("increment", "local"), "alpha": config.get("alpha", 1.0)}
+    if model == "penetration_hardness":
+        out["p_y_pa"] = _sheet_or(name, config, "p_y_mpa", record, "hardness_mpa", 1e6)
+        if out["p_y_pa"] <= 0:
+            raise SceneError(f"scene {name}: p_y_mpa = {out['p_y_pa'] * 1e-6:g}; expected > 0")
+    if model == "hardening":
+        out["k_pa_per_m"] = _sheet_or(
+            name, config, "k_mpa_per_nm", record, "hardening_k_mpa_per_nm", 1e15
+        )
+    return out
+
+
+def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -> Scene:
+    """The scene ``name`` (its config entry) on the AFM map of ``sphere`` (its sheet record:
+    diameter_mm, e_star_gpa, loads, hardness_mpa, hardening_k_mpa_per_nm)."""
+    if config["surface"] != "afm_before":
+        raise SceneError(f"scene {name}: surface = {config['surface']!r} is not a sphere's map")
+    loads = config["loads"]
+    loads_mn = list(record["loads"]) if loads == "measured" else [float(f) for f in loads]
+    e_star_pa = float(record["e_star_gpa"]) * 1e9
+    radius_m = float(record["diameter_mm"]) * 0.5e-3
+    loads_n = tuple(f * 1e-3 for f in loads_mn)
+    return Scene(
+        name=name,
+        surface="afm_before",
+        geometry=config["geometry"],
+        model=config["model"],
+        e_star_pa=e_star_pa,
+        radius_m=radius_m,
+        loads_n=loads_n,
+        pixel_m=config["pixel_nm"] * 1e-9,
+        window_m=_window_m(name, config, loads_n, radius_m, e_star_pa),
+        tol=config["tol"],
+        optics=config["optics"],
+        rendering=config.get("rendering", "emission"),
+        **_model_parameters(name, config, {**record, "sphere": sphere}),
+    )
+
+
+def synthetic_scene(name: str, config: Mapping) -> Scene:
+    """A scene on a synthetic self-affine surface: it names E*, loads and (for the sphere
+    geometry) the radius itself, and reads nothing of the experiment."""
+    synthetic = config["synthetic"]
+    loads = config["loads"]
+    if loads == "measured":
+        raise SceneError(f"scene {name}: loads = 'measured' needs a sphere; give a list (mN)")
+    loads_n = tuple(float(f) * 1e-3 for f in loads)
+    radius_m = None
+    if config["geometry"] == "sphere":
+        radius_m = synthetic["radius_mm"] * 1e-3
+    e_star_pa = synthetic["e_star_gpa"] * 1e9
+    window_m = _window_m(name, config, loads_n, radius_m, e_star_pa)
+    pixel_m = config["pixel_nm"] * 1e-9
+    surface = SyntheticSurface(
+        hurst=synthetic["hurst"],
+        rms_slope=synthetic.get("rms_slope"),
+        rms_height_m=_scaled(synthetic.get("rms_height_nm"), 1e-9),
+        short_cutoff_m=_scaled(synthetic.get("short_cutoff_um"), 1e-6),
+        long_cutoff_m=_scaled(synthetic.get("long_cutoff_um"), 1e-6),
+        seed=int(synthetic["seed"]),
+        side_px=int(round(window_m / pixel_m)),
+    )
+    return Scene(
+        name=name,
+        surface="synthetic",
+        geometry=config["geometry"],
+        model=config["model"],
+        e_star_pa=e_star_pa,
+        radius_m=radius_m,
+        loads_n=loads_n,
+        pixel_m=pixel_m,
+        window_m=window_m,
+        tol=config["tol"],
+        optics=config["optics"],
+        rendering=config.get("rendering", "emission"),
+        synthetic=surface,
+        **_model_parameters(name, config, {"sphere": "(synthetic)"}),
+    )
+
+
+def _scaled(value, scale):
+    return None if value is None else float(value) * scale

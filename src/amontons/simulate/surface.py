@@ -1,0 +1,135 @@
+"""The rigid indenter of a scene on its solver grid (docs/simulate.md, "Surface to solver grid").
+
+A sphere's levelled ``afm_before`` map (the topography step's sphere fit and scan-line
+alignment) is cut to the scene's window about the fitted apex and brought to the solver pixel
+by area averaging: each solver pixel holds the mean height of the AFM area it covers, with
+AFM pixels cut by its edge counted by their covered fraction. Point sampling would alias the
+roughness finer than the solver pixel into it; averaging keeps the mean height of every
+patch the solver sees and removes what it cannot carry.
+
+Sign convention (appendix B.2.2): the sphere is the rigid indenter, heights larger = closer to
+the glass (an AFM scan of the apex, apex up, as is); the glass roughness is neglected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from amontons.contact.surfaces import self_affine, sphere
+from amontons.measure.topography import level_sphere
+from amontons.physics.roughness import roughness_statistics
+from amontons.simulate.scene import Scene, SceneError
+
+
+@dataclass(frozen=True)
+class Indenter:
+    """Heights (m) of a scene's rigid indenter on its solver grid of ``spacing_m``; the
+    window's centre in the AFM frame (m from the scan centre, (row, col)); the roughness
+    statistics of the map at its own pixel and of the indenter at the solver pixel."""
+
+    heights: np.ndarray
+    spacing_m: float
+    centre_in_scan_m: tuple[float, float]
+    afm_statistics: dict
+    solver_statistics: dict
+
+
+def overlap_weights(n_in: int, pixel_in: float, first_edge: float, n_out: int, pixel_out):
+    """(n_out × n_in) weights averaging an axis of ``n_in`` pixels of ``pixel_in`` (m; pixel
+    i spans [i, i+1)·pixel_in) onto ``n_out`` pixels of ``pixel_out`` starting at
+    ``first_edge`` (m): each row holds the fraction of the output pixel each input covers."""
+    edges_out = first_edge + np.arange(n_out + 1) * pixel_out
+    lo = np.maximum(edges_out[:-1, None], np.arange(n_in)[None, :] * pixel_in)
+    hi = np.minimum(edges_out[1:, None], (np.arange(n_in)[None, :] + 1) * pixel_in)
+    return np.clip(hi - lo, 0.0, None) / pixel_out
+
+
+def area_average(
+    heights: np.ndarray, pixel_in: float, origin_m: tuple[float, float], n_out: int, pixel_out
+) -> np.ndarray:
+    """Mean of ``heights`` over each pixel of an ``n_out``² grid of ``pixel_out`` (m) whose
+    corner lies at ``origin_m`` (row, col; m from the map's corner). The grid must lie inside
+    the map (ValueError otherwise)."""
+    n0, n1 = heights.shape
+    extent = (n0 * pixel_in, n1 * pixel_in)
+    for axis, (start, size) in enumerate(zip(origin_m, extent, strict=True)):
+        end = start + n_out * pixel_out
+        if start < -1e-9 * pixel_in or end > size + 1e-9 * pixel_in:
+            raise ValueError(
+                f"window [{start * 1e6:.2f}, {end * 1e6:.2f}] µm along axis {axis} leaves the "
+                f"map (0 to {size * 1e6:.2f} µm)"
+            )
+    rows = overlap_weights(n0, pixel_in, origin_m[0], n_out, pixel_out)
+    cols = overlap_weights(n1, pixel_in, origin_m[1], n_out, pixel_out)
+    return rows @ heights @ cols.T
+
+
+def _statistics(heights: np.ndarray, pixel_m: float) -> dict:
+    stats = roughness_statistics(heights - heights.mean(), pixel_m)
+    return {
+        "pixel_nm": pixel_m * 1e9,
+        "roughness_rms_nm": stats.h_rms_m * 1e9,
+        "slope_rms": stats.slope_rms,
+    }
+
+
+def afm_indenter(heights: np.ndarray, pixel_m: float, scene: Scene, source: str) -> Indenter:
+    """The scene's indenter from a sphere's AFM map (heights m, square pixels of ``pixel_m``):
+    levelled, cut to the scene's window about the fitted apex and area-averaged to the solver
+    pixel. A window that leaves the scan raises SceneError naming ``source`` and the sizes."""
+    fit = level_sphere(heights, pixel_m)
+    levelled = heights - fit.line_offsets[:, None]
+    n = scene.side_px
+    window = n * scene.pixel_m
+    n0, n1 = heights.shape
+    # apex_xy_m is (x, y) = (col, row) from the map centre
+    apex_rc = (fit.apex_xy_m[1] + n0 * pixel_m / 2, fit.apex_xy_m[0] + n1 * pixel_m / 2)
+    origin = (apex_rc[0] - window / 2, apex_rc[1] - window / 2)
+    try:
+        solver = area_average(levelled, pixel_m, origin, n, scene.pixel_m)
+    except ValueError as error:
+        raise SceneError(
+            f"{source}: scene {scene.name}: the solver window ({window * 1e6:.1f} µm about the "
+            f"fitted apex) does not fit in the AFM scan ({n0} × {n1} px of "
+            f"{pixel_m * 1e9:.1f} nm): {error}; expected a scan that covers the window "
+            "(lower window_factor or side_px, or scan a larger field)"
+        ) from error
+    roughness = solver - sphere(solver.shape, scene.pixel_m, fit.radius_m)
+    centre = (origin[0] + window / 2 - n0 * pixel_m / 2, origin[1] + window / 2 - n1 * pixel_m / 2)
+    return Indenter(
+        heights=solver - solver.max(),
+        spacing_m=scene.pixel_m,
+        centre_in_scan_m=centre,
+        afm_statistics=_statistics(fit.roughness, pixel_m),
+        solver_statistics=_statistics(roughness, scene.pixel_m),
+    )
+
+
+def synthetic_indenter(scene: Scene) -> Indenter:
+    """The scene's indenter from its synthetic self-affine surface (periodic; on a sphere of
+    the scene's radius for the sphere geometry)."""
+    spec = scene.synthetic
+    if spec is None:
+        raise SceneError(f"scene {scene.name}: no synthetic surface given")
+    n = scene.side_px
+    rough = self_affine(
+        (n, n),
+        scene.pixel_m,
+        spec.hurst,
+        rms_slope=spec.rms_slope,
+        rms_height=spec.rms_height_m,
+        short_cutoff=spec.short_cutoff_m,
+        long_cutoff=spec.long_cutoff_m,
+        rng=spec.seed,
+    )
+    heights = rough if scene.periodic else rough + sphere((n, n), scene.pixel_m, scene.radius_m)
+    stats = _statistics(rough, scene.pixel_m)
+    return Indenter(
+        heights=heights - heights.max(),
+        spacing_m=scene.pixel_m,
+        centre_in_scan_m=(0.0, 0.0),
+        afm_statistics=stats,
+        solver_statistics=stats,
+    )

@@ -1,0 +1,63 @@
+"""A scene's load series against analytic and limiting cases: an elastic scene on a smooth
+sphere's AFM map is Hertz; an elastic scene runs no plastic loop; the fields survive HDF5."""
+
+import numpy as np
+import pytest
+
+from amontons.fits import fit_power_law
+from amontons.io.fields import read_load_series, write_load_series
+from amontons.measure.topography import sphere_cap
+from amontons.physics import hertz
+from amontons.simulate.scene import scene_for_sphere
+from amontons.simulate.solve import solve_scene
+from amontons.simulate.surface import afm_indenter
+
+from .test_surface import SCENE
+
+# A smooth sphere unlike the virtual experiment's: R = 1 mm, E* = 2 GPa, 5-80 mN, a 100 nm AFM
+# pixel, solved on 250 nm.
+RECORD = {"diameter_mm": 2.0, "e_star_gpa": 2.0, "loads": [5.0, 10.0, 20.0, 40.0, 80.0]}
+
+
+@pytest.fixture(scope="module")
+def hertz_scene():
+    scene = scene_for_sphere("elastic", SCENE, "smooth", RECORD)
+    heights = sphere_cap((1000, 1000), 100e-9, 1e-3, (0.7e-6, -1.1e-6), 0.0)
+    indenter = afm_indenter(heights, 100e-9, scene, "smooth.tif")
+    return scene, indenter, solve_scene(scene, indenter)
+
+
+def test_elastic_scene_on_a_smooth_sphere_is_hertz(hertz_scene):
+    """Area within 1 % of πa² at every load (the contact radius is ≥ 49 solver pixels, whose
+    discretisation moves the area by < 0.5 %), and the load-area exponent within 0.01 of 2/3."""
+    scene, _, solution = hertz_scene
+    areas = np.array([row["area_um2"] for row in solution.per_load]) * 1e-12
+    loads = np.array(scene.loads_n)
+    expected = np.pi * np.array([hertz.contact_radius(f, 1e-3, 2e9) for f in loads]) ** 2
+    assert areas == pytest.approx(expected, rel=0.01)
+    exponent = fit_power_law(loads, areas, x_ref=loads[0]).exponent.estimate
+    assert exponent == pytest.approx(2 / 3, abs=0.01)
+
+
+def test_elastic_scene_runs_no_plastic_loop(hertz_scene):
+    _, _, solution = hertz_scene
+    assert [row["outer_iterations"] for row in solution.per_load] == [0] * 5
+    assert {row["route"] for row in solution.per_load} == {"elastic"}
+    assert all(np.all(f["plastic_displacement"] == 0) for f in solution.fields)
+
+
+def test_fields_round_trip_through_hdf5_with_units(hertz_scene, tmp_path):
+    scene, _, solution = hertz_scene
+    path = tmp_path / "fields.h5"
+    write_load_series(path, solution.fields, solution.per_load, scene.to_record())
+    fields, per_load, settings = read_load_series(path)
+    assert settings["loads_mn"] == pytest.approx(RECORD["loads"])
+    assert per_load[2]["area_um2"] == solution.per_load[2]["area_um2"]
+    for mine, theirs in zip(solution.fields, fields, strict=True):
+        assert np.array_equal(mine["pressure"], theirs["pressure"])
+        assert np.array_equal(mine["contact"], theirs["contact"])
+    import h5py
+
+    with h5py.File(path) as h5:
+        assert h5["load_0/pressure"].attrs["unit"] == "Pa"
+        assert h5["load_0/gap"].attrs["unit"] == "m"
