@@ -61,3 +61,21 @@ def test_fields_round_trip_through_hdf5_with_units(hertz_scene, tmp_path):
     with h5py.File(path) as h5:
         assert h5["load_0/pressure"].attrs["unit"] == "Pa"
         assert h5["load_0/gap"].attrs["unit"] == "m"
+
+
+def test_a_window_the_contact_reaches_fails_loudly():
+    """A hardening scene on a rough sphere whose window is the Hertz diameter itself: the
+    hardened, rough contact spreads beyond it, so the solver's free-boundary check raises
+    (never a silent result)."""
+    from amontons.contact import FreeBoundaryError
+    from amontons.contact.surfaces import self_affine
+
+    record = {**RECORD, "loads": [20.0, 40.0, 80.0], "hardening_k_mpa_per_nm": 1.0}
+    scene = scene_for_sphere(
+        "tight", {**SCENE, "model": "hardening", "window_factor": 1.0}, "rough", record
+    )
+    cap = sphere_cap((1000, 1000), 100e-9, 1e-3, (0.0, 0.0), 0.0)
+    rough = self_affine((1000, 1000), 100e-9, 0.8, rms_height=40e-9, long_cutoff=10e-6, rng=2)
+    indenter = afm_indenter(cap + rough, 100e-9, scene, "rough.tif")
+    with pytest.raises(FreeBoundaryError, match="contact reaches the window edge"):
+        solve_scene(scene, indenter)

@@ -271,7 +271,32 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
     _edit_config(project, lambda c: c.update(optics={"psf": {"profile_radius_nm": 1800.0}}))
     changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
     stats = changed.stdout.split("Job stats:", 1)[1].split("total", 1)[0]
-    assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {"measure_psf": "2", "all": "1"}
+    # The PSF also renders the three optics scenes of each sphere: they follow it.
+    assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {
+        "measure_psf": "2",
+        "render_scene": "6",
+        "compare_scene": "6",
+        "fit_scene": "6",
+        "tabulate_scenes": "2",
+        "all": "1",
+    }
+
+    # A changed scene re-runs its own jobs only: one scene, two spheres.
+    def retune_hardening(config):
+        config.pop("optics")
+        config["scenes"] = {"hardening": {"tol": 1.0e-7}}
+
+    _edit_config(project, retune_hardening)
+    changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
+    stats = changed.stdout.split("Job stats:", 1)[1].split("total", 1)[0]
+    assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {
+        "simulate_scene": "2",
+        "render_scene": "2",
+        "compare_scene": "2",
+        "fit_scene": "2",
+        "tabulate_scenes": "2",
+        "all": "1",
+    }
 
 
 def test_own_data_is_measured_and_a_replaced_image_reruns_its_jobs(small_run, tmp_path):
