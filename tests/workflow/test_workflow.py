@@ -342,7 +342,7 @@ def check_measurements_against_truth(project, material, sphere):
         # undetermined, and the mean gap at the profiles' own edges within 2 nm of the truth
         # there (the forward model's average gap at each ray's true edge, truth.json's
         # edge_profiles). Measured: 2.74 nm against 1.29 nm here; 1.33 against the full run's
-        # 0.72 nm (before the per-profile edge, against the equal-area edge's truth: 2.47 vs
+        # 1.51 nm (before the per-profile edge, against the equal-area edge's truth: 2.47 vs
         # 0.59 and 1.32 vs 0.72 nm).
         assert gap["flag"] is None or not gap["flag"].startswith("undetermined")
         assert gap["edge_gap_nm"]["mean"] == pytest.approx(
