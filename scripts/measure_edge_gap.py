@@ -45,6 +45,8 @@ def main(
             hertz_radius_m=contact_radius(
                 reflection_load_mn * 1e-3, diameter_mm * 0.5e-3, e_star_gpa * 1e9
             ),
+            mask_closing_m=newton_rings["mask_closing_um"] * 1e-6,
+            margin_m=newton_rings["undetermined_margin_nm"] * 1e-9,
         )
     except NotMeasurable as error:
         # A rough sphere scatters its rings, an image may show no contact: the gap is not
@@ -55,21 +57,32 @@ def main(
         plot_unmeasured(str(error), title, figure_paths)
         return
     rings = result.rings
-    log.info(
-        "%s: edge gap %.2f ± %.2f nm over %d half-profiles",
-        reflection_path,
-        rings.edge_gap_mean_m * 1e9,
-        rings.edge_gap_sd_m * 1e9,
-        rings.edge_gaps_m.size,
-    )
+    if result.undetermined:
+        # Not resolved by its own uncertainty: a flagged null like unreadable rings, but the
+        # record and the figure keep the profiles that led to it.
+        log.warning("edge gap %s", result.undetermined)
+    else:
+        log.info(
+            "%s: edge gap %.2f ± %.2f nm (95 %%) over %d half-profiles",
+            reflection_path,
+            result.interval.mean_m * 1e9,
+            result.interval.half_width_m * 1e9,
+            rings.edge_gaps_m.size,
+        )
     write_json(gap_path, result.to_record())
     plot_edge_gap(
         [p.ring_r_m * 1e6 for p in rings.half_profiles],
         [p.ring_gap_m * 1e9 for p in rings.half_profiles],
-        result.contact_radius_m * 1e6,
+        rings.edge_radii_m * 1e6,
         rings.edge_gaps_m * 1e9,
         title,
         figure_paths,
+        equal_area_radius_um=result.equal_area_radius_m * 1e6,
+        summary=result.undetermined
+        or (
+            f"edge: {result.interval.mean_m * 1e9:.1f} ± "
+            f"{result.interval.half_width_m * 1e9:.1f} nm (95 %)"
+        ),
     )
 
 

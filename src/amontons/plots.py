@@ -109,29 +109,38 @@ def plot_absorbance(
 def plot_edge_gap(
     ring_r_um: list[np.ndarray],
     ring_gap_nm: list[np.ndarray],
-    edge_radius_um: float,
+    edge_radii_um: np.ndarray,
     edge_gaps_nm: np.ndarray,
     title: str,
     paths: list[str],
+    *,
+    equal_area_radius_um: float,
+    summary: str,
 ) -> None:
     """Gap of each Newton ring versus distance from the contact centre, every half-profile,
-    and the extrapolated gaps at the fluorescent edge (appendix Fig. B.7b)."""
-    fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
+    and each profile's extrapolated gap at its own fluorescent edge (green squares, as in
+    appendix Fig. B.7b); the equal-area radius of the contact for comparison. ``summary``:
+    the mean with its interval, or why it is undetermined (then written in red)."""
+    fig, ax = plt.subplots(figsize=(4.5, 3.8), constrained_layout=True)
     for r, gap in zip(ring_r_um, ring_gap_nm, strict=True):
         ax.plot(r, gap, "o-", ms=2, lw=0.4, color="tab:blue", alpha=0.4)
-    ax.plot(
-        np.full(edge_gaps_nm.shape, edge_radius_um),
-        edge_gaps_nm,
-        "s",
-        ms=3,
-        color="tab:green",
-        label=f"edge: {edge_gaps_nm.mean():.1f} ± {edge_gaps_nm.std(ddof=1):.1f} nm",
+    ax.plot(edge_radii_um, edge_gaps_nm, "s", ms=3, color="tab:green", label="edge of each profile")
+    ax.axvline(equal_area_radius_um, color="0.5", lw=0.8, ls=":", label="equal-area radius")
+    ax.axhline(0, color="0.7", lw=0.5)
+    undetermined = summary.startswith("undetermined")
+    ax.text(
+        0.02,
+        0.98,
+        textwrap.fill(summary, 70),
+        transform=ax.transAxes,
+        va="top",
+        fontsize=6,
+        color="tab:red" if undetermined else "black",
     )
-    ax.axvline(edge_radius_um, color="tab:green", lw=0.8, ls="--")
     ax.set_xlabel("distance from contact centre (µm)")
     ax.set_ylabel("gap (nm)")
     ax.set_title(title, fontsize=9)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="lower right")
     _save(fig, paths)
 
 

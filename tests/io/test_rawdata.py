@@ -110,7 +110,7 @@ def _edge_gap_of(folder):
         load_mn=25.0,
         otsu=OtsuSettings(),
         n_profiles=4,
-        edge_model="hertz",
+        edge_model="hertz_free_radius",
         wavelength_m=APPENDIX_WAVELENGTH_M,
         n_medium=FORMAMIDE_REFRACTIVE_INDEX,
     )

@@ -113,6 +113,13 @@ def test_smooth_glass_truth_matches_an_independent_hertz_recomputation(glass):
     assert truth["approach_nm"][0] == pytest.approx(a0**2 / radius * 1e9, rel=0.02)
     assert truth["area_exponent"] == pytest.approx(2 / 3, abs=0.01)
     assert truth["edge_gap_nm"] == pytest.approx(0.0, abs=0.5)  # no roughness, no gap
+    # Per ray (every degree): a smooth contact's rays all leave it at the Hertz radius, to
+    # the staircase of its 256 nm solver pixels (a pixel corner reaches 0.7 px = 0.18 µm
+    # past its centre), where the Hertz gap is still < 0.1 nm.
+    profiles = truth["edge_profiles"]
+    np.testing.assert_allclose(profiles["edge_radius_um"], a0 * 1e6, atol=0.3)
+    assert profiles["mean_ring_gap_nm"] == pytest.approx(0.0, abs=0.5)
+    assert max(profiles["local_gap_nm"]) < 0.5
     assert json.loads(json.dumps(truth)) == truth
 
 

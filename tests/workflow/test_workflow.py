@@ -363,10 +363,20 @@ def check_measurements_against_truth(project, material, sphere):
         assert gap["first_ring_gap_nm"] == pytest.approx(84.3, abs=0.1)
         assert gap["edge_gap_nm"]["n"] + len(gap["rejected_half_profiles"]) == 40
     if sphere == "glass":
-        # The glass sphere (the appendix's Newton-ring sphere, Fig. B.6): the average gap at
-        # the edge within 2 nm of the truth (the issue's target); measured at 4 noise seeds
-        # of the full-size sphere: +1.0 to +1.6 nm off.
-        assert gap["edge_gap_nm"]["mean"] == pytest.approx(truth["edge_gap_nm"], abs=2.0)
+        # The glass sphere (the appendix's Newton-ring sphere, Fig. B.6): a number, not
+        # undetermined, and the mean gap at the profiles' own edges within 2 nm of the truth
+        # there (the forward model's average gap at each ray's true edge, truth.json's
+        # edge_profiles). Measured: 2.74 nm against 1.29 nm here; 1.33 against the full run's
+        # 1.51 nm (before the per-profile edge, against the equal-area edge's truth: 2.47 vs
+        # 0.59 and 1.32 vs 0.72 nm).
+        assert gap["flag"] is None or not gap["flag"].startswith("undetermined")
+        assert gap["edge_gap_nm"]["mean"] == pytest.approx(
+            truth["edge_profiles"]["mean_ring_gap_nm"], abs=2.0
+        )
+        # The sheet-radius model's sensitivity to E*: a stiffer sheet shrinks the Hertz radius
+        # and lowers the gap (measured −2.4 nm per +10 %, the issue's −12.6/+18.3 nm per
+        # ∓20 % on a larger contact).
+        assert -5.0 < gap["edge_gap_change_nm_per_10pct_e_star"] < -0.5
 
     # Static friction: the torque-peak median scatters by 0.5 % at 1 % torque noise
     # (tests/virtual); 2 % per load. Speed from the angle slope to 2 % as well.

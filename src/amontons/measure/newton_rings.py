@@ -15,18 +15,24 @@ local parabola, number them m = 0, 1, 2 … from the centre outward, and fit the
   the gap is Hertz-like: the gap rises as (r − a)^{3/2} from the edge, which no parabola
   through the rings (27–47 µm from the centre for a 4 mm glass sphere at 100 mN, edge at
   16.6 µm) follows, and it extrapolates to −15 nm at the edge where the truth is 0.
-- ``edge_model="hertz"`` (default): d(r) = δ + S(r)/R_eff with the Hertz exterior shape
-  S(r) = [a·√(r² − a²) − (2a² − r²)·acos(a/r)]/π about the given edge radius a; a linear
-  least-squares fit for the edge gap δ and the curvature 1/R_eff. Exact for a Hertz contact,
-  also when the gap outside is offset by δ.
+- ``edge_model="hertz_sheet_radius"``: d(r) = δ + c·S(r; a) with the Hertz exterior shape
+  S(r) = [a·√(r² − a²) − (2a² − r²)·acos(a/r)]/π about a given radius a (the Hertz radius
+  of the load from the sheet's E* and diameter); per half-profile a linear least-squares fit
+  for δ and the curvature c = 1/R_eff. Exact for a Hertz contact of that radius, also when
+  the gap outside is offset by δ; biased when a is: ±20 % on E* moves a by ∓6–7 %.
+- ``edge_model="hertz_free_radius"`` (default): the same shape with a fitted to the rings
+  themselves, one radius shared by every half-profile (the load's far field is
+  axisymmetric), δ and c per half-profile (variable projection: for each trial a the
+  per-profile fits are linear; a minimises the summed squared residuals).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.ndimage import gaussian_filter, map_coordinates
+from scipy.optimize import minimize_scalar
 from scipy.signal import find_peaks
 
 from amontons.physics.newton_rings import (
@@ -35,8 +41,11 @@ from amontons.physics.newton_rings import (
     ring_gap,
 )
 
-_EDGE_MODELS = ("hertz", "quadratic")
-_MIN_RINGS = {"hertz": 2, "quadratic": 3}
+SHEET_RADIUS, FREE_RADIUS, QUADRATIC = "hertz_sheet_radius", "hertz_free_radius", "quadratic"
+EDGE_MODELS = (FREE_RADIUS, SHEET_RADIUS, QUADRATIC)
+# Fewest rings a half-profile needs: two for two linear unknowns (δ, c; the free radius is
+# shared by all profiles), three for the parabola's three.
+_MIN_RINGS = {FREE_RADIUS: 2, SHEET_RADIUS: 2, QUADRATIC: 3}
 
 
 class NewtonRingError(ValueError):
@@ -54,12 +63,13 @@ class MissedRingError(NewtonRingError):
 
 @dataclass(frozen=True)
 class HalfProfile:
-    """Rings along one ray from the contact centre."""
+    """Rings along one ray from the contact centre; lengths in m."""
 
     angle_rad: float
+    edge_radius_m: float  # the fluorescent contact edge on this ray
     ring_r_m: np.ndarray  # distance of each ring maximum from the centre
     ring_gap_m: np.ndarray  # its gap from eq. B.1
-    edge_gap_m: float  # the fitted gap extrapolated to the contact edge
+    edge_gap_m: float = float("nan")  # the fitted gap extrapolated to this ray's edge
 
 
 @dataclass(frozen=True)
@@ -71,17 +81,30 @@ class NewtonRingGap:
     edge_gaps_m: np.ndarray  # one per half-profile, in the order of angles_rad
     angles_rad: np.ndarray
     first_ring_gap_m: float  # d_0 = λ/4n
-    contact_radius_m: float
+    edge_radii_m: np.ndarray  # the fluorescent edge of each accepted half-profile
     edge_model: str
     half_profiles: tuple[HalfProfile, ...]
     # half-profiles left out, each with its reason (a rough sphere scatters its rings)
     rejected: tuple[str, ...] = ()
+    # radius of the Hertz shape the rings were fitted with (None for the parabola)
+    shape_radius_m: float | None = None
+
+
+def half_profile_angles(n_profiles: int) -> np.ndarray:
+    """Angles (rad) of the 2·n_profiles half-profiles: kπ/n and kπ/n + π, k = 0 … n − 1,
+    measured from the +column axis towards +row."""
+    if n_profiles < 1:
+        raise NewtonRingError(f"n_profiles = {n_profiles}; expected at least 1")
+    base = np.arange(n_profiles) * np.pi / n_profiles
+    return np.concatenate([base, base + np.pi])
 
 
 def hertz_exterior_shape(r_m: np.ndarray, edge_radius_m: float) -> np.ndarray:
     """S(r) = [a·√(r² − a²) − (2a² − r²)·acos(a/r)]/π (m²): Hertz gap × R outside r = a."""
     a = edge_radius_m
     r = np.maximum(np.asarray(r_m, dtype=float), a)
+    if a <= 0:
+        return r**2 / 2  # the limit a → 0: a bare paraboloid
     return (a * np.sqrt(r**2 - a**2) - (2 * a**2 - r**2) * np.arccos(a / r)) / np.pi
 
 
@@ -111,25 +134,83 @@ def refine_peak(r: np.ndarray, values: np.ndarray, index: int, half_width: int) 
     return float(r[index] + offset)
 
 
+def _hertz_coefficients(ring_r_m, ring_gap_m, shape_radius_m):
+    """(δ, c) of d = δ + c·S(r; a) by linear least squares, and the squared residual sum."""
+    design = np.column_stack(
+        [np.ones_like(ring_r_m), hertz_exterior_shape(ring_r_m, shape_radius_m)]
+    )
+    coefficients, *_ = np.linalg.lstsq(design, ring_gap_m, rcond=None)
+    residual = ring_gap_m - design @ coefficients
+    return coefficients, float(residual @ residual)
+
+
 def fit_edge_gap(
     ring_r_m: np.ndarray,
     ring_gap_m: np.ndarray,
-    contact_radius_m: float,
+    edge_radius_m: float,
     edge_model: str,
     shape_radius_m: float | None = None,
 ) -> float:
-    """Gap (m) at ``contact_radius_m`` from a fit to the ring points.
+    """Gap (m) at ``edge_radius_m`` from a fit to the ring points (r in m, gaps in m).
 
-    'hertz': gap = g0 + c·S(r; a) with the Hertz exterior shape S of radius a =
-    ``shape_radius_m`` (default: the contact radius itself), g0 and c fitted.
+    'quadratic': the parabola through the rings. The Hertz models: gap = δ + c·S(r; a) with
+    a = ``shape_radius_m`` (the sheet's Hertz radius, or the radius fitted to every
+    profile's rings by :func:`fit_hertz_radius`), δ and c fitted.
     """
-    if edge_model == "quadratic":
+    if edge_model == QUADRATIC:
         coefficients = np.polyfit(ring_r_m, ring_gap_m, 2)
-        return float(np.polyval(coefficients, contact_radius_m))
-    a = contact_radius_m if shape_radius_m is None else shape_radius_m
-    design = np.column_stack([np.ones_like(ring_r_m), hertz_exterior_shape(ring_r_m, a)])
-    (offset, scale), *_ = np.linalg.lstsq(design, ring_gap_m, rcond=None)
-    return float(offset + scale * hertz_exterior_shape(np.array([contact_radius_m]), a)[0])
+        return float(np.polyval(coefficients, edge_radius_m))
+    if shape_radius_m is None:
+        raise NewtonRingError(f"edge model '{edge_model}' needs the radius of its Hertz shape")
+    (offset, scale), _ = _hertz_coefficients(ring_r_m, ring_gap_m, shape_radius_m)
+    return float(
+        offset + scale * hertz_exterior_shape(np.array([edge_radius_m]), shape_radius_m)[0]
+    )
+
+
+def _summed_residuals(profiles, shape_radius_m: float) -> float:
+    return sum(_hertz_coefficients(p.ring_r_m, p.ring_gap_m, shape_radius_m)[1] for p in profiles)
+
+
+def fit_hertz_radius(profiles, grid_points: int = 200) -> float:
+    """Radius a (m) of the Hertz exterior shape that fits every half-profile's rings best.
+
+    One a for all profiles, δ and c per profile (each linear once a is fixed): a grid search
+    over 0 ≤ a < the innermost ring of any profile (the rings lie outside the contact), then
+    a bounded scalar minimisation around the best grid point. The rings constrain a only
+    through the shape's (r − a)^{3/2} rise near the edge and its 4a³/3πRr tail, so a needs
+    the rings of many profiles; a single profile's a would scatter by microns.
+    """
+    upper = min(float(p.ring_r_m[0]) for p in profiles) * (1 - 1e-6)
+    grid = np.linspace(0.0, upper, grid_points)
+    costs = np.array([_summed_residuals(profiles, a) for a in grid])
+    best = int(np.argmin(costs))
+    lo, hi = grid[max(best - 1, 0)], grid[min(best + 1, grid.size - 1)]
+    refined = minimize_scalar(
+        lambda a: _summed_residuals(profiles, a), bounds=(lo, hi), method="bounded"
+    )
+    return float(refined.x) if refined.fun <= costs[best] else float(grid[best])
+
+
+def extrapolate_to_edges(
+    profiles, edge_model: str, shape_radius_m: float | None = None
+) -> tuple[np.ndarray, float | None]:
+    """Gap (m) of each half-profile's fit at its own edge, and the Hertz radius (m) used.
+
+    ``shape_radius_m`` is the sheet's Hertz radius for 'hertz_sheet_radius'; the free-radius
+    model fits it (:func:`fit_hertz_radius`); the parabola has none (None).
+    """
+    if edge_model == FREE_RADIUS:
+        shape_radius_m = fit_hertz_radius(profiles)
+    elif edge_model == QUADRATIC:
+        shape_radius_m = None
+    gaps = np.array(
+        [
+            fit_edge_gap(p.ring_r_m, p.ring_gap_m, p.edge_radius_m, edge_model, shape_radius_m)
+            for p in profiles
+        ]
+    )
+    return gaps, shape_radius_m
 
 
 def _ray(
@@ -177,22 +258,28 @@ def _half_profile(
     centre_px: tuple[float, float],
     angle: float,
     pixel_m: float,
-    contact_radius_m: float,
+    edge_radius_m: float,
     settings: dict,
 ) -> HalfProfile:
+    """The numbered rings outside ``edge_radius_m`` along one ray (not yet extrapolated)."""
+    degrees = np.degrees(angle)
+    if not np.isfinite(edge_radius_m):
+        raise NewtonRingError(
+            f"profile at {degrees:.1f}°: the ray meets no contact pixel, so it has no edge to "
+            "extrapolate to"
+        )
     r_px, values = _ray(image, centre_px, angle, settings["step_px"])
     r_m = r_px * pixel_m
     reach_m = float(r_m[-1]) if r_m.size else 0.0
     peaks, _ = find_peaks(values, prominence=settings["prominence"])
-    degrees = np.degrees(angle)
-    inside = peaks[r_m[peaks] <= contact_radius_m]
+    inside = peaks[r_m[peaks] <= edge_radius_m]
     if inside.size:
         raise NewtonRingError(
             f"profile at {degrees:.1f}°: a bright ring at r = {r_m[inside[0]]:.3g} m lies inside "
-            f"the contact edge ({contact_radius_m:.3g} m), so the ring orders are ambiguous; "
+            f"the contact edge ({edge_radius_m:.3g} m), so the ring orders are ambiguous; "
             "expected the first ring (m = 0) outside the edge — check the centre and radius"
         )
-    if settings["max_rings"] is not None:
+    if settings["max_rings"] is not None and settings["edge_model"] != FREE_RADIUS:
         peaks = peaks[: settings["max_rings"]]
     needed = _MIN_RINGS[settings["edge_model"]]
     if peaks.size < needed:
@@ -203,7 +290,7 @@ def _half_profile(
         )
     # Refine each maximum over ±1/8 of the local ring spacing (±π/4 of fringe phase), where a
     # fringe is still close to a parabola; ring 0's spacing is its distance from the edge.
-    spacing = np.diff(np.concatenate([[contact_radius_m / pixel_m / settings["step_px"]], peaks]))
+    spacing = np.diff(np.concatenate([[edge_radius_m / pixel_m / settings["step_px"]], peaks]))
     ring_r = np.array(
         [
             refine_peak(r_m, values, int(p), max(2, round(0.125 * s)))
@@ -212,22 +299,33 @@ def _half_profile(
     )
     _check_spacing(ring_r, degrees, settings["max_spacing_ratio"])
     gaps = ring_gap(np.arange(ring_r.size), settings["wavelength_m"], settings["n_medium"])
-    edge = fit_edge_gap(
-        ring_r, gaps, contact_radius_m, settings["edge_model"], settings["shape_radius_m"]
-    )
-    return HalfProfile(float(angle), ring_r, gaps, edge)
+    return HalfProfile(float(angle), float(edge_radius_m), ring_r, gaps)
+
+
+def _edge_radii(contact_radius_m, n_half_profiles: int) -> np.ndarray:
+    """One edge radius (m) per half-profile from a scalar or a per-profile array (NaN: the
+    ray meets no contact)."""
+    radii = np.broadcast_to(np.asarray(contact_radius_m, dtype=float), (n_half_profiles,))
+    if radii.shape != (n_half_profiles,) or np.any(radii[np.isfinite(radii)] <= 0):
+        raise NewtonRingError(
+            f"contact edge radii {np.asarray(contact_radius_m)!r} m; expected one value > 0 "
+            f"or {n_half_profiles} (one per half-profile, NaN where a ray meets no contact)"
+        )
+    if not np.isfinite(radii).any():
+        raise NewtonRingError("no half-profile meets the contact; expected a contact edge")
+    return radii
 
 
 def newton_ring_gap(
     reflection: np.ndarray,
     pixel_m: float,
     centre_px: tuple[float, float],
-    contact_radius_m: float,
+    contact_radius_m,
     n_profiles: int = 20,
     wavelength_m: float = APPENDIX_WAVELENGTH_M,
     n_medium: float = FORMAMIDE_REFRACTIVE_INDEX,
     *,
-    edge_model: str = "hertz",
+    edge_model: str = FREE_RADIUS,
     max_rings: int | None = None,
     prominence_fraction: float = 0.3,
     min_prominence_sd: float = 5.0,
@@ -239,38 +337,50 @@ def newton_ring_gap(
 ) -> NewtonRingGap:
     """Gap (m) at the contact edge from ``n_profiles`` lines through ``centre_px`` (row, col).
 
-    Each line gives two half-profiles (angles kπ/n and kπ/n + π), so 2·n_profiles edge gaps
-    enter the mean and sd. ``contact_radius_m`` is the fluorescent edge radius (from the Otsu
-    mask). A maximum counts as a ring when its prominence exceeds both ``prominence_fraction``
-    of the image's 2–98 % intensity range and ``min_prominence_sd`` pixel-noise standard
-    deviations (so pure noise never makes rings). ``max_rings`` keeps only the innermost rings.
-    ``shape_radius_m``: radius of the Hertz exterior shape the 'hertz' model fits (default
-    the fluorescent edge). The far field of a contact is set by its load: a rough or
-    flattened sphere's Otsu edge lies well inside the radius whose Hertz shape its rings
-    follow, and a shape of the edge's radius then biases the extrapolation by −8 nm (rough
-    glass sphere of the virtual experiment); the Hertz radius of the load does not.
+    Each line gives two half-profiles (:func:`half_profile_angles`), so 2·n_profiles edge
+    gaps enter the mean and sd. ``contact_radius_m`` is the fluorescent edge: one radius (m)
+    for every ray, or one per half-profile in the order of :func:`half_profile_angles` (NaN
+    where the ray meets no contact; that profile is refused). Each profile's fit is
+    extrapolated to its own edge. A maximum counts as a ring when its prominence exceeds
+    both ``prominence_fraction`` of the image's 2–98 % intensity range and
+    ``min_prominence_sd`` pixel-noise standard deviations (so pure noise never makes rings).
+    ``max_rings`` keeps only the innermost rings for 'hertz_sheet_radius' and 'quadratic';
+    'hertz_free_radius' takes every ring: its radius is constrained only by the shape's tail,
+    and on the rough virtual glass sphere its gap moved from −1.8 to +4.7 to +0.2 nm with 3,
+    4 and all (≤ 6) rings. ``shape_radius_m``: radius of the Hertz
+    exterior shape for 'hertz_sheet_radius' (the Hertz radius of the load from the sheet's E*
+    and diameter: a rough or flattened sphere's fluorescent edge lies well inside the radius
+    whose shape its rings follow, and a shape of the edge's radius biases the extrapolation
+    by −8 nm on the rough glass sphere of the virtual experiment); 'hertz_free_radius' fits
+    that radius to the rings (:func:`fit_hertz_radius`) and ignores ``shape_radius_m``.
     A half-profile whose ring spacing jumps by more than ``max_spacing_ratio`` is refused
     (a missed ring). Refused half-profiles are left out and listed in ``rejected`` with their
     reason, as long as at least ``min_accepted_fraction`` of them remain (roughness on the
     sphere scatters single rings; the rest still measure the average gap).
 
-    Raises NewtonRingError for a centre outside the image, an unknown edge model, or when
-    fewer than ``min_accepted_fraction`` of the half-profiles have enough, correctly ordered
-    rings outside the contact edge (the message names the first refused profile's reason).
+    Raises NewtonRingError for a centre outside the image, an unknown edge model, a
+    sheet-radius fit without a radius, or when fewer than ``min_accepted_fraction`` of the
+    half-profiles have enough, correctly ordered rings outside their contact edge (the
+    message names the first refused profile's reason).
     """
     image = np.asarray(reflection, dtype=float)
     if image.ndim != 2:
         raise NewtonRingError(f"reflection image has shape {image.shape}; expected 2-D")
-    if edge_model not in _EDGE_MODELS:
-        raise NewtonRingError(f"edge_model '{edge_model}'; expected one of {_EDGE_MODELS}")
+    if edge_model not in EDGE_MODELS:
+        raise NewtonRingError(f"edge_model '{edge_model}'; expected one of {EDGE_MODELS}")
+    if edge_model == SHEET_RADIUS and not (shape_radius_m and shape_radius_m > 0):
+        raise NewtonRingError(
+            f"edge model '{SHEET_RADIUS}' needs the sheet's Hertz radius (shape_radius_m > 0); "
+            f"got {shape_radius_m!r}"
+        )
     row, col = centre_px
     if not (0 <= row <= image.shape[0] - 1 and 0 <= col <= image.shape[1] - 1):
         raise NewtonRingError(
             f"contact centre (row {row:g}, col {col:g}) px lies outside the {image.shape} "
             "reflection image"
         )
-    if contact_radius_m <= 0:
-        raise NewtonRingError(f"contact radius {contact_radius_m} m; expected > 0")
+    angles = half_profile_angles(n_profiles)
+    edge_radii = _edge_radii(contact_radius_m, angles.size)
     low, high = np.percentile(image, [2, 98])
     settings = {
         "prominence": max(
@@ -282,23 +392,14 @@ def newton_ring_gap(
         "wavelength_m": wavelength_m,
         "n_medium": n_medium,
         "max_spacing_ratio": max_spacing_ratio,
-        "shape_radius_m": shape_radius_m,
     }
     # Noise is independent per pixel while the rings are tens of pixels wide: smoothing by a
     # pixel removes most of the noise and leaves the ring maxima where they are.
     smoothed = gaussian_filter(image, smooth_px, mode="nearest") if smooth_px > 0 else image
-    angles = np.concatenate(
-        [
-            np.arange(n_profiles) * np.pi / n_profiles,
-            np.arange(n_profiles) * np.pi / n_profiles + np.pi,
-        ]
-    )
     profiles, rejected, missed = [], [], []
-    for angle in angles:
+    for angle, edge in zip(angles, edge_radii, strict=True):
         try:
-            profiles.append(
-                _half_profile(smoothed, (row, col), angle, pixel_m, contact_radius_m, settings)
-            )
+            profiles.append(_half_profile(smoothed, (row, col), angle, pixel_m, edge, settings))
         except MissedRingError as error:
             missed.append(str(error))
         except NewtonRingError as error:
@@ -325,15 +426,17 @@ def newton_ring_gap(
             f"{len(rejected)} of {angles.size} half-profiles refused (at least "
             f"{min_accepted_fraction:.0%} must have usable rings); first: {rejected[0]}"
         )
-    edges = np.array([p.edge_gap_m for p in profiles])
+    edges, shape_radius = extrapolate_to_edges(profiles, edge_model, shape_radius_m)
+    profiles = [replace(p, edge_gap_m=float(g)) for p, g in zip(profiles, edges, strict=True)]
     return NewtonRingGap(
         edge_gap_mean_m=float(edges.mean()),
         edge_gap_sd_m=float(edges.std(ddof=1)),
         edge_gaps_m=edges,
         angles_rad=np.array([p.angle_rad for p in profiles]),
         first_ring_gap_m=float(ring_gap(0, wavelength_m, n_medium)),
-        contact_radius_m=float(contact_radius_m),
+        edge_radii_m=np.array([p.edge_radius_m for p in profiles]),
         edge_model=edge_model,
         half_profiles=tuple(profiles),
         rejected=tuple(rejected),
+        shape_radius_m=shape_radius,
     )

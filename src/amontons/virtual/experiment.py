@@ -311,6 +311,7 @@ def write_instruments(
         "edge_gap_nm": reflected.edge_gap_m * 1e9,
         "edge_gap_definition": "gap just outside the true (mechanical) contact edge at the "
         "reflection load; the Otsu edge of the fluorescence lies slightly inside it",
+        "edge_profiles": reflected.edge_profiles,
         "first_ring_gap_nm": float(ring_gap(0, settings.wavelength_m, settings.refractive_index))
         * 1e9,
         "wavelength_nm": settings.wavelength_m * 1e9,

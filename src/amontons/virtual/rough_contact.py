@@ -218,17 +218,80 @@ def simulate_rough_sphere(
     )
 
 
+def closed_envelope(contact: np.ndarray, spacing_m: float, closing_m: float) -> np.ndarray:
+    """The contact mask closed with a disc of radius ``closing_m`` (the gaps between patches
+    that the microscope cannot resolve), padded so the window edge does not erode it."""
+    r = max(1, int(round(closing_m / spacing_m)))
+    yy, xx = np.mgrid[-r : r + 1, -r : r + 1]
+    disc = xx**2 + yy**2 <= r * r
+    closed = ndimage.binary_closing(np.pad(contact, r + 1), structure=disc)
+    return closed[r + 1 : -(r + 1), r + 1 : -(r + 1)]
+
+
 def edge_radius_m(contact: np.ndarray, spacing_m: float, closing_m: float) -> float:
     """Radius (m) of the disc with the area of the contact's envelope: the contact mask closed
     with a disc of radius ``closing_m`` (the gaps between patches that the microscope cannot
     resolve) and its holes filled - the edge a thresholded fluorescence image shows."""
-    r = max(1, int(round(closing_m / spacing_m)))
-    yy, xx = np.mgrid[-r : r + 1, -r : r + 1]
-    disc = xx**2 + yy**2 <= r * r
-    padded = np.pad(contact, r + 1)
-    closed = ndimage.binary_closing(padded, structure=disc)
-    envelope = ndimage.binary_fill_holes(closed)
+    envelope = ndimage.binary_fill_holes(closed_envelope(contact, spacing_m, closing_m))
     return float(np.sqrt(envelope.sum() * spacing_m**2 / np.pi))
+
+
+# Rays of the per-profile edge truth: every degree, so that any n_profiles dividing 180 of the
+# measurement's rays (kπ/n and kπ/n + π) is among them.
+TRUTH_RAY_ANGLES = np.radians(np.arange(360.0))
+
+
+def ray_edges_m(contact: np.ndarray, spacing_m: float, angles_rad: np.ndarray) -> np.ndarray:
+    """Distance (m) from the window centre at which each ray leaves the outermost contact
+    pixel on it (sampled every 0.1 px, half a step past the last sample in contact); NaN for a
+    ray without contact."""
+    n0, n1 = contact.shape
+    r = np.arange(0.0, np.hypot(n0, n1) / 2, 0.1)
+    radii = np.full(len(angles_rad), np.nan)
+    for k, angle in enumerate(angles_rad):
+        rows = np.floor((n0 - 1) / 2 + r * np.sin(angle) + 0.5).astype(int)
+        cols = np.floor((n1 - 1) / 2 + r * np.cos(angle) + 0.5).astype(int)
+        inside = (rows >= 0) & (rows < n0) & (cols >= 0) & (cols < n1)
+        hits = np.nonzero(contact[rows[inside], cols[inside]])[0]
+        if hits.size:
+            radii[k] = (r[hits[-1]] + 0.05) * spacing_m
+    return radii
+
+
+def edge_profile_truth(result: ContactResult, closing_m: float) -> dict:
+    """The true edge of each ray (every degree from the apex) and the gap there, JSON-ready
+    (µm, nm): the per-profile edge the measurement finds (docs/models.md §1.5), on the true
+    contact closed by ``closing_m``. ``ring_gap_nm``: the azimuthal mean gap at each ray's
+    edge radius, the average local gap the Newton rings see at that distance;
+    ``local_gap_nm``: the gap at the edge point itself (≈ 0: the last contact pixel, what the
+    molecules see)."""
+    dx = result.spacing
+    closed = closed_envelope(result.contact, dx, closing_m)
+    radii = ray_edges_m(closed, dx, TRUTH_RAY_ANGLES)
+    found = np.isfinite(radii)
+    ring_gap_m = np.full(radii.shape, np.nan)
+    ring_gap_m[found] = azimuthal_mean(result.gap, dx, radii[found])
+    n0, n1 = result.gap.shape
+    rows = (n0 - 1) / 2 + np.nan_to_num(radii) / dx * np.sin(TRUTH_RAY_ANGLES)
+    cols = (n1 - 1) / 2 + np.nan_to_num(radii) / dx * np.cos(TRUTH_RAY_ANGLES)
+    local = ndimage.map_coordinates(result.gap, [rows, cols], order=1)
+    local = np.where(found, np.maximum(local, 0.0), np.nan)
+
+    def listed(values, scale):
+        return [None if not np.isfinite(v) else float(v * scale) for v in values]
+
+    return {
+        "angles_deg": np.degrees(TRUTH_RAY_ANGLES).tolist(),
+        "edge_radius_um": listed(radii, 1e6),
+        "ring_gap_nm": listed(ring_gap_m, 1e9),
+        "local_gap_nm": listed(local, 1e9),
+        "mean_ring_gap_nm": float(np.nanmean(ring_gap_m) * 1e9),
+        "mean_edge_radius_um": float(np.nanmean(radii) * 1e6),
+        "max_edge_radius_um": float(np.nanmax(radii) * 1e6),
+        "definition": "per ray from the apex (every degree): the outermost pixel of the true "
+        f"contact closed by {closing_m * 1e9:.0f} nm, the azimuthal mean gap at that radius "
+        "(ring_gap_nm, what the Newton rings average) and the gap at the point (local_gap_nm)",
+    }
 
 
 def image_contact_states(
@@ -256,13 +319,14 @@ def image_contact_states(
     centre = ((shape[0] - 1) / 2, (shape[1] - 1) / 2)
     states = []
     for index, result in enumerate(solution.results):
-        gap = edge_gap = None
+        gap = edge_gap = profiles = None
         if index == gap_index:
             rows_m = (np.arange(shape[0]) - centre[0]) * pixel_m
             cols_m = (np.arange(shape[1]) - centre[1]) * pixel_m
             gap = np.maximum(resample(result.gap, dx, rows_m, cols_m, 1, "constant"), 0.0)
             r_edge = edge_radius_m(result.contact, dx, closing_m)
             edge_gap = float(azimuthal_mean(result.gap, dx, np.array([r_edge]))[0])
+            profiles = edge_profile_truth(result, closing_m)
         states.append(
             ContactState(
                 load_n=float(result.load),
@@ -275,6 +339,7 @@ def image_contact_states(
                 area_m2=result.area,
                 edge_gap_m=edge_gap,
                 centre_px=centre,
+                edge_profiles=profiles,
             )
         )
     return states

@@ -17,7 +17,10 @@ class ContactState:
     pressure; ``gap_m``: gap at pixel centres
     (m, 0 in contact; None where no instrument needs it); ``contact``: pixels in contact;
     ``area_m2``: the true contact area; ``edge_gap_m``: the average gap at the contact edge
-    (m), what the Newton rings extrapolate to (None with ``gap_m``).
+    (m), what the Newton rings extrapolate to (None with ``gap_m``); ``edge_profiles``: the
+    true edge of each ray and the gap there (JSON-ready, µm and nm;
+    :func:`amontons.virtual.rough_contact.edge_profile_truth`; None with ``gap_m`` and for
+    the analytic Hertz sphere, whose edge is a circle).
     """
 
     load_n: float
@@ -28,6 +31,7 @@ class ContactState:
     area_m2: float
     edge_gap_m: float | None
     centre_px: tuple[float, float]
+    edge_profiles: dict | None = None
 
 
 def load_index(loads_n, load_n: float) -> int | None:
