@@ -19,6 +19,7 @@ SCENE = {
     "pixel_nm": 250.0,
     "window_factor": 1.5,
     "side_px": None,
+    "max_side_px": 512,
     "tol": 1e-8,
     "optics": "none",
     "rendering": "emission",

@@ -500,6 +500,7 @@ PROBE_SCENE = {
     "pixel_nm": 256.0,
     "window_factor": 1.5,
     "side_px": None,
+    "max_side_px": 512,
     "tol": 1.0e-6,
     "optics": "none",
     "rendering": "emission",

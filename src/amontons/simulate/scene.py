@@ -136,6 +136,15 @@ def _window_m(name: str, config: Mapping, loads_n, radius_m, e_star_pa) -> float
     return config["window_factor"] * hertz_diameter_m(max(loads_n), radius_m, e_star_pa)
 
 
+def _solver_pixel_m(config: Mapping, window_m: float) -> float:
+    """Solver pixel (m): ``pixel_nm``, or coarser when a window set by ``window_factor`` would
+    need more than ``max_side_px`` pixels (a large contact then costs no more than the cap)."""
+    pixel_m = config["pixel_nm"] * 1e-9
+    if config.get("side_px") is not None:
+        return pixel_m
+    return max(pixel_m, window_m / config["max_side_px"])
+
+
 def _sheet_or(name: str, config: Mapping, key: str, record: Mapping, column: str, scale: float):
     """The scene's own value of ``key`` or, where it is null, the sheet's ``column``."""
     value = config.get(key)
@@ -175,6 +184,7 @@ def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -
     e_star_pa = float(record["e_star_gpa"]) * 1e9
     radius_m = float(record["diameter_mm"]) * 0.5e-3
     loads_n = tuple(f * 1e-3 for f in loads_mn)
+    window_m = _window_m(name, config, loads_n, radius_m, e_star_pa)
     return Scene(
         name=name,
         surface="afm_before",
@@ -183,8 +193,8 @@ def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -
         e_star_pa=e_star_pa,
         radius_m=radius_m,
         loads_n=loads_n,
-        pixel_m=config["pixel_nm"] * 1e-9,
-        window_m=_window_m(name, config, loads_n, radius_m, e_star_pa),
+        pixel_m=_solver_pixel_m(config, window_m),
+        window_m=window_m,
         tol=config["tol"],
         optics=config["optics"],
         rendering=config.get("rendering", "emission"),
@@ -205,7 +215,7 @@ def synthetic_scene(name: str, config: Mapping) -> Scene:
         radius_m = synthetic["radius_mm"] * 1e-3
     e_star_pa = synthetic["e_star_gpa"] * 1e9
     window_m = _window_m(name, config, loads_n, radius_m, e_star_pa)
-    pixel_m = config["pixel_nm"] * 1e-9
+    pixel_m = _solver_pixel_m(config, window_m)
     surface = SyntheticSurface(
         hurst=synthetic["hurst"],
         rms_slope=synthetic.get("rms_slope"),
