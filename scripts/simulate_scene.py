@@ -7,27 +7,32 @@ if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
-from amontons.io.fields import write_load_series
+from amontons.io.fields import read_levelled_map, write_load_series
 from amontons.io.files import write_json
-from amontons.io.heightmap import read_height_map
-from amontons.measure.topography import square_pixels
 from amontons.runlog import run_logged
 from amontons.simulate.scene import scene_for_sphere, synthetic_scene
 from amontons.simulate.solve import solve_scene
-from amontons.simulate.surface import afm_indenter, synthetic_indenter
+from amontons.simulate.surface import LevelledMap, afm_indenter, synthetic_indenter
 
 log = logging.getLogger(__name__)
 
 
+def levelled_map(path: str) -> LevelledMap:
+    """The levelled AFM map the level_afm_map rule wrote."""
+    heights, pixel_m, attrs = read_levelled_map(path)
+    return LevelledMap(
+        heights, pixel_m, attrs["radius_m"], tuple(attrs["apex_xy_m"]), attrs["apex_height_m"]
+    )
+
+
 def main(
-    afm_before: str | None,
+    levelled_path: str | None,
     fields_path: str,
     solve_path: str,
     scene_name: str,
     scene_config: dict,
     sphere: str | None,
     sphere_record: dict | None,
-    afm: dict,
     threads: int,
 ) -> None:
     if sphere is None:
@@ -35,15 +40,7 @@ def main(
         indenter = synthetic_indenter(scene)
     else:
         scene = scene_for_sphere(scene_name, scene_config, sphere, sphere_record)
-        height_map = square_pixels(
-            read_height_map(
-                afm_before,
-                fallback_pixel_m=None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
-                nan_policy=afm["nan_policy"],
-                channel=afm["channel"],
-            )
-        )
-        indenter = afm_indenter(height_map.heights, height_map.pixel_m, scene, afm_before)
+        indenter = afm_indenter(levelled_map(levelled_path), scene, levelled_path)
     log.info(
         "%s: %d² solver grid of %.1f nm (window %.1f µm); surface rms %.1f nm, slope %.3f "
         "at the solver pixel (%.1f nm, slope %.3f at the map's)",
@@ -76,13 +73,12 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        afm_before=sm.input.get("afm_before"),
+        levelled_path=sm.input.get("levelled"),
         fields_path=sm.output.fields,
         solve_path=sm.output.solve,
         scene_name=sm.wildcards.scene,
         scene_config=sm.params.scene,
         sphere=sm.params.sphere,
         sphere_record=sm.params.sphere_record,
-        afm=sm.params.afm,
         threads=sm.threads,
     )

@@ -10,7 +10,7 @@ from amontons.measure.topography import sphere_cap
 from amontons.physics import hertz
 from amontons.simulate.scene import scene_for_sphere
 from amontons.simulate.solve import solve_scene
-from amontons.simulate.surface import afm_indenter
+from amontons.simulate.surface import afm_indenter, level_afm_map
 
 from .test_surface import SCENE
 
@@ -23,7 +23,7 @@ RECORD = {"diameter_mm": 2.0, "e_star_gpa": 2.0, "loads": [5.0, 10.0, 20.0, 40.0
 def hertz_scene():
     scene = scene_for_sphere("elastic", SCENE, "smooth", RECORD)
     heights = sphere_cap((1000, 1000), 100e-9, 1e-3, (0.7e-6, -1.1e-6), 0.0)
-    indenter = afm_indenter(heights, 100e-9, scene, "smooth.tif")
+    indenter = afm_indenter(level_afm_map(heights, 100e-9), scene, "smooth.tif")
     return scene, indenter, solve_scene(scene, indenter)
 
 
@@ -76,6 +76,6 @@ def test_a_window_the_contact_reaches_fails_loudly():
     )
     cap = sphere_cap((1000, 1000), 100e-9, 1e-3, (0.0, 0.0), 0.0)
     rough = self_affine((1000, 1000), 100e-9, 0.8, rms_height=40e-9, long_cutoff=10e-6, rng=2)
-    indenter = afm_indenter(cap + rough, 100e-9, scene, "rough.tif")
+    indenter = afm_indenter(level_afm_map(cap + rough, 100e-9), scene, "rough.tif")
     with pytest.raises(FreeBoundaryError, match="contact reaches the window edge"):
         solve_scene(scene, indenter)

@@ -9,7 +9,7 @@ from amontons.contact.surfaces import self_affine
 from amontons.measure.topography import sphere_cap
 from amontons.physics.roughness import roughness_statistics
 from amontons.simulate.scene import SceneError, scene_for_sphere
-from amontons.simulate.surface import afm_indenter, area_average
+from amontons.simulate.surface import afm_indenter, area_average, level_afm_map
 
 SCENE = {
     "surface": "afm_before",
@@ -91,7 +91,7 @@ def test_window_is_cut_about_the_fitted_apex():
     scene = scene_for_sphere("s", SCENE, "S", record)
     apex = (3.1e-6, -4.7e-6)
     heights = _sphere_map(900, 100e-9, 1e-3, apex)
-    indenter = afm_indenter(heights, 100e-9, scene, "map.tif")
+    indenter = afm_indenter(level_afm_map(heights, 100e-9), scene, "map.tif")
     top = np.unravel_index(np.argmax(indenter.heights), indenter.heights.shape)
     centre = (indenter.heights.shape[0] - 1) / 2
     assert np.abs(np.array(top) - centre).max() <= 1
@@ -104,4 +104,4 @@ def test_a_window_larger_than_the_scan_names_the_file_and_sizes():
     scene = scene_for_sphere("wide", SCENE, "S", record)
     heights = _sphere_map(400, 100e-9, 1e-3)
     with pytest.raises(SceneError, match=r"map\.tif: scene wide: the solver window .* AFM scan"):
-        afm_indenter(heights, 100e-9, scene, "map.tif")
+        afm_indenter(level_afm_map(heights, 100e-9), scene, "map.tif")

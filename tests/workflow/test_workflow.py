@@ -529,7 +529,12 @@ def _scene_jobs(project, target, **changes):
 def test_an_elastic_scene_without_optics_schedules_no_psf_rendering_or_plastic_job(project):
     target = "results/small/PS/PS/scenes/probe/scene_fit.json"
     jobs, _ = _scene_jobs(project, target)
-    assert set(jobs) == {"generate_virtual_experiment_with_flim", "simulate_scene", "fit_scene"}
+    assert set(jobs) == {
+        "generate_virtual_experiment_with_flim",
+        "level_afm_map",
+        "simulate_scene",
+        "fit_scene",
+    }
 
 
 def test_switching_a_scene_to_the_microscope_adds_exactly_its_psf_and_rendering_jobs(project):

@@ -356,3 +356,12 @@ def synthetic_scene_outputs():
         f"{SYNTHETIC_SCENE.format(scene=s)}/scene_fit.json"
         for s in scene_names(surface="synthetic")
     ]
+
+
+def scene_fit_inputs(wildcards):
+    """A scene's solve and, with optics, its rendered areas."""
+    folder = scene_dir(wildcards.material, wildcards.sphere, wildcards.scene)
+    inputs = {"solve": f"{folder}/solve.json"}
+    if SCENES[wildcards.scene]["optics"] == "microscope":
+        inputs["render"] = f"{folder}/render.csv"
+    return inputs

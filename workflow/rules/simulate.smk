@@ -4,9 +4,33 @@
 # the experiment for a synthetic surface.
 
 
-rule simulate_scene:
+rule level_afm_map:
     input:
         afm_before=lambda wc: afm_path(wc.sphere, "afm_before"),
+    output:
+        levelled=f"{MEASURED}/afm_before_levelled.h5",
+    log:
+        f"{SPHERE_LOGS}/level_afm_map.log",
+    benchmark:
+        f"{SPHERE_LOGS}/level_afm_map.benchmark.tsv"
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=3000,
+        runtime=10,
+    params:
+        afm=lambda wc: {
+            **afm_reading(),
+            "pixel_nm": sheet_value(wc.sphere, "afm_pixel_nm"),
+        },
+    script:
+        "../../scripts/level_afm_map.py"
+
+
+rule simulate_scene:
+    input:
+        levelled=f"{MEASURED}/afm_before_levelled.h5",
     output:
         fields=f"{SCENE}/fields.h5",
         solve=f"{SCENE}/solve.json",
@@ -26,17 +50,13 @@ rule simulate_scene:
         scene=lambda wc: scene_config(wc.scene),
         sphere=lambda wc: wc.sphere,
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
-        afm=lambda wc: {
-            **afm_reading(),
-            "pixel_nm": sheet_value(wc.sphere, "afm_pixel_nm"),
-        },
     script:
         "../../scripts/simulate_scene.py"
 
 
 rule simulate_greenwood_tripp:
     input:
-        afm_before=lambda wc: afm_path(wc.sphere, "afm_before"),
+        levelled=f"{MEASURED}/afm_before_levelled.h5",
     output:
         solve=f"{SCENE}/solve.json",
     log:
@@ -55,10 +75,6 @@ rule simulate_greenwood_tripp:
         scene=lambda wc: scene_config(wc.scene),
         sphere=lambda wc: wc.sphere,
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
-        afm=lambda wc: {
-            **afm_reading(),
-            "pixel_nm": sheet_value(wc.sphere, "afm_pixel_nm"),
-        },
     script:
         "../../scripts/simulate_greenwood_tripp.py"
 
@@ -83,7 +99,6 @@ rule simulate_synthetic_scene:
         scene=lambda wc: scene_config(wc.scene),
         sphere=None,
         sphere_record=None,
-        afm=None,
     script:
         "../../scripts/simulate_scene.py"
 
@@ -150,15 +165,6 @@ rule compare_scene:
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/compare_scene.py"
-
-
-def scene_fit_inputs(wildcards):
-    """A scene's solve and, with optics, its rendered areas."""
-    folder = scene_dir(wildcards.material, wildcards.sphere, wildcards.scene)
-    inputs = {"solve": f"{folder}/solve.json"}
-    if SCENES[wildcards.scene]["optics"] == "microscope":
-        inputs["render"] = f"{folder}/render.csv"
-    return inputs
 
 
 rule fit_scene:

@@ -80,3 +80,21 @@ def _decoded(value):
         except json.JSONDecodeError:
             return value
     return value.item() if isinstance(value, np.generic) else value
+
+
+def write_levelled_map(path: str | Path, heights_m: np.ndarray, pixel_m: float, attrs: Mapping):
+    """A levelled AFM map (heights in m, square pixels of ``pixel_m``) with its sphere fit and
+    provenance as attributes, atomically."""
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+        dataset = h5.create_dataset("heights", data=np.asarray(heights_m), compression="gzip")
+        dataset.attrs["unit"] = "m"
+        h5.attrs["pixel_m"] = pixel_m
+        for key, value in attrs.items():
+            h5.attrs[key] = _attribute(value)
+
+
+def read_levelled_map(path: str | Path) -> tuple[np.ndarray, float, dict]:
+    """(heights in m, pixel in m, attributes) as written by write_levelled_map."""
+    with h5py.File(path, "r") as h5:
+        attrs = {key: _decoded(value) for key, value in h5.attrs.items()}
+        return h5["heights"][()], float(attrs.pop("pixel_m")), attrs

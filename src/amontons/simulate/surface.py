@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from amontons.contact.surfaces import self_affine, sphere
-from amontons.measure.topography import level_sphere
+from amontons.measure.topography import level_sphere, sphere_cap
 from amontons.physics.roughness import roughness_statistics
 from amontons.simulate.scene import Scene, SceneError
 
@@ -75,20 +75,55 @@ def _statistics(heights: np.ndarray, pixel_m: float) -> dict:
     }
 
 
-def afm_indenter(heights: np.ndarray, pixel_m: float, scene: Scene, source: str) -> Indenter:
-    """The scene's indenter from a sphere's AFM map (heights m, square pixels of ``pixel_m``):
-    levelled, cut to the scene's window about the fitted apex and area-averaged to the solver
-    pixel. A window that leaves the scan raises SceneError naming ``source`` and the sizes."""
+@dataclass(frozen=True)
+class LevelledMap:
+    """An AFM map levelled by the topography step: heights (m) with the scan-line offsets
+    removed and the sphere kept, square pixels (m), the fitted sphere (radius m; apex (x, y) m
+    from the map centre; apex height m)."""
+
+    heights_m: np.ndarray
+    pixel_m: float
+    radius_m: float
+    apex_xy_m: tuple[float, float]
+    apex_height_m: float
+
+    @property
+    def roughness_m(self) -> np.ndarray:
+        """The map minus the fitted sphere, about its mean, m."""
+        cap = sphere_cap(self.heights_m.shape, self.pixel_m, self.radius_m, self.apex_xy_m)
+        rough = self.heights_m - cap
+        return rough - rough.mean()
+
+    def to_attributes(self) -> dict:
+        return {
+            "radius_m": self.radius_m,
+            "apex_xy_m": list(self.apex_xy_m),
+            "apex_height_m": self.apex_height_m,
+        }
+
+
+def level_afm_map(heights: np.ndarray, pixel_m: float) -> LevelledMap:
+    """Level a sphere's AFM map with the topography step's sphere fit and scan-line alignment
+    (:func:`amontons.measure.topography.level_sphere`)."""
     fit = level_sphere(heights, pixel_m)
-    levelled = heights - fit.line_offsets[:, None]
+    return LevelledMap(
+        heights - fit.line_offsets[:, None], pixel_m, fit.radius_m, fit.apex_xy_m, fit.apex_height_m
+    )
+
+
+def afm_indenter(levelled: LevelledMap, scene: Scene, source: str) -> Indenter:
+    """The scene's indenter from a sphere's levelled AFM map: cut to the scene's window about
+    the fitted apex and area-averaged to the solver pixel. A window that leaves the scan
+    raises SceneError naming ``source`` and the sizes."""
+    heights, pixel_m = levelled.heights_m, levelled.pixel_m
     n = scene.side_px
     window = n * scene.pixel_m
     n0, n1 = heights.shape
     # apex_xy_m is (x, y) = (col, row) from the map centre
-    apex_rc = (fit.apex_xy_m[1] + n0 * pixel_m / 2, fit.apex_xy_m[0] + n1 * pixel_m / 2)
+    apex_rc = (levelled.apex_xy_m[1] + n0 * pixel_m / 2, levelled.apex_xy_m[0] + n1 * pixel_m / 2)
     origin = (apex_rc[0] - window / 2, apex_rc[1] - window / 2)
     try:
-        solver = area_average(levelled, pixel_m, origin, n, scene.pixel_m)
+        solver = area_average(heights, pixel_m, origin, n, scene.pixel_m)
     except ValueError as error:
         raise SceneError(
             f"{source}: scene {scene.name}: the solver window ({window * 1e6:.1f} µm about the "
@@ -96,13 +131,13 @@ def afm_indenter(heights: np.ndarray, pixel_m: float, scene: Scene, source: str)
             f"{pixel_m * 1e9:.1f} nm): {error}; expected a scan that covers the window "
             "(lower window_factor or side_px, or scan a larger field)"
         ) from error
-    roughness = solver - sphere(solver.shape, scene.pixel_m, fit.radius_m)
+    roughness = solver - sphere(solver.shape, scene.pixel_m, levelled.radius_m)
     centre = (origin[0] + window / 2 - n0 * pixel_m / 2, origin[1] + window / 2 - n1 * pixel_m / 2)
     return Indenter(
         heights=solver - solver.max(),
         spacing_m=scene.pixel_m,
         centre_in_scan_m=centre,
-        afm_statistics=_statistics(fit.roughness, pixel_m),
+        afm_statistics=_statistics(levelled.roughness_m, pixel_m),
         solver_statistics=_statistics(roughness, scene.pixel_m),
     )
 

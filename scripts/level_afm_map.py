@@ -1,0 +1,47 @@
+"""Rule level_afm_map: a sphere's AFM map before contact, levelled once for all its scenes."""
+
+import logging
+
+from amontons.io.fields import write_levelled_map
+from amontons.io.heightmap import read_height_map
+from amontons.measure.topography import square_pixels
+from amontons.runlog import run_logged
+from amontons.simulate.surface import level_afm_map
+
+log = logging.getLogger(__name__)
+
+
+def main(afm_before: str, levelled_path: str, afm: dict) -> None:
+    height_map = square_pixels(
+        read_height_map(
+            afm_before,
+            fallback_pixel_m=None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
+            nan_policy=afm["nan_policy"],
+            channel=afm["channel"],
+        )
+    )
+    levelled = level_afm_map(height_map.heights, height_map.pixel_m)
+    log.info(
+        "%s: %d × %d px of %.1f nm, fitted radius %.4f mm",
+        afm_before,
+        *height_map.heights.shape,
+        height_map.pixel_m * 1e9,
+        levelled.radius_m * 1e3,
+    )
+    write_levelled_map(
+        levelled_path,
+        levelled.heights_m,
+        levelled.pixel_m,
+        {**levelled.to_attributes(), "source": afm_before},
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        afm_before=sm.input.afm_before,
+        levelled_path=sm.output.levelled,
+        afm=sm.params.afm,
+    )
