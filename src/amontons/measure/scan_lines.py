@@ -31,6 +31,10 @@ STEP_THRESHOLD_SD = 6.0
 # Running median that carries the smooth part of the steps (form the sphere fit left, long
 # roughness waves): 9 rows ignore the two opposite steps of a single shifted line.
 _TREND_ROWS = 9
+# The rows are offset throughout (not at a few lines) when their steps' robust sd exceeds this
+# many step-noise sd: without offsets the ratio is 1 (±7 % over 256 rows; a few shifted lines
+# move it by ~10 %), with a 2 nm offset on every row of a 1 nm-noise map ~25.
+THROUGHOUT_RATIO = 1.5
 _MAD_TO_SD = 1.4826  # σ of a normal population per median absolute deviation
 _MIN_LINES = 2 * _TREND_ROWS
 # A block of at most this many shifted rows (half the trend window) is bounded by a step and
@@ -47,14 +51,17 @@ class LineLevelling:
     """What was done to a map's scan lines.
 
     ``offsets_m`` per row (m, removed from the map; zeros when nothing was applied),
-    ``stepped_rows`` the number of row-to-row steps taken as offsets, ``step_noise_m`` the
-    robust sd of the column-to-column steps against which a step is judged (m).
+    ``stepped_rows`` the number of row-to-row steps taken as offsets, ``every_row`` whether
+    every row was aligned to the previous one (``on``, or ``auto`` on rows offset
+    throughout), ``step_noise_m`` the robust sd of the column-to-column steps against which
+    a step is judged (m).
     """
 
     mode: str
     applied: bool
     offsets_m: np.ndarray
     stepped_rows: int
+    every_row: bool
     step_noise_m: float
 
     def to_record(self) -> dict:
@@ -63,6 +70,7 @@ class LineLevelling:
             "mode": self.mode,
             "applied": self.applied,
             "stepped_rows": self.stepped_rows,
+            "every_row_aligned": self.every_row,
             "row_offset_rms_nm": float(np.sqrt(np.mean(self.offsets_m**2))) * 1e9,
             # None when the mode ('off') judged no step
             "step_threshold_nm": (
@@ -115,20 +123,40 @@ def step_noise(residual: np.ndarray) -> float:
     return _robust_sd(_detrended(column_steps(residual))) * np.sqrt(ny / nx)
 
 
-def outstanding_steps(residual: np.ndarray) -> tuple[np.ndarray, float]:
-    """The row-to-row offset steps (m; zero where a step does not stand out) and the step
-    noise (m).
+@dataclass(frozen=True)
+class _JudgedSteps:
+    """Row-to-row steps (m), whether each stands out, and the step noise (m)."""
 
-    A step stands out when it lies more than ``STEP_THRESHOLD_SD`` × :func:`step_noise` from
-    the running median of its neighbours. Its size is the step less the mean of the nearest
-    ordinary steps on either side: the surface's own slope along y at that row, which
-    correlates over a few rows (a running median of more rows leaves up to the roughness
-    step scatter in it).
-    """
+    steps: np.ndarray
+    outstanding: np.ndarray
+    noise: float
+
+    @property
+    def offset_throughout(self) -> bool:
+        """Whether most rows are offset, not a few: the typical row step (robust sd, which a
+        minority of outstanding steps does not move) then scatters more than an unshifted
+        step would, i.e. than the column steps do."""
+        return _robust_sd(_detrended(self.steps)) > THROUGHOUT_RATIO * self.noise
+
+
+def judge_steps(residual: np.ndarray) -> _JudgedSteps:
+    """The row-to-row steps of ``residual`` and which stand out: more than
+    ``STEP_THRESHOLD_SD`` × :func:`step_noise` from the running median of their neighbours."""
     steps = row_steps(residual)
     noise = step_noise(residual)
-    outstanding = np.abs(_detrended(steps)) > STEP_THRESHOLD_SD * noise
-    return _less_local_slope(steps, outstanding), noise
+    return _JudgedSteps(steps, np.abs(_detrended(steps)) > STEP_THRESHOLD_SD * noise, noise)
+
+
+def outstanding_steps(residual: np.ndarray) -> tuple[np.ndarray, float]:
+    """The row-to-row offset steps (m; zero where a step does not stand out,
+    :func:`judge_steps`) and the step noise (m).
+
+    A step's size is the step less the mean of the nearest ordinary steps on either side:
+    the surface's own slope along y at that row, which correlates over a few rows (a running
+    median of more rows leaves up to the roughness step scatter in it).
+    """
+    judged = judge_steps(residual)
+    return _less_local_slope(judged.steps, judged.outstanding), judged.noise
 
 
 def _less_local_slope(steps: np.ndarray, outstanding: np.ndarray) -> np.ndarray:
@@ -152,12 +180,17 @@ def _offsets_from_steps(steps: np.ndarray) -> np.ndarray:
 
 
 def _takes_back(steps: np.ndarray, first: int, later: int, tolerance_m: float) -> bool:
-    """Whether the step at row ``later`` undoes the one at ``first``: opposite signs, and
-    either a short block between them (their sum there is the local slope of the surface
-    along y, not an offset) or a sum within ``tolerance_m``."""
+    """Whether the step at row ``later`` undoes the one at ``first``: opposite signs, both
+    isolated (no outstanding step just before the first or just after the later: in a run of
+    outstanding steps every row is offset, and only their sum places them), and either a
+    short block between them (their sum there is the local slope of the surface along y,
+    not an offset) or a sum within ``tolerance_m``."""
     opposite = steps[first] * steps[later] < 0
+    isolated = (first == 0 or steps[first - 1] == 0) and (
+        later == steps.size - 1 or steps[later + 1] == 0
+    )
     short = later - first <= _SHORT_BLOCK_ROWS
-    return opposite and (short or abs(steps[first] + steps[later]) <= tolerance_m)
+    return opposite and isolated and (short or abs(steps[first] + steps[later]) <= tolerance_m)
 
 
 def _paired_offsets(steps: np.ndarray, tolerance_m: float) -> np.ndarray:
@@ -165,8 +198,9 @@ def _paired_offsets(steps: np.ndarray, tolerance_m: float) -> np.ndarray:
 
     A step followed by one that takes it back (:func:`_takes_back`) bounds a block of
     shifted rows, shifted by the mean of the two: summing the two noisy steps instead would
-    leave their sum as a false step under every later row. A step without its way back
-    shifts every later row.
+    leave their sum as a false step under every later row. Any other step shifts every later
+    row (so a run of outstanding steps, every row offset, is summed as the median of
+    differences does).
     """
     offsets = np.zeros(steps.size + 1)
     flagged = list(np.flatnonzero(steps))
@@ -184,8 +218,11 @@ def level_lines(residual: np.ndarray, mode: str = "auto") -> LineLevelling:
     """Scan-line offsets of ``residual`` (a height map with its form removed, m).
 
     ``auto``: offsets only at the steps that stand out (:func:`outstanding_steps`); none
-    when no step does. ``on``: every row aligned to the previous one by the median of their
-    differences (Gwyddion), which adds a random walk of the noise along y. ``off``: none.
+    when no step does; every row aligned, as ``on``, when the rows are offset throughout
+    (:attr:`_JudgedSteps.offset_throughout`: then the small offsets hide among the ordinary
+    steps, and leaving them would be the larger error). ``on``: every row aligned to the
+    previous one by the median of their differences (Gwyddion), which adds a random walk of
+    the noise along y. ``off``: none.
     """
     if mode not in LINE_LEVELLING_MODES:
         raise ScanLineError(
@@ -197,11 +234,12 @@ def level_lines(residual: np.ndarray, mode: str = "auto") -> LineLevelling:
             "rows and columns to tell an offset from the surface"
         )
     if mode == "off":
-        return LineLevelling(mode, False, np.zeros(residual.shape[0]), 0, float("nan"))
-    steps, noise = outstanding_steps(residual)
-    if mode == "on":
-        steps = row_steps(residual)
-        return LineLevelling(mode, True, _offsets_from_steps(steps), steps.size, noise)
-    stepped = int(np.count_nonzero(steps))
-    offsets = _paired_offsets(steps, STEP_THRESHOLD_SD * noise)
-    return LineLevelling(mode, stepped > 0, offsets, stepped, noise)
+        return LineLevelling(mode, False, np.zeros(residual.shape[0]), 0, False, float("nan"))
+    judged = judge_steps(residual)
+    if mode == "on" or (judged.outstanding.any() and judged.offset_throughout):
+        offsets = _offsets_from_steps(judged.steps)
+        return LineLevelling(mode, True, offsets, judged.steps.size, True, judged.noise)
+    sizes = _less_local_slope(judged.steps, judged.outstanding)
+    offsets = _paired_offsets(sizes, STEP_THRESHOLD_SD * judged.noise)
+    stepped = int(np.count_nonzero(sizes))
+    return LineLevelling(mode, stepped > 0, offsets, stepped, False, judged.noise)
