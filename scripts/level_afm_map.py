@@ -4,6 +4,7 @@ import logging
 
 from amontons.io.fields import write_levelled_map
 from amontons.io.heightmap import read_height_map
+from amontons.measure.scan_lines import line_levelling_mode
 from amontons.measure.topography import square_pixels
 from amontons.runlog import run_logged
 from amontons.simulate.surface import level_afm_map
@@ -20,7 +21,7 @@ def main(afm_before: str, levelled_path: str, afm: dict) -> None:
             channel=afm["channel"],
         )
     )
-    levelled = level_afm_map(height_map.heights, height_map.pixel_m)
+    levelled = level_afm_map(height_map.heights, height_map.pixel_m, line_levelling_mode(afm["line_levelling"]))
     log.info(
         "%s: %d × %d px of %.1f nm, fitted radius %.4f mm",
         afm_before,

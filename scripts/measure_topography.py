@@ -3,6 +3,7 @@
 import logging
 
 from amontons.io.files import write_json
+from amontons.measure.scan_lines import line_levelling_mode
 from amontons.measure.topography import measure_topography
 from amontons.plots import plot_topography
 from amontons.runlog import run_logged
@@ -18,6 +19,7 @@ def main(
     afm_pixel_nm: float | None,
     nan_policy: str,
     channel: str | None,
+    line_levelling: str | bool,
     data_label: str,
     sphere: str,
 ) -> None:
@@ -27,14 +29,20 @@ def main(
         None if afm_pixel_nm is None else afm_pixel_nm * 1e-9,
         nan_policy=nan_policy,
         channel=channel,
+        line_levelling=line_levelling_mode(line_levelling),
     )
+    flattening = topo.flattening
     log.info(
-        "%s: R = %.3f mm, h_rms %.1f nm, h' %.3f, flattening %.1f nm",
+        "%s: R = %.3f mm, h_rms %.1f nm, h' %.3f, flattening %s nm (%s); lines levelled: "
+        "before %s, after %s",
         sphere,
         topo.before.radius_m * 1e3,
         topo.before_statistics.h_rms_m * 1e9,
         topo.before_statistics.slope_rms,
-        topo.max_flattening_m * 1e9,
+        "none" if flattening.depth_m is None else f"{flattening.depth_m * 1e9:.2f}",
+        flattening.flag or "resolved",
+        topo.before.line_levelling.applied,
+        topo.after.line_levelling.applied,
     )
     write_json(topography_path, topo.to_record())
     plot_topography(
@@ -59,6 +67,7 @@ if __name__ == "__main__":
         afm_pixel_nm=sm.params.afm_pixel_nm,
         nan_policy=sm.params.nan_policy,
         channel=sm.params.channel,
+        line_levelling=sm.params.line_levelling,
         data_label=sm.params.data_label,
         sphere=sm.wildcards.sphere,
     )

@@ -101,6 +101,18 @@ def test_wrong_type_names_key_value_and_expectation(repo, config_schema):
         validate(config, config_schema, "my.yaml")
 
 
+def test_line_levelling_takes_yaml_on_and_off_and_names_a_wrong_mode(repo, config_schema):
+    """YAML reads an unquoted on/off as true/false: both spellings pass the schema; any other
+    value is refused naming the key and the allowed values."""
+    config = _config(repo)
+    for text in ("auto", "on", "off", "'off'"):
+        config["surface"]["line_levelling"] = yaml.safe_load(f"v: {text}")["v"]
+        validate(config, config_schema, "my.yaml")
+    config["surface"]["line_levelling"] = "always"
+    with pytest.raises(ConfigError, match=r"surface\.line_levelling = 'always'.*'auto', 'on'"):
+        validate(config, config_schema, "my.yaml")
+
+
 @pytest.mark.parametrize("loads", ["25,50,50,100", "25,100,50", "0,25"])
 def test_loads_must_be_positive_and_strictly_increasing(loads):
     with pytest.raises(ConfigError, match="loads_mn"):

@@ -10,12 +10,8 @@ import tifffile
 from amontons.io.heightmap import HeightMap
 from amontons.io.layout import RawDataError, afm_file
 from amontons.io.tiff import read_image, write_image
-from amontons.measure.topography import (
-    measure_topography,
-    sphere_cap,
-    square_pixels,
-    unchanged_level,
-)
+from amontons.measure.flattening import unchanged_level
+from amontons.measure.topography import measure_topography, sphere_cap, square_pixels
 
 PIXEL = 32e-9
 

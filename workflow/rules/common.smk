@@ -317,6 +317,7 @@ def afm_reading():
         {
             "nan_policy": config["surface"]["afm_nan_policy"],
             "channel": config["surface"]["afm_channel"],
+            "line_levelling": config["surface"]["line_levelling"],
         }
     )
 

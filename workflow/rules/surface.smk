@@ -28,6 +28,7 @@ rule measure_topography:
         afm_pixel_nm=lambda wc: sheet_value(wc.sphere, "afm_pixel_nm"),
         nan_policy=config["surface"]["afm_nan_policy"],
         channel=config["surface"]["afm_channel"],
+        line_levelling=config["surface"]["line_levelling"],
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_topography.py"

@@ -1,5 +1,6 @@
-"""AFM topography of a sphere (docs/models.md §1.8): levelling by a sphere fit and scan-line
-alignment, roughness statistics, and the plastic flattening between two scans (Fig. B.9).
+"""AFM topography of a sphere (docs/models.md §1.8): levelling by a sphere fit and, where the
+scan lines are offset, line levelling; roughness statistics, and the plastic flattening between
+two scans (Fig. B.9).
 
 Heights are in metres, positive towards the cover slip (the apex of the sphere is the maximum);
 the height maps are read by amontons.io.heightmap.
@@ -15,6 +16,8 @@ from scipy import ndimage, optimize
 
 from amontons.io.heightmap import HeightMap, TopographyError, read_height_map
 from amontons.io.layout import RawDataError
+from amontons.measure.flattening import Flattening, measure_flattening
+from amontons.measure.scan_lines import LineLevelling, ScanLineError, level_lines
 from amontons.physics.roughness import RoughnessStatistics, roughness_statistics
 
 
@@ -23,14 +26,20 @@ class SphereFit:
     """Least-squares sphere through a height map.
 
     radius_m, apex (x, y) in m from the map centre, apex height in m; ``roughness`` is the map
-    minus the sphere (and minus scan-line offsets, when removed), m; ``line_offsets`` per row, m.
+    minus the sphere (and minus scan-line offsets, when removed), m; ``line_levelling`` what
+    was done to the scan lines.
     """
 
     radius_m: float
     apex_xy_m: tuple[float, float]
     apex_height_m: float
     roughness: np.ndarray
-    line_offsets: np.ndarray
+    line_levelling: LineLevelling
+
+    @property
+    def line_offsets(self) -> np.ndarray:
+        """Offset removed from each row, m (zeros when no line was levelled)."""
+        return self.line_levelling.offsets_m
 
 
 def _coordinates(shape, pixel_m):
@@ -74,25 +83,23 @@ def _fit_sphere_once(heights, pixel_m):
     return float(r_), (float(x_), float(y_)), float(z_)
 
 
-def scan_line_offsets(residual: np.ndarray) -> np.ndarray:
-    """Per-row offsets (m) by the median of differences between consecutive rows (Gwyddion's
-    'median of differences' row alignment): steps between rows are taken as offsets, smooth
-    roughness contributes little because neighbouring rows are strongly correlated."""
-    steps = np.median(np.diff(residual, axis=0), axis=1)
-    offsets = np.concatenate([[0.0], np.cumsum(steps)])
-    return offsets - np.median(offsets)
-
-
-def level_sphere(heights: np.ndarray, pixel_m: float, *, align_rows: bool = True) -> SphereFit:
-    """Fit a sphere, remove scan-line offsets from the residual, refit on corrected data."""
+def level_sphere(heights: np.ndarray, pixel_m: float, *, line_levelling: str = "auto") -> SphereFit:
+    """Fit a sphere; level the scan lines of the residual as ``line_levelling`` says
+    (:func:`amontons.measure.scan_lines.level_lines`: ``auto``, ``on``, ``off``) and, if any
+    offset was removed, refit the sphere on the corrected map."""
     radius, apex, z0 = _fit_sphere_once(heights, pixel_m)
-    offsets = np.zeros(heights.shape[0])
-    if align_rows:
-        residual = heights - sphere_cap(heights.shape, pixel_m, radius, apex, z0)
-        offsets = scan_line_offsets(residual)
-        radius, apex, z0 = _fit_sphere_once(heights - offsets[:, None], pixel_m)
-    roughness = heights - offsets[:, None] - sphere_cap(heights.shape, pixel_m, radius, apex, z0)
-    return SphereFit(radius, apex, z0, roughness - roughness.mean(), offsets)
+    try:
+        lines = level_lines(
+            heights - sphere_cap(heights.shape, pixel_m, radius, apex, z0), line_levelling
+        )
+    except ScanLineError as error:
+        raise TopographyError(str(error)) from error
+    if lines.applied:
+        radius, apex, z0 = _fit_sphere_once(heights - lines.offsets_m[:, None], pixel_m)
+    roughness = (
+        heights - lines.offsets_m[:, None] - sphere_cap(heights.shape, pixel_m, radius, apex, z0)
+    )
+    return SphereFit(radius, apex, z0, roughness - roughness.mean(), lines)
 
 
 @dataclass(frozen=True)
@@ -103,7 +110,9 @@ class Topography:
     after: SphereFit
     before_statistics: RoughnessStatistics
     after_statistics: RoughnessStatistics
-    change_m: np.ndarray  # after − before, the unchanged points at 0, m
+    flattening: Flattening  # after − before: the change map and the depth of the flattening
+    line_levelling: str  # the mode asked for: auto, on or off
+    difference_levelling: LineLevelling  # scan-line offsets removed from after − before
     pixel_m: float
     filled_pixels: int
     nan_policy: str
@@ -113,9 +122,9 @@ class Topography:
     channel: str | None  # the files' height channel read (None: a file of one channel)
 
     @property
-    def max_flattening_m(self) -> float:
-        """The deepest flattening, m: the largest drop of after below before."""
-        return float(-self.change_m.min())
+    def change_m(self) -> np.ndarray:
+        """after − before, the points that did not flow at 0, m."""
+        return self.flattening.change_m
 
     def to_record(self) -> dict:
         """JSON-ready record, units in the key names."""
@@ -129,8 +138,9 @@ class Topography:
             }
 
         return {
-            "quantity": "AFM topography levelled by a sphere fit and scan-line alignment; "
-            "statistics at the AFM pixel",
+            "quantity": "AFM topography levelled by a sphere fit (and scan-line levelling where "
+            "lines are offset); statistics at the AFM pixel; flattening = median depth of the "
+            "smoothed drop over the region that flowed",
             "pixel_nm": self.pixel_m * 1e9,
             "shape_px": list(self.change_m.shape),
             "file_pixel_nm": {"x": self.file_pixel_m[0] * 1e9, "y": self.file_pixel_m[1] * 1e9},
@@ -138,7 +148,13 @@ class Topography:
             "channel": self.channel,
             "before": statistics(self.before, self.before_statistics),
             "after": statistics(self.after, self.after_statistics),
-            "max_flattening_nm": self.max_flattening_m * 1e9,
+            **self.flattening.to_record(),
+            "line_levelling": {
+                "mode": self.line_levelling,
+                "before": self.before.line_levelling.to_record(),
+                "after": self.after.line_levelling.to_record(),
+                "difference": self.difference_levelling.to_record(),
+            },
             "filled_nan_pixels": self.filled_pixels,
             "nan_policy": self.nan_policy,
             "before_file": str(self.before_path),
@@ -162,25 +178,6 @@ def square_pixels(height_map: HeightMap) -> HeightMap:
     return replace(height_map, heights=heights, pixel_m=pixel, pixel_y_m=pixel)
 
 
-def unchanged_level(change_m: np.ndarray, bin_m: float = 0.25e-9) -> float:
-    """The height change (m) of the points that did not flow: the mode of after − before.
-
-    Two AFM scans share no absolute height, and flattened points are not a minority near a
-    large contact, so neither 0 nor the median is the reference; the points that never
-    touched (most of a rough sphere, even inside the contact) form a peak as narrow as the
-    scan noise.
-    """
-    low, high = np.percentile(change_m, [0.5, 99.5])
-    if high - low < bin_m:
-        return float(np.median(change_m))  # nothing flowed: one narrow population
-    bins = int(np.ceil((high - low) / bin_m))
-    counts, edges = np.histogram(change_m, bins=bins, range=(low, high))
-    peak = int(np.argmax(counts))
-    # the peak bin locates the population; its median places it to better than a bin
-    inside = change_m[(change_m >= edges[peak] - bin_m) & (change_m <= edges[peak + 1] + bin_m)]
-    return float(np.median(inside))
-
-
 def measure_topography(
     before_path: str | Path,
     after_path: str | Path,
@@ -188,12 +185,14 @@ def measure_topography(
     *,
     nan_policy: str,
     channel: str | None = None,
+    line_levelling: str = "auto",
 ) -> Topography:
-    """Level both scans (sphere fit, scan-line offsets) and take their roughness statistics and
-    their difference, the plastic flattening (appendix Fig. B.9). Both scans must cover the
-    same field on the same grid (a repeated scan of the same area). ``channel`` names the
-    height channel of a vendor file (None: the format's default). Scans with non-square pixels
-    are resampled to square ones first (:func:`square_pixels`)."""
+    """Level both scans (sphere fit, scan-line offsets as ``line_levelling`` says: ``auto``,
+    ``on``, ``off``) and take their roughness statistics and their difference, the plastic
+    flattening (appendix Fig. B.9; :func:`amontons.measure.flattening.measure_flattening`).
+    Both scans must cover the same field on the same grid (a repeated scan of the same area).
+    ``channel`` names the height channel of a vendor file (None: the format's default). Scans
+    with non-square pixels are resampled to square ones first (:func:`square_pixels`)."""
     files = []
     for path in (before_path, after_path):
         try:
@@ -224,11 +223,13 @@ def measure_topography(
             f"the field of {before.path} ({before.heights.shape} px of "
             f"{before.pixel_m * 1e9:.4g} nm)"
         )
-    fits = [level_sphere(m.heights, m.pixel_m) for m in maps]
-    # No row alignment of the difference: near a large contact most of a row may have flowed,
-    # so row statistics would eat the flattening; the scan-line offsets (a few nm on a few
-    # rows) stay in it, which the report's tolerance allows for.
-    change = after.heights - before.heights
+    try:
+        fits = [level_sphere(m.heights, m.pixel_m, line_levelling=line_levelling) for m in maps]
+    except TopographyError as error:
+        raise RawDataError(f"{before.path}, {after.path}: {error}") from error
+    difference, difference_lines = _levelled_difference(
+        after.heights - before.heights, line_levelling
+    )
     return Topography(
         file_pixel_m=(files[0].pixel_m, files[0].pixel_y_m),
         channel=files[0].channel,
@@ -236,10 +237,24 @@ def measure_topography(
         after=fits[1],
         before_statistics=roughness_statistics(fits[0].roughness, before.pixel_m),
         after_statistics=roughness_statistics(fits[1].roughness, after.pixel_m),
-        change_m=change - unchanged_level(change),
+        flattening=measure_flattening(difference, before.pixel_m),
+        line_levelling=line_levelling,
+        difference_levelling=difference_lines,
         pixel_m=before.pixel_m,
         filled_pixels=before.filled + after.filled,
         nan_policy=nan_policy,
         before_path=Path(before_path),
         after_path=Path(after_path),
     )
+
+
+def _levelled_difference(difference: np.ndarray, mode: str) -> tuple[np.ndarray, LineLevelling]:
+    """after − before without the scan-line offsets of either scan (m).
+
+    The scans share their roughness, so offsets stand out of their difference far more
+    clearly than of either scan. Only outstanding steps are removed, also when every row of
+    the scans is aligned (``on``): near a large contact most of a row may have flowed, and
+    aligning every row would take the flattening into the offsets.
+    """
+    lines = level_lines(difference, "off" if mode == "off" else "auto")
+    return difference - lines.offsets_m[:, None], lines

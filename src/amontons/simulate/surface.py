@@ -102,12 +102,16 @@ class LevelledMap:
         }
 
 
-def level_afm_map(heights: np.ndarray, pixel_m: float) -> LevelledMap:
-    """Level a sphere's AFM map with the topography step's sphere fit and scan-line alignment
-    (:func:`amontons.measure.topography.level_sphere`)."""
-    fit = level_sphere(heights, pixel_m)
+def level_afm_map(heights: np.ndarray, pixel_m: float, line_levelling: str = "auto") -> LevelledMap:
+    """Level a sphere's AFM map with the topography step's sphere fit and scan-line levelling
+    (:func:`amontons.measure.topography.level_sphere`; ``line_levelling`` auto, on or off)."""
+    fit = level_sphere(heights, pixel_m, line_levelling=line_levelling)
     return LevelledMap(
-        heights - fit.line_offsets[:, None], pixel_m, fit.radius_m, fit.apex_xy_m, fit.apex_height_m
+        heights - fit.line_levelling.offsets_m[:, None],
+        pixel_m,
+        fit.radius_m,
+        fit.apex_xy_m,
+        fit.apex_height_m,
     )
 
 

@@ -19,7 +19,7 @@ from amontons.io.heightmap import write_height_map
 from amontons.io.layout import AFM_AFTER_NAME, AFM_BEFORE_NAME
 from amontons.io.tiff import write_image
 from amontons.physics.beer_lambert import EPSILON_M2_PER_MOL, surface_density_per_m2
-from amontons.physics.roughness import roughness_statistics
+from amontons.physics.roughness import flattening_depth, roughness_statistics
 from amontons.simulate.grid import resample_points
 from amontons.virtual.absorbance import absorbance_spectrum
 from amontons.virtual.afm import MAX_APEX_OFFSET, AfmSettings, afm_to_microscope, scan_artefacts
@@ -242,5 +242,13 @@ def write_afm_scans(
         "slope_rms": stats.slope_rms,
         "curvature_rms_per_um": stats.curvature_rms_per_m * 1e-6,
         "max_plastic_depth_nm": float((before - after).max() * 1e9),
+        # the measurement's depth statistic on the noise-free scans (docs/models.md §1.8),
+        # at its smoothing (physics.roughness.FLATTENING_SMOOTHING_PX)
+        "flattening_depth_nm": _depth_nm(before - after),
         "flattened_fraction": float(np.mean(after < before)),
     }
+
+
+def _depth_nm(drop_m: np.ndarray) -> float | None:
+    depth, _ = flattening_depth(drop_m)
+    return None if depth is None else depth * 1e9
