@@ -21,7 +21,9 @@ def main(afm_before: str, levelled_path: str, afm: dict) -> None:
             channel=afm["channel"],
         )
     )
-    levelled = level_afm_map(height_map.heights, height_map.pixel_m, line_levelling_mode(afm["line_levelling"]))
+    levelled = level_afm_map(
+        height_map.heights, height_map.pixel_m, line_levelling_mode(afm["line_levelling"])
+    )
     log.info(
         "%s: %d × %d px of %.1f nm, fitted radius %.4f mm",
         afm_before,
