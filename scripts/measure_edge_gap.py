@@ -47,6 +47,7 @@ def main(
             ),
             mask_closing_m=newton_rings["mask_closing_um"] * 1e-6,
             margin_m=newton_rings["undetermined_margin_nm"] * 1e-9,
+            spread_margin_m=newton_rings["undetermined_spread_nm"] * 1e-9,
         )
     except NotMeasurable as error:
         # A rough sphere scatters its rings, an image may show no contact: the gap is not

@@ -90,6 +90,16 @@ def test_a_resolved_gap_near_zero_stays_a_number():
     assert undetermined_reason(interval, MARGIN) is None
 
 
+def test_a_gap_near_zero_whose_profiles_scatter_by_the_roughness_stays_a_number():
+    """The full reproduction's virtual glass sphere (2026-11-23): 40 profiles with sd 4.2 nm
+    around 1.6 nm (truth 0.8 nm), interval -0.8 to 4.0 nm. Single profiles scatter by more
+    than the mean (the sphere's 3 nm roughness under the rings), but by far less than the
+    10 nm spread margin at which profiles stop measuring one edge: a number."""
+    gaps = 1.6 + 4.2 * np.random.default_rng(3).standard_normal(40)
+    gaps = (gaps - gaps.mean()) / gaps.std(ddof=1) * 4.2 + 1.6
+    assert undetermined_reason(_interval(gaps), MARGIN) is None
+
+
 def test_profiles_scattering_more_than_their_mean_are_undetermined():
     # The issue's patchy sphere: 26 ± 44 nm (sd) over 40 profiles, single profiles −23 to
     # +142 nm. Its mean's interval (±14 nm) is narrower than 26 nm, but single profiles

@@ -83,19 +83,25 @@ def gap_interval(gaps_m: np.ndarray, angles_rad: np.ndarray) -> GapInterval:
     return GapInterval(mean, sd, se, mean - half, mean + half, n, n_eff)
 
 
-def undetermined_reason(interval: GapInterval, margin_m: float) -> str | None:
+def undetermined_reason(
+    interval: GapInterval, margin_m: float, spread_margin_m: float = 10e-9
+) -> str | None:
     """Why the mean edge gap is not a measurement, or None when it is.
 
-    The rule (docs/models.md §1.5), with m = ``margin_m``: the gap is undetermined when
-    - the profiles disagree by more than the gap: their sd > max(|mean|, m). A mean of
+    The rule (docs/models.md §1.5), with m = ``margin_m`` and s = ``spread_margin_m``: the gap
+    is undetermined when
+    - the profiles disagree by more than the gap: their sd > max(|mean|, s). A mean of
       profiles that scatter more than it (a patchy contact: edges from 1 to 14 µm, rings
       misnumbered by a patch, single gaps from −20 to +150 nm) is no single gap at the edge;
     - its 95 % interval (:func:`gap_interval`) is wider than the gap: half-width >
       max(|mean|, m); or
     - that interval reaches below −m. A gap cannot be negative; an interval that reaches
       there says the extrapolated curve does not describe the profiles.
-    The margin keeps a well-resolved gap near 0 a number: the smooth virtual glass sphere's
-    profiles scatter by an sd of ~3 nm around a mean within 2 nm of its truth.
+    The margins keep a well-resolved gap near 0 a number: the virtual glass sphere's profiles
+    scatter by an sd of 3-4 nm (its 3 nm roughness under the rings) around a mean within 2 nm
+    of its truth. The spread margin s (10 nm, an eighth of the first ring's gap λ/4n = 84 nm)
+    separates profiles that cross one edge at the ring fit's precision from profiles that do
+    not measure one gap (the patchy sphere: sd 48 nm).
     """
     nm = 1e9
     mean, half, sd = interval.mean_m, interval.half_width_m, interval.sd_m
@@ -104,7 +110,7 @@ def undetermined_reason(interval: GapInterval, margin_m: float) -> str | None:
         f"{interval.high_m * nm:.1f} nm, profiles' sd {sd * nm:.1f} nm over {interval.n} "
         "half-profiles"
     )
-    if sd > max(abs(mean), margin_m):
+    if sd > max(abs(mean), spread_margin_m):
         return f"undetermined: single profiles scatter more than the mean gap ({figures})"
     if half > max(abs(mean), margin_m):
         return f"undetermined: the 95 % interval is wider than the gap itself ({figures})"
@@ -141,6 +147,7 @@ class EdgeGap:
     equal_area_radius_m: float  # radius of the disc with the filled mask's area
     mask_closing_m: float
     margin_m: float
+    spread_margin_m: float
     fluorescence_path: Path
     reflection_path: Path
     load_mn: float
@@ -173,9 +180,10 @@ class EdgeGap:
             "edge_gap_nm": None if self.undetermined else _gap_record(self.interval),
             "undetermined_edge_gap_nm": _gap_record(self.interval) if self.undetermined else None,
             "flag": "; ".join(f for f in (self.undetermined, refused) if f) or None,
-            "undetermined_rule": "null when the profiles' sd or the 95 % interval's half-width "
-            f"exceeds both |mean| and {self.margin_m * nm:g} nm, or the interval's lower end lies "
-            f"below -{self.margin_m * nm:g} nm",
+            "undetermined_rule": "null when the profiles' sd exceeds both |mean| and "
+            f"{self.spread_margin_m * nm:g} nm, the 95 % interval's half-width exceeds both "
+            f"|mean| and {self.margin_m * nm:g} nm, or the interval's lower end lies below "
+            f"-{self.margin_m * nm:g} nm",
             "edge_model": rings.edge_model,
             "edge_gaps_nm": (rings.edge_gaps_m * nm).tolist(),
             "edge_radii_um": (rings.edge_radii_m * um).tolist(),
@@ -249,6 +257,7 @@ def measure_edge_gap(
     hertz_radius_m: float | None = None,
     mask_closing_m: float = 0.25e-6,
     margin_m: float = 4e-9,
+    spread_margin_m: float = 10e-9,
 ) -> EdgeGap:
     """Gap at the contact edge from the reflection image (appendix Figs. B.6, B.7).
 
@@ -262,14 +271,15 @@ def measure_edge_gap(
     the E* sensitivity that every model reports) as in
     amontons.measure.newton_rings.newton_ring_gap; bright rings sit at the gaps
     (m + ½)·``wavelength_m``/2``n_medium``. ``load_mn`` is the load of both images.
-    ``margin_m``: the resolution margin of :func:`undetermined_reason`.
+    ``margin_m`` and ``spread_margin_m``: the margins of :func:`undetermined_reason`.
 
     Raises NoContact if the fluorescence image shows no contact, RingsUnreadable if the
     rings cannot be numbered; an unresolved mean comes back with ``undetermined`` set.
     """
-    if mask_closing_m < 0 or margin_m < 0:
+    if mask_closing_m < 0 or margin_m < 0 or spread_margin_m < 0:
         raise ValueError(
-            f"mask closing {mask_closing_m} m and margin {margin_m} m; expected both ≥ 0"
+            f"mask closing {mask_closing_m} m, margins {margin_m} and {spread_margin_m} m; "
+            "expected all ≥ 0"
         )
     fluorescence = read_fluorescence(fluorescence_path, fallback_pixel_m)
     area = separated_contact(fluorescence, otsu)
@@ -304,11 +314,12 @@ def measure_edge_gap(
     return EdgeGap(
         rings=rings,
         interval=interval,
-        undetermined=undetermined_reason(interval, margin_m),
+        undetermined=undetermined_reason(interval, margin_m, spread_margin_m),
         centre_px=centre,
         equal_area_radius_m=equal_area,
         mask_closing_m=closing_px * pixel,
         margin_m=margin_m,
+        spread_margin_m=spread_margin_m,
         fluorescence_path=fluorescence.path,
         reflection_path=reflection.path,
         load_mn=load_mn,

@@ -23,11 +23,9 @@ def resample(
     """``field`` (on a grid of ``spacing_m`` about its centre) at the positions (m) given by
     the outer product of ``rows_m`` and ``cols_m``; spline ``order`` 0, 1 or 3; ``mode`` as in
     scipy.ndimage.map_coordinates ('constant' is 0 outside)."""
-    n0, n1 = field.shape
-    r = (n0 - 1) / 2 + np.asarray(rows_m) / spacing_m
-    c = (n1 - 1) / 2 + np.asarray(cols_m) / spacing_m
-    rr, cc = np.meshgrid(r, c, indexing="ij")
-    return ndimage.map_coordinates(field, [rr, cc], order=order, mode=mode, cval=0.0)
+    rows = np.asarray(rows_m)[:, None]
+    cols = np.asarray(cols_m)[None, :]
+    return resample_points(field, spacing_m, rows, cols, order, mode)
 
 
 def resample_points(
