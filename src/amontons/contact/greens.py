@@ -15,7 +15,7 @@ Periodic
 Non-periodic
     Love (1929) / Johnson (1985, eq. 3.25): displacement at offset ``(x, y)`` from the
     centre of a ``2a × 2b`` rectangle carrying unit uniform pressure. Its value at the
-    centre of a square (``a = b``) is ``(4a / (π E*)) ln(1 + √2) · 2 = 2.2446 a / E*``.
+    centre of a square (``a = b``) is ``(4a / (π E*)) ln(1 + √2) · 2 = 2.2444 a / E*``.
     It is sampled at wrapped offsets on the Hockney-padded ``2n0 × 2n1`` grid so that a
     circular convolution on the padded grid is the exact free-space convolution on the
     ``n0 × n1`` window.
