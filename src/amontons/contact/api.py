@@ -8,6 +8,7 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .cg import polonsky_keer
 from .convolution import get_operator
@@ -86,8 +87,12 @@ def solve(
     max_iter : int, optional
         Conjugate-gradient iteration cap per solve on the finest grid (default
         ``1000 + 4(n0 + n1)``).
-    threads : int
-        FFTW threads (ignored, with a warning, by the numpy backend).
+    threads : int or None
+        FFTW threads; None means every core this process may use (its CPU affinity). The
+        numpy FFT backend is serial (a warning says so when threads > 1). Every other native
+        thread pool (OpenBLAS, OpenMP) is held to one thread for the duration of the call and
+        the caller's limits are restored after it, also on an exception: the CG's BLAS calls
+        are level 1, and their threads cost more than they bring.
     warm_start : array_like, optional
         Initial pressure, Pa (e.g. the pressure of a previous, nearby solve).
     coarse_to_fine : bool
@@ -180,17 +185,23 @@ def solve(
         coarse_to_fine=coarse_to_fine,
         warm_start=warm_start is not None,
     )
-    return _solve_step(
-        h,
-        spacing,
-        e_star,
-        opts,
-        load=load,
-        displacement=displacement,
-        warm_start=warm_start,
-        plastic_prev=plastic_prev,
-        coarse_to_fine=bool(coarse_to_fine),
-    )
+    # Every native pool (OpenBLAS, OpenMP) runs one thread for the call and is restored after
+    # it, also on an exception. The CG's BLAS calls are level 1 (dot, axpy) on one field:
+    # unbounded, their threads spin against the solver's own (a plain process lost 1.7-3.5x,
+    # issue 21), and even bounded to 2 they made threads=2 11x slower at 512²
+    # (benchmarks/bench_thread_pools.py); ``threads`` goes to FFTW.
+    with threadpool_limits(limits=1):
+        return _solve_step(
+            h,
+            spacing,
+            e_star,
+            opts,
+            load=load,
+            displacement=displacement,
+            warm_start=warm_start,
+            plastic_prev=plastic_prev,
+            coarse_to_fine=bool(coarse_to_fine),
+        )
 
 
 def solve_load_series(
@@ -257,22 +268,23 @@ def solve_load_series(
     plastic = None if opts.law is None else np.zeros(h.shape)
     results = []
     prev = None
-    for i, w in enumerate(arr):
-        res = _solve_step(
-            h,
-            spacing,
-            e_star,
-            opts,
-            load=float(w),
-            displacement=None,
-            warm_start=_scaled_start(prev, w),
-            plastic_prev=plastic,
-            coarse_to_fine=bool(coarse_to_fine) and i == 0,
-        )
-        if opts.law is not None:
-            plastic = res.plastic_displacement
-        results.append(res)
-        prev = res
+    with threadpool_limits(limits=1):  # as in solve
+        for i, w in enumerate(arr):
+            res = _solve_step(
+                h,
+                spacing,
+                e_star,
+                opts,
+                load=float(w),
+                displacement=None,
+                warm_start=_scaled_start(prev, w),
+                plastic_prev=plastic,
+                coarse_to_fine=bool(coarse_to_fine) and i == 0,
+            )
+            if opts.law is not None:
+                plastic = res.plastic_displacement
+            results.append(res)
+            prev = res
     return results
 
 

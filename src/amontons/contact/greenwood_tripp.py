@@ -26,6 +26,7 @@ from functools import cache
 
 import numpy as np
 from scipy import integrate, interpolate, optimize, special
+from threadpoolctl import threadpool_limits
 
 from .result import ContactError, ContactInputError
 
@@ -219,6 +220,20 @@ def greenwood_tripp(
     max_iter: int = 200,
 ) -> GreenwoodTrippResult:
     """Solve the GT rough-sphere problem at total load ``load_n``.
+
+    Every native thread pool runs one thread for the call (the influence matrix's products are
+    a few hundred square), as in :func:`amontons.contact.solve`; the caller's limits come back.
+    """
+    with threadpool_limits(limits=1):
+        return _greenwood_tripp(
+            radius_m, e_star_pa, model, load_n, r_max_m, n_radial, tol, max_iter
+        )
+
+
+def _greenwood_tripp(
+    radius_m, e_star_pa, model, load_n, r_max_m, n_radial, tol, max_iter
+) -> GreenwoodTrippResult:
+    """:func:`greenwood_tripp` without the thread bound.
 
     ``r_max_m`` defaults to three Hertz radii; the pressure on the outermost annulus must be
     below 1e-6 of the peak, else GreenwoodTrippError asks for a larger domain.

@@ -8,6 +8,7 @@ and what was expected, and returns the value in the form the solver uses.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,12 +116,26 @@ def check_count(name, value) -> int:
     return int(value)
 
 
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity; all cores where the platform has
+    no affinity)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # macOS, Windows
+        return os.cpu_count() or 1
+
+
 def check_threads(threads) -> int:
-    """FFTW threads as an int >= 1."""
-    threads = int(threads)
-    if threads < 1:
-        raise ContactInputError(f"threads must be >= 1, got {threads}")
-    return threads
+    """Threads of a solve as an int >= 1; None means every core this process may use."""
+    if threads is None:
+        return available_cores()
+    try:
+        ok = int(threads) == threads and threads >= 1
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ContactInputError(f"threads must be an integer >= 1 or None, got {threads!r}")
+    return int(threads)
 
 
 def check_heights(heights) -> np.ndarray:

@@ -1,0 +1,115 @@
+"""The solver holds every native thread pool to one thread for the duration of a call (``threads``
+goes to FFTW) and gives the caller's limits back, also when the call raises (issue 21:
+unbounded OpenBLAS threads spun against the solver's own and cost a plain process 1.7-3.5x;
+bounded to 2 they made threads=2 11x slower, benchmarks/bench_thread_pools.py). The limits are
+observed from inside the call, through the CG loop and the GT iteration, not by timing."""
+
+import os
+
+import numpy as np
+import pytest
+from threadpoolctl import threadpool_info, threadpool_limits
+
+import amontons.contact.greenwood_tripp as gt_module
+from amontons.contact import ContactInputError, ConvergenceError, api, solve, solve_load_series
+from amontons.contact.greenwood_tripp import AsperityModel, greenwood_tripp
+from amontons.contact.inputs import check_threads
+from amontons.contact.surfaces import sphere
+
+CALLER = 2  # the caller's own limit, different from the solve's
+
+
+def _limits():
+    """Threads of every native pool loaded in this process (OpenBLAS, OpenMP, ...)."""
+    return [pool["num_threads"] for pool in threadpool_info()]
+
+
+@pytest.fixture
+def seen_in_cg(monkeypatch):
+    """Record the pools' limits each time the CG loop runs."""
+    seen = []
+    original = api._run_cg
+
+    def recording(*args, **kwargs):
+        seen.append(_limits())
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(api, "_run_cg", recording)
+    return seen
+
+
+def _sphere():
+    return sphere((64, 64), 1e-6, 1e-3), 1e-6, 1e9
+
+
+def test_there_is_a_pool_to_bound():
+    # Without a native pool the tests below could not fail.
+    assert _limits(), "no native thread pool loaded (numpy without BLAS?)"
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_solve_holds_the_pools_to_one_thread_and_restores_the_callers(seen_in_cg, threads):
+    h, dx, e_star = _sphere()
+    with threadpool_limits(limits=CALLER):
+        before = _limits()
+        solve(h, dx, e_star, load=1e-3, threads=threads)
+        after = _limits()
+    assert seen_in_cg and all(limits == [1] * len(limits) for limits in seen_in_cg)
+    assert after == before == [CALLER] * len(before)
+
+
+def test_a_load_series_bounds_the_pools_for_every_step(seen_in_cg):
+    h, dx, e_star = _sphere()
+    with threadpool_limits(limits=CALLER):
+        solve_load_series(h, dx, e_star, [1e-3, 2e-3, 4e-3], threads=1)
+        after = _limits()
+    assert len(seen_in_cg) >= 3
+    assert all(limits == [1] * len(limits) for limits in seen_in_cg)
+    assert after == [CALLER] * len(after)
+
+
+def test_the_callers_limits_come_back_when_the_solve_raises(seen_in_cg):
+    h, dx, e_star = _sphere()
+    with threadpool_limits(limits=CALLER):
+        with pytest.raises(ConvergenceError):
+            solve(h, dx, e_star, load=1e-3, threads=1, max_iter=1, tol=1e-14)
+        after = _limits()
+    assert seen_in_cg and all(limits == [1] * len(limits) for limits in seen_in_cg)
+    assert after == [CALLER] * len(after)
+
+
+def test_greenwood_tripp_bounds_the_pools(monkeypatch):
+    seen = []
+    original = gt_module._solve_separation
+
+    def recording(*args, **kwargs):
+        seen.append(_limits())
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(gt_module, "_solve_separation", recording)
+    model = AsperityModel.from_roughness(30e-9, 2e6)
+    with threadpool_limits(limits=CALLER):
+        greenwood_tripp(1e-3, 3e9, model, 0.05)
+        after = _limits()
+    assert seen and all(limits == [1] * len(limits) for limits in seen)
+    assert after == [CALLER] * len(after)
+
+
+def test_threads_none_means_the_cores_this_process_may_use():
+    assert check_threads(None) == len(os.sched_getaffinity(0))
+
+
+@pytest.mark.parametrize("bad", [0, -1, 1.5, "2"])
+def test_bad_threads_are_refused(bad):
+    with pytest.raises(ContactInputError, match="threads must be an integer >= 1 or None"):
+        check_threads(bad)
+
+
+def test_answers_do_not_depend_on_the_bound():
+    """The bound changes who computes, not what: the same pressure to 1e-10 relative."""
+    h, dx, e_star = _sphere()
+    one = solve(h, dx, e_star, load=1e-3, threads=1)
+    with threadpool_limits(limits=CALLER):
+        two = solve(h, dx, e_star, load=1e-3, threads=2)
+    scale = np.abs(one.pressure).max()
+    assert np.abs(one.pressure - two.pressure).max() <= 1e-10 * scale
