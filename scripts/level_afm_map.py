@@ -3,32 +3,26 @@
 import logging
 
 from amontons.io.fields import write_levelled_map
-from amontons.io.heightmap import read_height_map
 from amontons.measure.scan_lines import line_levelling_mode
-from amontons.measure.topography import square_pixels
 from amontons.runlog import run_logged
-from amontons.simulate.surface import level_afm_map
+from amontons.simulate.surface import read_and_level_afm_map
 
 log = logging.getLogger(__name__)
 
 
 def main(afm_before: str, levelled_path: str, afm: dict) -> None:
-    height_map = square_pixels(
-        read_height_map(
-            afm_before,
-            fallback_pixel_m=None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
-            nan_policy=afm["nan_policy"],
-            channel=afm["channel"],
-        )
-    )
-    levelled = level_afm_map(
-        height_map.heights, height_map.pixel_m, line_levelling_mode(afm["line_levelling"])
+    levelled = read_and_level_afm_map(
+        afm_before,
+        fallback_pixel_m=None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
+        nan_policy=afm["nan_policy"],
+        channel=afm["channel"],
+        line_levelling=line_levelling_mode(afm["line_levelling"]),
     )
     log.info(
         "%s: %d × %d px of %.1f nm, fitted radius %.4f mm",
         afm_before,
-        *height_map.heights.shape,
-        height_map.pixel_m * 1e9,
+        *levelled.heights_m.shape,
+        levelled.pixel_m * 1e9,
         levelled.radius_m * 1e3,
     )
     write_levelled_map(

@@ -3,13 +3,12 @@ roughness statistics of the sphere's levelled AFM map."""
 
 import logging
 
-from amontons.io.fields import read_levelled_map
 from amontons.io.files import write_json
 from amontons.physics.roughness import roughness_statistics
 from amontons.runlog import run_logged
 from amontons.simulate.scene import scene_for_sphere
 from amontons.simulate.solve import greenwood_tripp_scene
-from amontons.simulate.surface import LevelledMap
+from amontons.simulate.surface import load_levelled_map
 
 log = logging.getLogger(__name__)
 
@@ -23,10 +22,8 @@ def main(
     sphere_record: dict,
 ) -> None:
     scene = scene_for_sphere(scene_name, scene_config, sphere, sphere_record)
-    heights, pixel_m, attrs = read_levelled_map(levelled_path)
-    levelled = LevelledMap(
-        heights, pixel_m, attrs["radius_m"], tuple(attrs["apex_xy_m"]), attrs["apex_height_m"]
-    )
+    levelled = load_levelled_map(levelled_path)
+    pixel_m = levelled.pixel_m
     stats = roughness_statistics(levelled.roughness_m, pixel_m)
     rows = greenwood_tripp_scene(scene, stats.h_rms_m, stats.curvature_rms_per_m)
     for row in rows:

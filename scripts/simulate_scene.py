@@ -7,22 +7,14 @@ if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
-from amontons.io.fields import read_levelled_map, write_load_series
+from amontons.io.fields import write_load_series
 from amontons.io.files import write_json
 from amontons.runlog import run_logged
 from amontons.simulate.scene import scene_for_sphere, synthetic_scene
 from amontons.simulate.solve import solve_scene
-from amontons.simulate.surface import LevelledMap, afm_indenter, synthetic_indenter
+from amontons.simulate.surface import afm_indenter, load_levelled_map, synthetic_indenter
 
 log = logging.getLogger(__name__)
-
-
-def levelled_map(path: str) -> LevelledMap:
-    """The levelled AFM map the level_afm_map rule wrote."""
-    heights, pixel_m, attrs = read_levelled_map(path)
-    return LevelledMap(
-        heights, pixel_m, attrs["radius_m"], tuple(attrs["apex_xy_m"]), attrs["apex_height_m"]
-    )
 
 
 def main(
@@ -40,7 +32,7 @@ def main(
         indenter = synthetic_indenter(scene)
     else:
         scene = scene_for_sphere(scene_name, scene_config, sphere, sphere_record)
-        indenter = afm_indenter(levelled_map(levelled_path), scene, levelled_path)
+        indenter = afm_indenter(load_levelled_map(levelled_path), scene, levelled_path)
     log.info(
         "%s: %d² solver grid of %.1f nm (window %.1f µm); surface rms %.1f nm, slope %.3f "
         "at the solver pixel (%.1f nm, slope %.3f at the map's)",

@@ -105,3 +105,35 @@ def test_a_window_larger_than_the_scan_names_the_file_and_sizes():
     heights = _sphere_map(400, 100e-9, 1e-3)
     with pytest.raises(SceneError, match=r"map\.tif: scene wide: the solver window .* AFM scan"):
         afm_indenter(level_afm_map(heights, 100e-9), scene, "map.tif")
+
+
+def test_a_map_that_is_no_sphere_apex_is_refused_naming_the_file(tmp_path):
+    """A bowl (concave) scanned instead of a sphere's apex: the levelling finds no apex, and
+    the error names the file and what was expected."""
+    from amontons.io.heightmap import write_height_map
+    from amontons.io.layout import RawDataError
+    from amontons.simulate.surface import read_and_level_afm_map
+
+    path = tmp_path / "afm_before.tif"
+    write_height_map(path, -_sphere_map(128, 100e-9, 1e-3), 100e-9)
+    with pytest.raises(RawDataError, match=r"afm_before\.tif: .*not convex upwards.*sphere's apex"):
+        read_and_level_afm_map(
+            path, fallback_pixel_m=None, nan_policy="fail", channel=None, line_levelling="auto"
+        )
+
+
+def test_a_levelled_map_survives_its_hdf5_file(tmp_path):
+    """What level_afm_map writes, the scenes read back: heights to the bit, the sphere fit."""
+    from amontons.io.fields import write_levelled_map
+    from amontons.simulate.surface import load_levelled_map
+
+    levelled = level_afm_map(_sphere_map(256, 100e-9, 1e-3, (1e-6, 2e-6)), 100e-9)
+    path = tmp_path / "levelled.h5"
+    write_levelled_map(path, levelled.heights_m, levelled.pixel_m, levelled.to_attributes())
+    back = load_levelled_map(path)
+    assert np.array_equal(back.heights_m, levelled.heights_m)
+    assert (back.pixel_m, back.radius_m, back.apex_xy_m) == (
+        levelled.pixel_m,
+        levelled.radius_m,
+        levelled.apex_xy_m,
+    )

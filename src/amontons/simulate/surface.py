@@ -14,11 +14,15 @@ the glass (an AFM scan of the apex, apex up, as is); the glass roughness is negl
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from amontons.contact.surfaces import self_affine, sphere
-from amontons.measure.topography import level_sphere, sphere_cap
+from amontons.io.fields import read_levelled_map
+from amontons.io.heightmap import TopographyError, read_height_map
+from amontons.io.layout import RawDataError
+from amontons.measure.topography import level_sphere, sphere_cap, square_pixels
 from amontons.physics.roughness import roughness_statistics
 from amontons.simulate.scene import Scene, SceneError
 
@@ -112,6 +116,35 @@ def level_afm_map(heights: np.ndarray, pixel_m: float, line_levelling: str = "au
         fit.radius_m,
         fit.apex_xy_m,
         fit.apex_height_m,
+    )
+
+
+def read_and_level_afm_map(
+    path: str | Path,
+    *,
+    fallback_pixel_m: float | None,
+    nan_policy: str,
+    channel: str | None,
+    line_levelling: str,
+) -> LevelledMap:
+    """Read a sphere's AFM map (amontons.io.heightmap: any supported format, square pixels)
+    and level it; a map that is no sphere's apex raises RawDataError naming the file."""
+    height_map = square_pixels(
+        read_height_map(
+            path, fallback_pixel_m=fallback_pixel_m, nan_policy=nan_policy, channel=channel
+        )
+    )
+    try:
+        return level_afm_map(height_map.heights, height_map.pixel_m, line_levelling)
+    except TopographyError as error:
+        raise RawDataError(f"{path}: {error}; expected the AFM map of a sphere's apex") from error
+
+
+def load_levelled_map(path: str | Path) -> LevelledMap:
+    """A levelled map as the level_afm_map rule wrote it (HDF5, amontons.io.fields)."""
+    heights, pixel_m, attrs = read_levelled_map(path)
+    return LevelledMap(
+        heights, pixel_m, attrs["radius_m"], tuple(attrs["apex_xy_m"]), attrs["apex_height_m"]
     )
 
 
