@@ -244,7 +244,10 @@ def load_workflow_config(
 
 
 def hertz_diameter_um(load_mn: float, diameter_mm: float, e_star_gpa: float) -> float:
-    """Hertz contact diameter (µm) of a sphere at ``load_mn``: 2·(3FR/4E*)^(1/3)."""
+    """Hertz contact diameter (µm) of a sphere at ``load_mn``: 2·(3FR/4E*)^(1/3).
+
+    amontons.physics.hertz.contact_radius in config units: that module imports numpy, which
+    the workflow's DAG helpers must not (tests/test_architecture.py)."""
     radius_m = diameter_mm * 0.5e-3
     return 2e6 * (3 * load_mn * 1e-3 * radius_m / (4 * e_star_gpa * 1e9)) ** (1 / 3)
 

@@ -250,6 +250,12 @@ def test_small_run_figures_show_the_otsu_separation_and_the_intensity_law(small_
                 assert path.stat().st_size > 10_000, path
 
 
+def _job_stats(stdout: str) -> dict[str, str]:
+    """Rule → job count, from the 'Job stats' table of a dry run."""
+    stats = stdout.split("Job stats:", 1)[1].split("total", 1)[0]
+    return dict(re.findall(r"(\w+)\s+(\d+)\n", stats))
+
+
 def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
     project = small_run
     again = snakemake(project, "-n", "--configfile", "config/test.yaml")
@@ -266,9 +272,8 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
     # (Key order is kept: Snakemake compares params dicts in order.)
     _edit_config(project, lambda c: c.update(optics={"psf": {"profile_radius_nm": 1800.0}}))
     changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
-    stats = changed.stdout.split("Job stats:", 1)[1].split("total", 1)[0]
     # The PSF also renders the three optics scenes of each sphere: they follow it.
-    assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {
+    assert _job_stats(changed.stdout) == {
         "measure_psf": "2",
         "render_scene": "6",
         "compare_scene": "6",
@@ -284,8 +289,7 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
 
     _edit_config(project, retune_hardening)
     changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
-    stats = changed.stdout.split("Job stats:", 1)[1].split("total", 1)[0]
-    assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {
+    assert _job_stats(changed.stdout) == {
         "simulate_scene": "2",
         "render_scene": "2",
         "compare_scene": "2",
@@ -322,8 +326,7 @@ def test_own_data_is_measured_and_a_replaced_image_reruns_its_jobs(small_run, tm
     noise = np.random.default_rng(0).poisson(120, read_image(image).data.shape)
     write_image(image, noise.astype(np.uint16), pixel)
     dry = snakemake(tmp_path, *args, "-n")
-    stats = dry.stdout.split("Job stats:", 1)[1].split("total", 1)[0]
-    assert dict(re.findall(r"(\w+)\s+(\d+)\n", stats)) == {
+    assert _job_stats(dry.stdout) == {
         "measure_contact_area": "1",
         "fit_load_area": "1",
     }

@@ -107,10 +107,5 @@ def afm_scan_centre_in_image_m(
     """Where the AFM scan's centre lies in the measured image (m about the image centre,
     (row, col)): the registration maps the simulation window's centre, which sits at
     ``window_centre_in_scan_m`` from the scan centre in the AFM frame."""
-    p = -np.asarray(window_centre_in_scan_m) / pixel_m
-    if registration.mirrored:
-        p = p * np.array([1.0, -1.0])
-    theta = np.deg2rad(registration.rotation_deg)
-    row = np.cos(theta) * p[0] - np.sin(theta) * p[1] + registration.shift_px[0]
-    col = np.sin(theta) * p[0] + np.cos(theta) * p[1] + registration.shift_px[1]
+    row, col = registration.map_offset_px(-np.asarray(window_centre_in_scan_m) / pixel_m)
     return float(row * pixel_m), float(col * pixel_m)

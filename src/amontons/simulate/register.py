@@ -90,6 +90,12 @@ class Registration:
     shift_px: tuple[float, float]
     score: float
 
+    def map_offset_px(self, offset_px) -> np.ndarray:
+        """Where a point ``offset_px`` (row, col) from the simulated image's centre lands, as
+        an offset (px) from the measured image's centre: R(θ)·M·p + shift."""
+        forward = _forward_matrix(self.mirrored, self.rotation_deg)
+        return forward @ np.asarray(offset_px, dtype=float) + np.asarray(self.shift_px)
+
     def to_record(self) -> dict:
         """JSON-ready fields (plain Python types)."""
         return {

@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from amontons.contact import ContactHardening, PenetrationHardness
+from amontons.physics import hertz
 
 MODELS = ("greenwood_tripp", "elastic", "penetration_hardness", "hardening")
 INCREMENTS = {"local": "local", "volume_conserving": "volume"}
@@ -30,7 +31,7 @@ class SceneError(ValueError):
 @dataclass(frozen=True)
 class SyntheticSurface:
     """Self-affine surface (docs/models.md §2.6): Hurst exponent, rms slope or rms height (m),
-    short and long cut-off wavelengths (m), seed, grid side (px)."""
+    short and long cut-off wavelengths (m), seed (on the scene's solver grid)."""
 
     hurst: float
     rms_slope: float | None
@@ -38,7 +39,6 @@ class SyntheticSurface:
     short_cutoff_m: float | None
     long_cutoff_m: float | None
     seed: int
-    side_px: int
 
 
 @dataclass(frozen=True)
@@ -115,14 +115,8 @@ class Scene:
                 "short_cutoff_um": None if s.short_cutoff_m is None else s.short_cutoff_m * 1e6,
                 "long_cutoff_um": None if s.long_cutoff_m is None else s.long_cutoff_m * 1e6,
                 "seed": s.seed,
-                "side_px": s.side_px,
             }
         return record
-
-
-def hertz_diameter_m(load_n: float, radius_m: float, e_star_pa: float) -> float:
-    """Hertz contact diameter (m) at ``load_n``: 2·(3FR/4E*)^(1/3)."""
-    return 2 * (3 * load_n * radius_m / (4 * e_star_pa)) ** (1 / 3)
 
 
 def _window_m(name: str, config: Mapping, loads_n, radius_m, e_star_pa) -> float:
@@ -133,7 +127,8 @@ def _window_m(name: str, config: Mapping, loads_n, radius_m, e_star_pa) -> float
         return config["side_px"] * pixel_m
     if radius_m is None:
         raise SceneError(f"scene {name}: a flat surface needs side_px (no Hertz diameter)")
-    return config["window_factor"] * hertz_diameter_m(max(loads_n), radius_m, e_star_pa)
+    diameter = 2 * hertz.contact_radius(max(loads_n), radius_m, e_star_pa)
+    return config["window_factor"] * diameter
 
 
 def _solver_pixel_m(config: Mapping, window_m: float) -> float:
@@ -174,20 +169,22 @@ def _model_parameters(name: str, config: Mapping, record: Mapping) -> dict:
     return out
 
 
-def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -> Scene:
-    """The scene ``name`` (its config entry) on the AFM map of ``sphere`` (its sheet record:
-    diameter_mm, e_star_gpa, loads, hardness_mpa, hardening_k_mpa_per_nm)."""
-    if config["surface"] != "afm_before":
-        raise SceneError(f"scene {name}: surface = {config['surface']!r} is not a sphere's map")
-    loads = config["loads"]
-    loads_mn = list(record["loads"]) if loads == "measured" else [float(f) for f in loads]
-    e_star_pa = float(record["e_star_gpa"]) * 1e9
-    radius_m = float(record["diameter_mm"]) * 0.5e-3
-    loads_n = tuple(f * 1e-3 for f in loads_mn)
+def _scene(
+    name: str,
+    config: Mapping,
+    *,
+    e_star_pa: float,
+    radius_m: float | None,
+    loads_n: tuple[float, ...],
+    record: Mapping,
+    synthetic: SyntheticSurface | None = None,
+) -> Scene:
+    """The Scene of a config entry, given what its surface decides: E*, radius and loads (SI),
+    the sheet record its null model parameters come from, and a synthetic surface."""
     window_m = _window_m(name, config, loads_n, radius_m, e_star_pa)
     return Scene(
         name=name,
-        surface="afm_before",
+        surface=config["surface"],
         geometry=config["geometry"],
         model=config["model"],
         e_star_pa=e_star_pa,
@@ -198,24 +195,36 @@ def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -
         tol=config["tol"],
         optics=config["optics"],
         rendering=config.get("rendering", "emission"),
-        **_model_parameters(name, config, {**record, "sphere": sphere}),
+        synthetic=synthetic,
+        **_model_parameters(name, config, record),
+    )
+
+
+def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -> Scene:
+    """The scene ``name`` (its config entry) on the AFM map of ``sphere`` (its sheet record:
+    diameter_mm, e_star_gpa, loads, hardness_mpa, hardening_k_mpa_per_nm)."""
+    if config["surface"] != "afm_before":
+        raise SceneError(f"scene {name}: surface = {config['surface']!r} is not a sphere's map")
+    loads = config["loads"]
+    loads_mn = list(record["loads"]) if loads == "measured" else [float(f) for f in loads]
+    return _scene(
+        name,
+        config,
+        e_star_pa=float(record["e_star_gpa"]) * 1e9,
+        radius_m=float(record["diameter_mm"]) * 0.5e-3,
+        loads_n=tuple(f * 1e-3 for f in loads_mn),
+        record={**record, "sphere": sphere},
     )
 
 
 def synthetic_scene(name: str, config: Mapping) -> Scene:
     """A scene on a synthetic self-affine surface: it names E*, loads and (for the sphere
     geometry) the radius itself, and reads nothing of the experiment."""
+    if config["surface"] != "synthetic":
+        raise SceneError(f"scene {name}: surface = {config['surface']!r} is not synthetic")
     synthetic = config["synthetic"]
-    loads = config["loads"]
-    if loads == "measured":
+    if config["loads"] == "measured":
         raise SceneError(f"scene {name}: loads = 'measured' needs a sphere; give a list (mN)")
-    loads_n = tuple(float(f) * 1e-3 for f in loads)
-    radius_m = None
-    if config["geometry"] == "sphere":
-        radius_m = synthetic["radius_mm"] * 1e-3
-    e_star_pa = synthetic["e_star_gpa"] * 1e9
-    window_m = _window_m(name, config, loads_n, radius_m, e_star_pa)
-    pixel_m = _solver_pixel_m(config, window_m)
     surface = SyntheticSurface(
         hurst=synthetic["hurst"],
         rms_slope=synthetic.get("rms_slope"),
@@ -223,23 +232,15 @@ def synthetic_scene(name: str, config: Mapping) -> Scene:
         short_cutoff_m=_scaled(synthetic.get("short_cutoff_um"), 1e-6),
         long_cutoff_m=_scaled(synthetic.get("long_cutoff_um"), 1e-6),
         seed=int(synthetic["seed"]),
-        side_px=int(round(window_m / pixel_m)),
     )
-    return Scene(
-        name=name,
-        surface="synthetic",
-        geometry=config["geometry"],
-        model=config["model"],
-        e_star_pa=e_star_pa,
-        radius_m=radius_m,
-        loads_n=loads_n,
-        pixel_m=pixel_m,
-        window_m=window_m,
-        tol=config["tol"],
-        optics=config["optics"],
-        rendering=config.get("rendering", "emission"),
+    return _scene(
+        name,
+        config,
+        e_star_pa=synthetic["e_star_gpa"] * 1e9,
+        radius_m=synthetic["radius_mm"] * 1e-3 if config["geometry"] == "sphere" else None,
+        loads_n=tuple(float(f) * 1e-3 for f in config["loads"]),
+        record={"sphere": "(synthetic)"},
         synthetic=surface,
-        **_model_parameters(name, config, {"sphere": "(synthetic)"}),
     )
 
 

@@ -58,7 +58,10 @@ def afm_to_microscope(
     """Microscope-frame positions (row, col; m about the apex) of AFM-frame positions (m about
     the scan centre): mirror the column axis if ``mirrored``, rotate by ``rotation_deg``
     counter-clockwise as displayed (rows grow downward), then shift by ``centre_m`` (the scan
-    centre in the microscope frame)."""
+    centre in the microscope frame).
+
+    The same map as amontons.simulate.register.Registration's, written apart on purpose: the
+    truth of the registration test must not come from the code under test."""
     theta = np.deg2rad(settings.rotation_deg)
     cols = -cols_m if settings.mirrored else cols_m
     rows_q = np.cos(theta) * rows_m - np.sin(theta) * cols + centre_m[0]
