@@ -18,6 +18,7 @@ wildcard_constraints:
     sphere="|".join(map(re.escape, SPHERES)),
     material="|".join(map(re.escape, MATERIALS)),
     scene=names_pattern(list(SCENES)),
+    scan=names_pattern(list(SCANS)),
 
 
 include: "workflow/rules/virtual_experiment.smk"
@@ -26,13 +27,14 @@ include: "workflow/rules/load_area.smk"
 include: "workflow/rules/friction.smk"
 include: "workflow/rules/surface.smk"
 include: "workflow/rules/simulate.smk"
+include: "workflow/rules/study.smk"
 
 
 # Default target: every output of every selected material.
 rule all:
     default_target: True
     input:
-        material_outputs(MATERIALS),
+        material_outputs(MATERIALS) + study_overview_outputs(),
     localrule: True
 
 

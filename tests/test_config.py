@@ -317,3 +317,57 @@ def test_run_scenes_must_name_defined_scenes(repo, config_schema, sheet_schema, 
     config["run_scenes"] = ["elastic", "plastic"]
     with pytest.raises(ConfigError, match=r"run_scenes names 'plastic', not in scenes"):
         load_workflow_config(config, config_schema, sheet_schema, "my.yaml")
+
+
+@pytest.mark.parametrize(
+    ("edit", "expected"),
+    [
+        (
+            lambda c: c.update(run_scans=["k", "q"]),
+            r"run_scans names 'q', not in scans",
+        ),
+        (
+            lambda c: c.update(run_scenes=["elastic", "hardening", "greenwood_tripp"]),
+            r"scan p_y: scene 'penetration_hardness' is not in run_scenes",
+        ),
+        (
+            lambda c: c["scans"]["k"].update(scene="penetration_hardness"),
+            r"scan k: parameter k_mpa_per_nm belongs to model hardening, but base scene "
+            r"penetration_hardness has model penetration_hardness",
+        ),
+        (
+            lambda c: c["scenes"]["hardening"].update(optics="none"),
+            r"scan k: base scene hardening has optics = 'none'; expected 'microscope'",
+        ),
+        (
+            lambda c: c["scans"]["p_y"].update(range_factor=[2.0, 0.5]),
+            r"scan p_y: range_factor = \[2, 0\.5\]; expected low < high",
+        ),
+        (
+            lambda c: c["scans"]["p_y"].update(parameter="hurst"),
+            r"scans\.p_y\.parameter = 'hurst' is not allowed",
+        ),
+        (
+            lambda c: c["study"]["curvature_pairs"].update(
+                elastic=["curved_elastic", "flat_elastic"]
+            ),
+            r"study\.curvature_pairs\.elastic: scene curved_elastic has surface synthetic and "
+            r"geometry sphere; expected a synthetic flat_periodic scene",
+        ),
+        (
+            lambda c: c["study"]["curvature_pairs"].update(
+                elastic=["flat_elastic", "curved_hardening"]
+            ),
+            r"study\.curvature_pairs\.elastic: scenes flat_elastic and curved_hardening have "
+            r"models \['elastic', 'hardening'\]",
+        ),
+    ],
+)
+def test_bad_scans_and_study_pairs_stop_before_any_job(
+    repo, config_schema, sheet_schema, monkeypatch, edit, expected
+):
+    monkeypatch.chdir(repo)
+    config = _config(repo, "test.yaml")
+    edit(config)
+    with pytest.raises(ConfigError, match=expected):
+        load_workflow_config(config, config_schema, sheet_schema, "my.yaml")

@@ -102,6 +102,7 @@ _BOOLEAN_WORDS = {"true": True, "false": False, "yes": True, "no": False, "1": T
 # second rule of that name (each material gets its own target, `snakemake PS`).
 RESERVED_NAMES = frozenset(
     {"all", "optics", "surface", "friction", "fits", "figures", "virtual_experiment", "scenes"}
+    | {"scans", "study"}
     | {"synthetic"}  # the folder of the synthetic scenes, results/<run>/synthetic/
 )
 
@@ -240,6 +241,8 @@ def load_workflow_config(
     selected = {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
     check_reference_load(config["load_area"]["reference_load_mn"], selected, source)
     check_scenes(config, selected, source)
+    check_scans(config, selected, source)
+    check_curvature_pairs(config, source)
     return selected
 
 
@@ -349,6 +352,81 @@ def check_scenes(config: Mapping, spheres: Mapping[str, dict], source: str) -> N
         )
     for name in config["run_scenes"]:
         _check_one_scene(name, config["scenes"][name], spheres, source)
+
+
+SCAN_MODELS = {"p_y_mpa": "penetration_hardness", "k_mpa_per_nm": "hardening"}
+SCAN_COLUMNS = {"p_y_mpa": "hardness_mpa", "k_mpa_per_nm": "hardening_k_mpa_per_nm"}
+
+
+def _check_one_scan(name: str, scan: Mapping, config: Mapping, spheres, source: str) -> None:
+    where = f"{source}: scan {name}"
+    base = scan["scene"]
+    if base not in config["run_scenes"]:
+        raise ConfigError(
+            f"{where}: scene {base!r} is not in run_scenes; expected one of "
+            f"{', '.join(config['run_scenes']) or '(none)'} (a scan registers on its base "
+            "scene's comparison)"
+        )
+    scene = config["scenes"][base]
+    expected = {"surface": "afm_before", "optics": "microscope", "loads": "measured"}
+    for key, value in expected.items():
+        if scene[key] != value:
+            raise ConfigError(
+                f"{where}: base scene {base} has {key} = {scene[key]!r}; expected {value!r} "
+                "(a scan is judged against the measured images at the measured loads)"
+            )
+    model = SCAN_MODELS[scan["parameter"]]
+    if scene["model"] != model:
+        raise ConfigError(
+            f"{where}: parameter {scan['parameter']} belongs to model {model}, but base scene "
+            f"{base} has model {scene['model']}; expected a {model} scene"
+        )
+    low, high = scan["range_factor"]
+    if not low < high:
+        raise ConfigError(f"{where}: range_factor = [{low:g}, {high:g}]; expected low < high")
+    column = SCAN_COLUMNS[scan["parameter"]]
+    for sphere, record in spheres.items():
+        if record.get(column) is None:
+            raise ConfigError(
+                f"{where}: sphere {sphere} has no {column} in the sheet; expected a value (the "
+                "scan's range is range_factor times it)"
+            )
+
+
+def check_scans(config: Mapping, spheres: Mapping[str, dict], source: str) -> None:
+    """Scans that cannot run stop the run before any job (docs/study.md)."""
+    unknown = [name for name in config["run_scans"] if name not in config["scans"]]
+    if unknown:
+        raise ConfigError(
+            f"{source}: run_scans names {', '.join(map(repr, unknown))}, not in scans; "
+            f"expected one of {', '.join(config['scans'])}"
+        )
+    for name in config["run_scans"]:
+        _check_one_scan(name, config["scans"][name], config, spheres, source)
+
+
+def check_curvature_pairs(config: Mapping, source: str) -> None:
+    """Fig. B.10's pairs: [flat periodic, curved] synthetic scenes of one model, both running."""
+    for model, pair in config["study"]["curvature_pairs"].items():
+        where = f"{source}: study.curvature_pairs.{model}"
+        for name, geometry in zip(pair, ("flat_periodic", "sphere"), strict=True):
+            if name not in config["run_scenes"]:
+                raise ConfigError(
+                    f"{where}: scene {name!r} is not in run_scenes; expected a running scene"
+                )
+            scene = config["scenes"][name]
+            if scene["surface"] != "synthetic" or scene["geometry"] != geometry:
+                raise ConfigError(
+                    f"{where}: scene {name} has surface {scene['surface']} and geometry "
+                    f"{scene['geometry']}; expected a synthetic {geometry} scene (the pair is "
+                    "[flat periodic, curved])"
+                )
+        models = {config["scenes"][name]["model"] for name in pair}
+        if len(models) != 1:
+            raise ConfigError(
+                f"{where}: scenes {pair[0]} and {pair[1]} have models {sorted(models)}; "
+                "expected one model for both"
+            )
 
 
 def merge_config(base: Mapping, overlay: Mapping) -> dict:

@@ -533,6 +533,8 @@ def _scene_jobs(project, target, **changes):
     def edit(config):
         config["run_scenes"] = ["probe"]
         config["scenes"] = {"probe": {**PROBE_SCENE, **changes}}
+        config["run_scans"] = []  # the scans' base scenes are not selected
+        config["study"] = {"curvature_pairs": {}}
 
     _edit_config(project, edit)
     result = snakemake(project, target, "-n", "--configfile", "config/test.yaml")
@@ -672,3 +674,189 @@ def test_binary_rendering_overstates_the_measured_area(small_run):
     ratio = np.array([r.otsu.area_m2 * 1e12 for r in binary]) / table["measured_area_um2"]
     print("binary / measured Otsu area:", np.round(ratio, 3))
     assert (ratio > table["area_ratio"] + 0.03).all()
+
+
+# The study (docs/study.md): scans, best values, figures and the model table.
+
+
+def study_file(project, sphere, name, run=SMALL):
+    return project / "results" / run / sphere / sphere / "study" / name
+
+
+def scan_best(project, sphere, scan, run=SMALL):
+    path = project / "results" / run / sphere / sphere / "scans" / scan / "best.json"
+    return json.loads(path.read_text())
+
+
+def test_k_scan_recovers_the_true_k_of_the_rough_sphere_within_one_scan_step(small_run):
+    """The virtual PS sphere was made with contact hardening at the sheet's k (5 MPa/nm). The
+    scan (1 to 20 MPa/nm, 7 log steps of ×1.65; the truth is not a grid point) judges every
+    value by the rendered against the measured Otsu areas: its best value lies within one
+    scan step of the truth, and the interval the measured areas' scatter allows holds it."""
+    best = scan_best(small_run, "PS", "k")
+    truth = truth_of(small_run, "PS")["hardening_k_mpa_per_nm"]
+    step = np.log(best["values"][1] / best["values"][0])
+    print("PS k scan:", best["best"], best["scatter_interval"], "truth", truth)
+    assert abs(np.log(best["best"] / truth)) <= step * (1 + 1e-9)
+    low, high = best["scatter_interval"]
+    assert (low is None or low <= truth) and (high is None or truth <= high)
+    assert not best["at_scan_edge"]
+
+
+def test_k_of_glass_is_left_open_where_no_k_changes_its_contact(small_run):
+    """Glass (k = 10000 MPa/nm: E*/k = 3 nm, far below the 256 nm solver pixel) does not flow:
+    every k of its scan (2000-40000 MPa/nm) gives nearly the same areas, so the data cannot
+    bound k from above: the scatter interval is open there and holds the truth."""
+    best = scan_best(small_run, "glass", "k")
+    truth = truth_of(small_run, "glass")["hardening_k_mpa_per_nm"]
+    print("glass k scan:", best["best"], best["scatter_interval"])
+    low, high = best["scatter_interval"]
+    assert high is None
+    assert low is None or low <= truth
+
+
+def test_model_table_says_hardening_explains_the_rough_sphere(small_run):
+    """On the virtual PS sphere (made with contact hardening) the hardening model at its best k
+    gives the measured load-area exponent within 0.03 (the issue's bound); the elastic and
+    penetration-hardness exponents are reported with their distance from it. The truth
+    decides which model wins: hardening, with the smallest distance of all."""
+    table = pd.read_csv(small_run / "results" / SMALL / "PS" / "models.csv")
+    print(table[["model", "source", "value", "exponent", "exponent_difference"]].to_string())
+    fit = json.loads(measured(small_run, "PS", "PS", "load_area_fit.json").read_text())
+    assert (table["measured_exponent"] == fit["exponent"]["estimate"]).all()
+    best_k = table[table["source"] == "scan k, best value"].iloc[0]
+    assert best_k["value"] == scan_best(small_run, "PS", "k")["best"]
+    assert abs(best_k["exponent_difference"]) <= 0.03
+    others = table[table["model"].isin(["elastic", "penetration_hardness"])]
+    assert len(others) >= 3  # elastic scene, p_Y scene, p_Y scan best
+    assert (others["exponent_difference"].abs() > abs(best_k["exponent_difference"])).all()
+    assert table["area_ratio_largest"].notna().sum() == len(table) - 1  # all but GT
+
+
+def test_curvature_does_not_change_the_load_area_exponent(small_run):
+    """Appendix Fig. B.10: the same synthetic surface on a flat periodic and on a curved
+    interface gives load-area exponents within 0.03 of each other, elastic and hardening
+    (the issue's bound); the CSV holds each scene's exponent beside its areas."""
+    table = pd.read_csv(small_run / "results" / SMALL / "study" / "B10_curvature.csv")
+    for model, rows in table.groupby("model"):
+        exponents = rows.groupby("geometry")["exponent"].first()
+        print(model, exponents.to_dict())
+        assert exponents["curved"] == pytest.approx(exponents["flat periodic"], abs=0.03)
+        # and the CSV's exponent is the fit of its own areas (rounding-free check)
+        for _, one in rows.groupby("geometry"):
+            slope = np.polyfit(np.log(one["load_mn"]), np.log(one["area_um2"]), 1)[0]
+            assert one["exponent"].iloc[0] == pytest.approx(slope, abs=1e-9)
+
+
+def test_b8_csv_holds_every_scan_value_and_marks_the_best(small_run):
+    table = pd.read_csv(study_file(small_run, "PS", "B8_scans.csv"))
+    for scan in ("p_y", "k"):
+        best = scan_best(small_run, "PS", scan)
+        rows = table[table["scan"] == scan]
+        assert list(rows["value"]) == best["values"]
+        assert list(rows.loc[rows["best"], "value"]) == [best["best"]]
+        scan_table = pd.read_csv(
+            small_run / "results" / SMALL / "PS" / "PS" / "scans" / scan / "scan.csv"
+        )
+        assert np.allclose(
+            rows["log_area_distance"], scan_table["log_area_distance"], equal_nan=True
+        )
+        solved = rows[~rows["contact_leaves_window"]]
+        assert (
+            rows.loc[rows["best"], "log_area_distance"].iloc[0] == solved["log_area_distance"].min()
+        )
+
+
+def test_b11_csv_holds_the_measured_areas_and_the_best_k(small_run):
+    table = pd.read_csv(study_file(small_run, "PS", "B11_load_series.csv"))
+    areas = pd.read_csv(measured(small_run, "PS", "PS", "contact_area.csv"))
+    experiment = table[table["row"] == "experiment"]
+    assert np.allclose(experiment["area_um2"], areas["area_um2"])
+    assert set(table["row"]) == {"experiment", "greenwood_tripp", "elastic", "hardening"}
+    assert (table["best_k_mpa_per_nm"] == scan_best(small_run, "PS", "k")["best"]).all()
+    hardening = table[table["row"] == "hardening"]
+    elastic = table[table["row"] == "elastic"]
+    # the figure's claim: hardening at the best k overlaps the measured contact better than
+    # the elastic scene does, at every load
+    assert (hardening["iou"].to_numpy() > elastic["iou"].to_numpy()).all()
+
+
+def test_b9_csv_gives_the_measured_and_the_simulated_flattening(small_run):
+    """The measured flattening in the solver window has the depth the topography step
+    measured on the whole map (within 10 %: the window holds the whole contact), and the
+    hardening model at the best k flattens the surface by a depth of the same order (the
+    appendix: 'the overall magnitude ... is well described')."""
+    table = pd.read_csv(study_file(small_run, "PS", "B9_flattening.csv")).set_index("panel")
+    topography = json.loads(measured(small_run, "PS", "PS", "topography.json").read_text())
+    depth = topography["flattening_depth_nm"]["estimate"]
+    measured_depth = table.loc["measured (after - before)", "flattening_depth_nm"]
+    simulated_depth = table.loc["hardening model (h_pl)", "flattening_depth_nm"]
+    print(
+        "flattening depth, nm: whole map", depth, "window", measured_depth, "model", simulated_depth
+    )
+    assert measured_depth == pytest.approx(depth, rel=0.1)
+    assert 0.33 < simulated_depth / measured_depth < 3
+    assert (table["best_k_mpa_per_nm"] == scan_best(small_run, "PS", "k")["best"]).all()
+
+
+def test_b12_csv_holds_every_model_with_its_exponent(small_run):
+    table = pd.read_csv(study_file(small_run, "PS", "B12_models.csv"))
+    fit = json.loads(measured(small_run, "PS", "PS", "load_area_fit.json").read_text())
+    measured_rows = table[table["series"] == "measured"]
+    assert measured_rows["exponent"].iloc[0] == fit["exponent"]["estimate"]
+    best = scan_best(small_run, "PS", "k")
+    series = f"hardening, best k_mpa_per_nm = {best['best']:g}"
+    assert table.loc[table["series"] == series, "exponent"].iloc[0] == pytest.approx(
+        best["best_rendered_fit"]["exponent"]["estimate"], abs=1e-12
+    )
+    for scene in ("elastic", "penetration_hardness", "hardening", "greenwood_tripp"):
+        assert (table["series"] == f"scene {scene}").sum() == 5
+
+
+def test_b13_csv_normalises_measurement_and_model_at_the_reference_load(small_run):
+    table = pd.read_csv(small_run / "results" / SMALL / "study" / "B13_amontons.csv")
+    for sphere in ("PS", "glass"):
+        rows = table[table["sphere"] == sphere]
+        model = rows[rows["series"] == "hardening model"]
+        assert model.loc[np.isclose(model["load_over_ref"], 1.0), "area_over_ref"].iloc[0] == 1.0
+        assert (model["best_k_mpa_per_nm"] == scan_best(small_run, sphere, "k")["best"]).all()
+        amontons = pd.read_csv(small_run / "results" / SMALL / sphere / "amontons.csv")
+        measured_rows = rows[rows["series"] == "measured"]
+        assert np.allclose(measured_rows["area_over_ref"], amontons["area_over_area_ref"])
+
+
+def test_without_scans_no_scan_or_study_job_runs(project):
+    def edit(config):
+        config["run_scans"] = []
+        config["study"] = {"curvature_pairs": {}}
+
+    _edit_config(project, edit)
+    result = snakemake(project, "-n", "--configfile", "config/test.yaml")
+    assert result.returncode == 0, result.stderr
+    for rule in (
+        "scan_scene",
+        "best_scan_value",
+        "plot_scan_maps",
+        "tabulate_models",
+        "plot_curvature_study",
+        "plot_amontons_study",
+    ):
+        assert f"rule {rule}:" not in result.stdout
+    assert "scenes/hardening/comparison.csv" in result.stdout  # the scenes still run
+
+
+def test_slurm_dry_run_of_the_full_config_has_one_job_per_scan_value(project):
+    result = snakemake(
+        project,
+        "-n",
+        "--profile",
+        str(REPO / "profiles" / "slurm"),
+        "--configfile",
+        "config/config.yaml",
+    )
+    assert result.returncode == 0, result.stderr
+    config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    spheres = 5  # PS, PMMA-1.5mm, PMMA-4mm, PTFE, glass
+    expected = spheres * sum(config["scans"][s]["steps"] for s in config["run_scans"])
+    jobs = re.findall(r"rule scan_scene:\n(?:\s+.+\n)*?\s+wildcards: (.+)\n", result.stdout)
+    assert len(jobs) == expected == len(set(jobs))

@@ -259,6 +259,8 @@ def material_outputs(materials):
         + fits
         + figure_outputs(materials)
         + scene_outputs(materials)
+        + scan_outputs(materials)
+        + study_outputs(materials)
     )
     return list(dict.fromkeys(everything))  # once each, in order
 
@@ -279,6 +281,8 @@ def scene_names(surface=None, model=None, optics=None, field=None):
     names = []
     for name, scene in SCENES.items():
         if surface is not None and scene["surface"] != surface:
+            continue
+        if model is not None and scene["model"] != model:
             continue
         if optics is not None and scene["optics"] != optics:
             continue
@@ -366,3 +370,181 @@ def scene_fit_inputs(wildcards):
     if SCENES[wildcards.scene]["optics"] == "microscope":
         inputs["render"] = f"{folder}/render.csv"
     return inputs
+
+
+# Parameter scans and the study (workflow/rules/study.smk): each scan value of each sphere is
+# a job of its own; the study's figures and model table run with the scans.
+from amontons.simulate.scan_grid import scan_values, value_label
+
+SCANS = {name: config["scans"][name] for name in config["run_scans"]}
+SCAN = f"results/{RUN}/{{material}}/{{sphere}}/scans/{{scan}}"
+SCAN_LOGS = f"logs/{RUN}/{{material}}/{{sphere}}/scans/{{scan}}"
+STUDY = f"results/{RUN}/{{material}}/{{sphere}}/study"
+STUDY_LOGS = f"logs/{RUN}/{{material}}/{{sphere}}/study"
+SCAN_COLUMNS = {"p_y_mpa": "hardness_mpa", "k_mpa_per_nm": "hardening_k_mpa_per_nm"}
+
+
+def scan_value_labels(sphere, scan):
+    """The folder names of a scan's values for one sphere (range_factor x its sheet value)."""
+    spec = SCANS[scan]
+    centre = sphere_row(sphere)[SCAN_COLUMNS[spec["parameter"]]]
+    values = scan_values(centre, spec["range_factor"], spec["steps"], spec["spacing"])
+    return [value_label(v) for v in values]
+
+
+def scan_dir(material, sphere, scan):
+    return SCAN.format(material=material, sphere=sphere, scan=scan)
+
+
+def scan_points(wildcards):
+    """Every value's result of one sphere's scan."""
+    folder = scan_dir(wildcards.material, wildcards.sphere, wildcards.scan)
+    return [
+        f"{folder}/{value}/scan_point.json"
+        for value in scan_value_labels(wildcards.sphere, wildcards.scan)
+    ]
+
+
+def scan_outputs(materials):
+    """Every scan of every sphere of ``materials``: its table and best value."""
+    return [
+        f"{scan_dir(material, sphere, scan)}/{name}"
+        for material in materials
+        for sphere in spheres_of(material)
+        for scan in SCANS
+        for name in ("scan.csv", "best.json")
+    ]
+
+
+def scans_of(parameter):
+    """The running scans of ``parameter`` (p_y_mpa or k_mpa_per_nm)."""
+    return [name for name, spec in SCANS.items() if spec["parameter"] == parameter]
+
+
+def first_scene(model, optics=None):
+    """The first running AFM scene of ``model`` (and ``optics``), or None."""
+    names = scene_names(surface="afm_before", model=model, optics=optics)
+    return names[0] if names else None
+
+
+def scan_files(material, sphere, scan):
+    """What the study's figures read of one sphere's scan: its judgement, every value's
+    rendered fields and its base scene's registration."""
+    folder = scan_dir(material, sphere, scan)
+    base = scene_dir(material, sphere, SCANS[scan]["scene"])
+    return {
+        "best": f"{folder}/best.json",
+        "table": f"{folder}/scan.csv",
+        "rendered": [
+            f"{folder}/{v}/rendered.h5" for v in scan_value_labels(sphere, scan)
+        ],
+        "registration": f"{base}/registration.json",
+    }
+
+
+def flat_files(layout):
+    """Every path in a nested dict/list layout, once each."""
+    if isinstance(layout, dict):
+        return [p for value in layout.values() for p in flat_files(value)]
+    if isinstance(layout, list):
+        return [p for value in layout for p in flat_files(value)]
+    return [layout]
+
+
+def study_k_scan(wildcards):
+    """The files of the sphere's first k scan (figures B.9 and B.11)."""
+    return scan_files(wildcards.material, wildcards.sphere, scans_of("k_mpa_per_nm")[0])
+
+
+def load_series_layout(wildcards):
+    """Fig. B.11's inputs: the elastic scene's rendered loads and registration, the
+    Greenwood-Tripp solve and the k scan."""
+    elastic = scene_dir(
+        wildcards.material, wildcards.sphere, first_scene("elastic", "microscope")
+    )
+    gt = scene_dir(wildcards.material, wildcards.sphere, first_scene("greenwood_tripp"))
+    return {
+        "elastic": {
+            "rendered": f"{elastic}/rendered.h5",
+            "registration": f"{elastic}/registration.json",
+        },
+        "gt_solve": f"{gt}/solve.json",
+        "k_scan": study_k_scan(wildcards),
+    }
+
+
+def model_curve_layout(wildcards):
+    """Fig. B.12's inputs: each AFM scene's areas and each scan's best value."""
+    scenes = {}
+    for scene in scene_names(surface="afm_before"):
+        folder = scene_dir(wildcards.material, wildcards.sphere, scene)
+        files = {"solve": f"{folder}/solve.json"}
+        if SCENES[scene]["optics"] == "microscope":
+            files["render"] = f"{folder}/render.csv"
+        scenes[scene] = files
+    scans = {
+        scan: f"{scan_dir(wildcards.material, wildcards.sphere, scan)}/best.json"
+        for scan in SCANS
+    }
+    return {"scenes": scenes, "scans": scans}
+
+
+def model_table_layout(material):
+    """The model table's inputs per sphere: measured fit, scenes, scans' best values."""
+    layout = {}
+    for sphere in spheres_of(material):
+        scenes = {}
+        for scene in scene_names(surface="afm_before"):
+            folder = scene_dir(material, sphere, scene)
+            files = {"fit": f"{folder}/scene_fit.json", "solve": f"{folder}/solve.json"}
+            if SCENES[scene]["optics"] == "microscope":
+                files["comparison"] = f"{folder}/comparison.csv"
+            scenes[scene] = files
+        layout[sphere] = {
+            "measured": measured(material, sphere, "load_area_fit.json"),
+            "scenes": scenes,
+            "scans": {s: f"{scan_dir(material, sphere, s)}/best.json" for s in SCANS},
+        }
+    return layout
+
+
+CURVATURE_PAIRS = {
+    model: pair for model, pair in config["study"]["curvature_pairs"].items()
+}
+STUDY_RESULTS = f"results/{RUN}/study"
+
+
+def sphere_study_figures(material, sphere):
+    """The study's figures of one sphere that its scans and scenes allow (docs/study.md)."""
+    folder = STUDY.format(material=material, sphere=sphere)
+    names = []
+    if SCANS:
+        names += ["B8_scans", "B12_models"]
+    if scans_of("k_mpa_per_nm"):
+        names.append("B9_flattening")
+        if first_scene("elastic", "microscope") and first_scene("greenwood_tripp"):
+            names.append("B11_load_series")
+    return [f"{folder}/{name}.{ext}" for name in names for ext in ("png", "pdf", "csv")]
+
+
+def study_outputs(materials):
+    """The study's outputs of ``materials``: per-sphere figures and each material's model
+    table (with scans)."""
+    out = []
+    if SCANS:
+        for material in materials:
+            for sphere in spheres_of(material):
+                out += sphere_study_figures(material, sphere)
+            out.append(f"{MATERIAL.format(material=material)}/models.csv")
+    return out
+
+
+def study_overview_outputs():
+    """The study's figures across materials: Fig. B.13 (with scans) and Fig. B.10 (with
+    curvature pairs); built by `all` and `study`, not by a material's target."""
+    out = []
+    if SCANS:
+        out += [f"{STUDY_RESULTS}/B13_amontons.{ext}" for ext in ("png", "pdf", "csv")]
+    if CURVATURE_PAIRS:
+        out += [f"{STUDY_RESULTS}/B10_curvature.{ext}" for ext in ("png", "pdf", "csv")]
+    return out

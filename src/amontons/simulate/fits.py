@@ -62,3 +62,71 @@ def scene_table_rows(
             }
         )
     return rows
+
+
+def _exponent_columns(exponent: Mapping, measured: Mapping) -> dict:
+    return {
+        "exponent": exponent["estimate"],
+        "exponent_ci_low": exponent["ci_low"],
+        "exponent_ci_high": exponent["ci_high"],
+        "measured_exponent": measured["estimate"],
+        "measured_ci_low": measured["ci_low"],
+        "measured_ci_high": measured["ci_high"],
+        "exponent_difference": exponent["estimate"] - measured["estimate"],
+    }
+
+
+def model_table_rows(
+    sphere: str,
+    measured_fit: Mapping,
+    scenes: Mapping[str, Mapping],
+    scan_bests: Mapping[str, Mapping],
+    models: Mapping[str, str],
+) -> list[dict]:
+    """The model-comparison rows of one sphere (docs/study.md): each scene at its configured
+    parameter and each scan's best value, with its load-area exponent and interval beside the
+    measured one, its parameter, and the area ratio and IoU at the largest load.
+
+    ``scenes``: name → {"fit": scene_fit.json, "largest": the comparison's last row or None
+    (no optics), "solve": solve.json}; ``scan_bests``: scan name → best.json."""
+    measured = measured_fit["exponent"]
+    rows = []
+    for name, scene in scenes.items():
+        fit = scene["fit"]["rendered_area"] or scene["fit"]["solver_area"]
+        largest = scene["largest"]
+        parameter = {"penetration_hardness": "p_y_mpa", "hardening": "k_mpa_per_nm"}.get(
+            models[name]
+        )
+        rows.append(
+            {
+                "sphere": sphere,
+                "model": models[name],
+                "source": f"scene {name}",
+                "area": "rendered Otsu" if scene["fit"]["rendered_area"] else "solver",
+                "parameter": parameter,
+                "value": scene["solve"][parameter] if parameter else None,
+                "value_low": None,
+                "value_high": None,
+                **_exponent_columns(fit["exponent"], measured),
+                "area_ratio_largest": largest["area_ratio"] if largest else None,
+                "iou_largest": largest["iou"] if largest else None,
+            }
+        )
+    for name, best in scan_bests.items():
+        low, high = best["scatter_interval"]
+        rows.append(
+            {
+                "sphere": sphere,
+                "model": models[best["scene"]],
+                "source": f"scan {name}, best value",
+                "area": "rendered Otsu",
+                "parameter": best["parameter"],
+                "value": best["best"],
+                "value_low": low,
+                "value_high": high,
+                **_exponent_columns(best["best_rendered_fit"]["exponent"], measured),
+                "area_ratio_largest": best["area_ratio_largest"],
+                "iou_largest": best["iou_largest"],
+            }
+        )
+    return rows

@@ -96,6 +96,16 @@ class Registration:
         forward = _forward_matrix(self.mirrored, self.rotation_deg)
         return forward @ np.asarray(offset_px, dtype=float) + np.asarray(self.shift_px)
 
+    @classmethod
+    def from_record(cls, record: dict) -> Registration:
+        """The registration of a record written by :meth:`to_record` (registration.json)."""
+        return cls(
+            mirrored=bool(record["mirrored"]),
+            rotation_deg=float(record["rotation_deg"]),
+            shift_px=(float(record["shift_row_px"]), float(record["shift_col_px"])),
+            score=float(record["score"]),
+        )
+
     def to_record(self) -> dict:
         """JSON-ready fields (plain Python types)."""
         return {

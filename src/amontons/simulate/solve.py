@@ -97,7 +97,8 @@ def solve_scene(scene: Scene, indenter: Indenter, *, threads: int = 1) -> SceneS
 def greenwood_tripp_scene(
     scene: Scene, h_rms_m: float, curvature_rms_per_m: float, eta_sigma_beta: float = 0.05
 ) -> list[dict]:
-    """Greenwood-Tripp real contact area (µm²) per load of the scene's sphere, with the
+    """Greenwood-Tripp real contact area (µm²) per load of the scene's sphere, and its radial
+    profile of the real-area fraction (annulus mid-radii, µm), with the
     asperity closure of docs/models.md §2.5 (σ = h_rms, β = 1/h''_rms, ησβ = 0.05)."""
     model = AsperityModel.from_roughness(h_rms_m, curvature_rms_per_m, eta_sigma_beta)
     rows = []
@@ -109,6 +110,9 @@ def greenwood_tripp_scene(
                 "area_um2": gt.real_area_m2 * 1e12,
                 "approach_nm": gt.approach_m * 1e9,
                 "newton_iterations": int(gt.newton_iterations),
+                # the radial profile: the mean-field map a figure draws (no asperity map)
+                "r_um": [float(r) * 1e6 for r in gt.r_m],
+                "area_fraction": [float(f) for f in gt.area_fraction],
             }
         )
     return rows

@@ -1,0 +1,100 @@
+"""Rule best_scan_value: a sphere's scan judged (docs/study.md): every value's distance from
+the measured areas, the best value and its brackets."""
+
+import logging
+
+import pandas as pd
+
+from amontons.fits import fit_power_law
+from amontons.io.files import read_json, write_json, write_table
+from amontons.runlog import run_logged
+from amontons.simulate.scan import ScanError, ScanPoint, best_scan_value, log_area_scatter
+
+log = logging.getLogger(__name__)
+
+
+def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str, confidence):
+    records = sorted((read_json(p) for p in point_paths), key=lambda r: r["value"])
+    solved = [r for r in records if r["outside_window"] is None]
+    if not solved:
+        raise ScanError(
+            f"scan {scan_name}: at every value ({', '.join(str(r['value']) for r in records)}) "
+            "the contact leaves the base scene's window; expected a range_factor whose values "
+            "give contacts that fit (or a larger window_factor)"
+        )
+    measured = [row for row in solved[0]["loads"] if row["measured_contact_found"]]
+    scatter = log_area_scatter(
+        [row["load_mn"] for row in measured], [row["measured_area_um2"] for row in measured]
+    )
+    points = [
+        ScanPoint(r["value"], r["log_area_distance"], r["iou_largest"], r["area_ratio_largest"])
+        if r["outside_window"] is None
+        else ScanPoint(r["value"], float("inf"), 0.0, float("inf"))
+        for r in records
+    ]
+    best = best_scan_value(points, scatter, len(measured), confidence)
+    log.info(
+        "%s: best %s = %g (D = %.4f; scan bracket %s, scatter interval %s)",
+        scan_name,
+        records[0]["parameter"],
+        best.value,
+        best.distance,
+        [best.resolution_low, best.resolution_high],
+        [best.scatter_low, best.scatter_high],
+    )
+    rows = []
+    for record in records:
+        outside = record["outside_window"] is not None
+        largest = {} if outside else record["loads"][-1]
+        rows.append(
+            {
+                "value": record["value"],
+                "log_area_distance": record["log_area_distance"],
+                "iou_largest": record.get("iou_largest"),
+                "area_ratio_largest": record.get("area_ratio_largest"),
+                "simulated_area_largest_um2": largest.get("simulated_area_um2"),
+                "measured_area_largest_um2": largest.get("measured_area_um2"),
+                "best": record["value"] == best.value,
+                "contact_leaves_window": outside,
+                "wall_time_s": record.get("wall_time_s"),
+            }
+        )
+    write_table(table_path, pd.DataFrame(rows))
+    chosen = next(r for r in records if r["value"] == best.value)["loads"]
+    loads = [row["load_mn"] for row in chosen]
+    rendered = [row["simulated_area_um2"] for row in chosen]
+    write_json(
+        best_path,
+        {
+            "sphere": records[0]["sphere"],
+            "scan": scan_name,
+            "scene": records[0]["scene"],
+            "parameter": records[0]["parameter"],
+            "values": [r["value"] for r in records],
+            **best.to_record(),
+            "iou_largest": next(r["iou_largest"] for r in records if r["value"] == best.value),
+            "area_ratio_largest": next(
+                r["area_ratio_largest"] for r in records if r["value"] == best.value
+            ),
+            "best_loads": [
+                {k: row[k] for k in ("load_mn", "simulated_area_um2", "solver_area_um2")}
+                for row in chosen
+            ],
+            "best_rendered_fit": fit_power_law(
+                loads, rendered, x_ref=loads[0], confidence=confidence
+            ).to_record(),
+        },
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        point_paths=list(sm.input.points),
+        table_path=sm.output.table,
+        best_path=sm.output.best,
+        scan_name=sm.wildcards.scan,
+        confidence=sm.params.confidence,
+    )

@@ -1,0 +1,162 @@
+"""Rule plot_flattening_maps: appendix Fig. B.9 for one sphere. The AFM map before and after
+the load series, and the deformed surface h + h_pl of the hardening model at the k scan's
+best k after the largest load; sphere curvature subtracted from all three, all in the AFM
+frame cut to the solver window about the fitted apex. Each shows the flattening: measured,
+where after − before drops (amontons.measure.flattening); simulated, where h_pl < 0; its
+depth (the median drop over the pixels that went down by more than half of it, the same
+definition for both) and the centre of the flattened region."""
+
+import logging
+
+import numpy as np
+import pandas as pd
+
+from amontons.contact.surfaces import sphere as sphere_cap
+from amontons.io.fields import read_load_series
+from amontons.io.files import read_json, write_table
+from amontons.measure.flattening import SMOOTHING_PX
+from amontons.measure.scan_lines import line_levelling_mode
+from amontons.measure.topography import measure_topography
+from amontons.physics.roughness import flattening_depth
+from amontons.runlog import run_logged
+from amontons.study_figures import MapPanel, plot_height_maps
+
+log = logging.getLogger(__name__)
+
+
+def window_slices(shape, pixel_m: float, centre_m, window_m: float) -> tuple[slice, slice]:
+    """The AFM pixels of the solver window: side ``window_m`` about ``centre_m`` (row, col; m
+    from the scan centre)."""
+    half = window_m / 2 / pixel_m
+    out = []
+    for n, c in zip(shape, centre_m, strict=True):
+        mid = (n - 1) / 2 + c / pixel_m
+        out.append(slice(max(0, int(round(mid - half))), min(n, int(round(mid + half)))))
+    return tuple(out)
+
+
+def flattened_region(drop_m: np.ndarray, smoothing_px: float, floor_m: float):
+    """Depth (m or None), the flattened pixels, and their centre (row, col px)."""
+    depth, core = flattening_depth(drop_m, smoothing_px=smoothing_px, floor_m=floor_m)
+    if depth is None or not core.any():
+        return None, core, None
+    rows, cols = np.nonzero(core)
+    return depth, core, (float(rows.mean()), float(cols.mean()))
+
+
+def describe(name: str, depth, centre, pixel_m: float, shape, area_px: int) -> dict:
+    """The CSV row of one panel: depth (nm) and centre (µm from the window centre)."""
+    offset = (
+        [None, None]
+        if centre is None
+        else [(c - (n - 1) / 2) * pixel_m * 1e6 for c, n in zip(centre, shape, strict=True)]
+    )
+    return {
+        "panel": name,
+        "flattening_depth_nm": None if depth is None else depth * 1e9,
+        "centre_row_um": offset[0],
+        "centre_col_um": offset[1],
+        "flattened_area_um2": area_px * pixel_m**2 * 1e12,
+    }
+
+
+def _title(name: str, depth) -> str:
+    return f"{name}\nflattening {'none' if depth is None else f'{depth * 1e9:.1f} nm deep'}"
+
+
+def main(
+    before_path: str,
+    after_path: str,
+    k_scan: dict,
+    table_path: str,
+    figure_paths: list[str],
+    afm: dict,
+    label: str,
+) -> None:
+    topo = measure_topography(
+        before_path,
+        after_path,
+        None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
+        nan_policy=afm["nan_policy"],
+        channel=afm["channel"],
+        line_levelling=line_levelling_mode(afm["line_levelling"]),
+    )
+    best = read_json(k_scan["best"])
+    path = next(p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["best"])
+    fields, _, attrs = read_load_series(path)
+    last = fields[-1]
+    solver_pixel = attrs["pixel_nm"] * 1e-9
+    window = window_slices(
+        topo.before.roughness.shape,
+        topo.pixel_m,
+        [c * 1e-6 for c in attrs["window_centre_in_scan_um"]],
+        attrs["window_um"] * 1e-6,
+    )
+    before = topo.before.roughness[window]
+    after = topo.after.roughness[window]
+    change = topo.change_m[window]
+    threshold = topo.flattening.threshold_m
+    depth, core, centre = flattened_region(-change, SMOOTHING_PX, threshold)
+    # The simulation: h + h_pl minus the fitted sphere, on the solver grid; the same
+    # smoothing length and floor as the measurement decide its flattened region.
+    deformed = last["deformed_heights"] - sphere_cap(
+        last["deformed_heights"].shape, solver_pixel, topo.before.radius_m
+    )
+    deformed -= np.median(deformed)
+    sim_depth, sim_core, sim_centre = flattened_region(
+        -last["plastic_displacement"].astype(float),
+        SMOOTHING_PX * topo.pixel_m / solver_pixel,
+        threshold,
+    )
+    afm_um = topo.pixel_m * 1e6
+    panels = [
+        MapPanel(before * 1e9, _title("a) AFM before", depth), core, centre, pixel_um=afm_um),
+        MapPanel(after * 1e9, _title("b) AFM after", depth), core, centre, pixel_um=afm_um),
+        MapPanel(
+            deformed * 1e9,
+            _title(f"c) hardening, k = {best['best']:g} MPa/nm", sim_depth),
+            sim_core,
+            sim_centre,
+            pixel_um=solver_pixel * 1e6,
+        ),
+    ]
+    rows = [
+        describe(
+            "measured (after - before)", depth, centre, topo.pixel_m, change.shape, int(core.sum())
+        ),
+        describe(
+            "hardening model (h_pl)",
+            sim_depth,
+            sim_centre,
+            solver_pixel,
+            sim_core.shape,
+            int(sim_core.sum()),
+        ),
+    ]
+    table = pd.DataFrame(rows)
+    table["best_k_mpa_per_nm"] = best["best"]
+    table["load_mn"] = read_load_series(path)[1][-1]["load_mn"]
+    write_table(table_path, table)
+    log.info("\n%s", table.to_string(index=False))
+    plot_height_maps(
+        panels,
+        f"{label}: AFM before and after the load series, and the hardening model's deformed "
+        f"surface (best k = {best['best']:g} MPa/nm); sphere subtracted; outlines: flattened "
+        "regions, +: their centres",
+        figure_paths,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        before_path=sm.input.before,
+        after_path=sm.input.after,
+        k_scan=sm.params.k_scan,
+        table_path=sm.output.table,
+        figure_paths=[sm.output.png, sm.output.pdf],
+        afm=sm.params.afm,
+        label=sm.params.label,
+    )

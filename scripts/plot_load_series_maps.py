@@ -1,0 +1,149 @@
+"""Rule plot_load_series_maps: appendix Figs. 5.2 and B.11 for one sphere. Measured and
+simulated contact at increasing loads: the experiment, Greenwood-Tripp (its mean-field
+real-area fraction: the model has no asperity map), the elastic scene and the hardening
+model at the best k of the k scan, each simulation warped onto the measured image by its
+scene's registration."""
+
+import logging
+
+import numpy as np
+import pandas as pd
+
+from amontons.io.fields import read_load_series
+from amontons.io.files import read_json, write_table
+from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.rawdata import read_fluorescence_series
+from amontons.measure.area import OtsuSettings, image_contact_area
+from amontons.runlog import run_logged
+from amontons.simulate.compare import intersection_over_union
+from amontons.simulate.register import Registration, warp_to_measured
+from amontons.study_figures import MapPanel, crop_box, plot_map_grid
+
+log = logging.getLogger(__name__)
+
+
+def area_fraction_map(profile: dict, shape, centre_px, pixel_m: float) -> np.ndarray:
+    """Greenwood-Tripp's real-area fraction φ(r) on the image grid about ``centre_px``."""
+    rows, cols = np.indices(shape, dtype=float)
+    r_um = np.hypot(rows - centre_px[0], cols - centre_px[1]) * pixel_m * 1e6
+    return np.interp(r_um, profile["r_um"], profile["area_fraction"], right=0.0)
+
+
+def warped_series(path: str, registration: Registration, shape):
+    """Every load's rendered image of ``path`` on the measured grid, with its Otsu mask."""
+    fields, per_load, attrs = read_load_series(path)
+    out = []
+    for field, info in zip(fields, per_load, strict=True):
+        image = warp_to_measured(field["image"], registration, shape, order=1)
+        out.append((image, image > info["otsu_threshold"]))
+    return out, attrs
+
+
+def main(
+    fluorescence,
+    gt_solve: str,
+    elastic: dict,
+    k_scan: dict,
+    table_path: str,
+    figure_paths: list[str],
+    loads_mn: list[float],
+    pixel_nm: float,
+    otsu: dict,
+    label: str,
+) -> None:
+    pixel_m = pixel_nm * 1e-9
+    images = read_fluorescence_series(
+        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_m
+    )
+    settings = OtsuSettings.from_config(otsu)
+    measured = [image_contact_area(image, settings) for image in images]
+    shape = images[0].data.shape
+    box = crop_box(measured[-1].mask)
+    best = read_json(k_scan["best"])
+    best_path = next(
+        p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["best"]
+    )
+    hardening_registration = Registration.from_record(read_json(k_scan["registration"]))
+    elastic_registration = Registration.from_record(read_json(elastic["registration"]))
+    series = {
+        "elastic": warped_series(elastic["rendered"], elastic_registration, shape)[0],
+        "hardening": warped_series(best_path, hardening_registration, shape)[0],
+    }
+    gt = read_json(gt_solve)["loads"]
+    centre = (
+        np.asarray(hardening_registration.map_offset_px((0.0, 0.0))) + (np.asarray(shape) - 1) / 2
+    )
+    rows = {"experiment": [], "greenwood_tripp": [], "elastic": [], "hardening": []}
+    records = []
+    for i, load in enumerate(loads_mn):
+        rows["experiment"].append(
+            MapPanel(images[i].data[box], f"{load:g} mN", measured[i].mask[box])
+        )
+        phi = area_fraction_map(gt[i], shape, centre, pixel_m)
+        rows["greenwood_tripp"].append(MapPanel(phi[box], f"A = {gt[i]['area_um2']:.0f} µm²"))
+        records.append(
+            {
+                "load_mn": load,
+                "row": "experiment",
+                "area_um2": measured[i].area_m2 * 1e12,
+                "area": "measured Otsu",
+                "iou": None,
+            }
+        )
+        records.append(
+            {
+                "load_mn": load,
+                "row": "greenwood_tripp",
+                "area_um2": gt[i]["area_um2"],
+                "area": "model real area",
+                "iou": None,
+            }
+        )
+        for name in ("elastic", "hardening"):
+            image, mask = series[name][i]
+            area = np.count_nonzero(mask) * pixel_m**2 * 1e12
+            iou = intersection_over_union(mask, measured[i].mask)
+            rows[name].append(MapPanel(image[box], f"IoU {iou:.2f}", mask[box]))
+            records.append(
+                {
+                    "load_mn": load,
+                    "row": name,
+                    "area_um2": area,
+                    "area": "rendered Otsu (registered)",
+                    "iou": iou,
+                }
+            )
+    table = pd.DataFrame(records)
+    table["best_k_mpa_per_nm"] = best["best"]
+    write_table(table_path, table)
+    plot_map_grid(
+        list(rows.values()),
+        [
+            "experiment",
+            "Greenwood-Tripp\n(area fraction)",
+            "elastic",
+            f"hardening\nk = {best['best']:g} MPa/nm",
+        ],
+        pixel_nm * 1e-3,
+        f"{label}: measured and simulated contact at increasing loads (hardening at the k "
+        f"scan's best k = {best['best']:g} MPa/nm); outlines: Otsu masks",
+        figure_paths,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        fluorescence=sm.input.fluorescence,
+        gt_solve=sm.input.gt_solve,
+        elastic=sm.params.elastic,
+        k_scan=sm.params.k_scan,
+        table_path=sm.output.table,
+        figure_paths=[sm.output.png, sm.output.pdf],
+        loads_mn=sm.params.loads_mn,
+        pixel_nm=sm.params.pixel_nm,
+        otsu=sm.params.otsu,
+        label=sm.params.label,
+    )

@@ -1,0 +1,107 @@
+"""Rule plot_scan_maps: appendix Fig. B.8 for one sphere. The measured contact at the largest
+load beside the rendered contact of every value of every scan, each warped onto the measured
+image by its base scene's registration; the best value of each scan framed."""
+
+import logging
+
+import numpy as np
+import pandas as pd
+
+from amontons.io.fields import read_load_series
+from amontons.io.files import read_json, write_table
+from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.rawdata import read_fluorescence_series
+from amontons.measure.area import OtsuSettings, image_contact_area
+from amontons.runlog import run_logged
+from amontons.simulate.register import Registration, warp_to_measured
+from amontons.study_figures import MapPanel, crop_box, plot_map_grid
+
+log = logging.getLogger(__name__)
+
+
+def main(
+    fluorescence,
+    scans: dict,
+    table_path: str,
+    figure_paths: list[str],
+    loads_mn: list[float],
+    pixel_nm: float,
+    otsu: dict,
+    label: str,
+) -> None:
+    images = read_fluorescence_series(
+        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
+    )
+    measured = images[-1]
+    contact = image_contact_area(measured, OtsuSettings.from_config(otsu))
+    box = crop_box(contact.mask)
+    rows = [[MapPanel(measured.data[box], f"measured, {loads_mn[-1]:g} mN", contact.mask[box])]]
+    labels = ["experiment"]
+    records = []
+    for name, scan in scans.items():
+        best = read_json(scan["best"])
+        table = pd.read_csv(scan["table"]).set_index("value")
+        registration = Registration.from_record(read_json(scan["registration"]))
+        panels = []
+        for path in scan["rendered"]:
+            fields, per_load, attrs = read_load_series(path)
+            value = attrs["value"]
+            row = table.loc[value]
+            record = {
+                "scan": name,
+                "parameter": best["parameter"],
+                "value": value,
+                "log_area_distance": row["log_area_distance"],
+                "iou_largest": row["iou_largest"],
+                "area_ratio_largest": row["area_ratio_largest"],
+                "best": value == best["best"],
+                "contact_leaves_window": not fields,
+                "load_mn": loads_mn[-1],
+            }
+            records.append(record)
+            if not fields:
+                blank = np.zeros_like(measured.data[box], dtype=float)
+                panels.append(MapPanel(blank, f"{value:g}\ncontact leaves window"))
+                continue
+            image = warp_to_measured(
+                fields[-1]["image"], registration, measured.data.shape, order=1
+            )
+            threshold = per_load[-1]["otsu_threshold"]
+            panels.append(
+                MapPanel(
+                    image[box],
+                    f"{value:g}\nD = {row['log_area_distance']:.3f}",
+                    (image > threshold)[box],
+                    framed=record["best"],
+                )
+            )
+        rows.append(panels)
+        symbol = {"p_y_mpa": "p_Y (MPa)", "k_mpa_per_nm": "k (MPa/nm)"}[best["parameter"]]
+        labels.append(f"{best['scene']}\n{symbol}")
+        log.info("%s: best %s = %g", name, best["parameter"], best["best"])
+    write_table(table_path, pd.DataFrame(records))
+    bests = ", ".join(f"{r['parameter']} = {r['value']:g}" for r in records if r["best"])
+    plot_map_grid(
+        rows,
+        labels,
+        pixel_nm * 1e-3,
+        f"{label}: contact at {loads_mn[-1]:g} mN, measured and simulated over the scans; "
+        f"best (framed): {bests}; D: rms log-area distance over all loads",
+        figure_paths,
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        fluorescence=sm.input.fluorescence,
+        scans=sm.params.scans,
+        table_path=sm.output.table,
+        figure_paths=[sm.output.png, sm.output.pdf],
+        loads_mn=sm.params.loads_mn,
+        pixel_nm=sm.params.pixel_nm,
+        otsu=sm.params.otsu,
+        label=sm.params.label,
+    )

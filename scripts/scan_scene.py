@@ -1,0 +1,152 @@
+"""Rule scan_scene: one value of a parameter scan (docs/study.md). The base scene with its
+parameter set to the value, solved over the measured loads (warm-started load to load),
+rendered like the microscope sees it, and compared with the measured contact under the base
+scene's registration."""
+
+import logging
+import os
+
+if "snakemake" in globals():
+    # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
+
+from amontons.contact import FreeBoundaryError
+from amontons.io.fields import write_load_series
+from amontons.io.files import read_json, write_json
+from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.rawdata import read_fluorescence_series
+from amontons.measure.area import OtsuSettings, image_contact_area
+from amontons.runlog import run_logged
+from amontons.simulate.compare import compare_loads
+from amontons.simulate.register import Registration
+from amontons.simulate.render import render_load_series
+from amontons.simulate.scan import log_area_distance, scene_config_at
+from amontons.simulate.scene import scene_for_sphere
+from amontons.simulate.solve import solve_scene
+from amontons.simulate.surface import afm_indenter, load_levelled_map
+
+log = logging.getLogger(__name__)
+
+
+def main(
+    levelled_path: str,
+    psf_path: str,
+    registration_path: str,
+    fluorescence,
+    fields_path: str,
+    point_path: str,
+    scan: dict,
+    base_config: dict,
+    value: float,
+    sphere: str,
+    sphere_record: dict,
+    pixel_nm: float,
+    otsu: dict,
+    threads: int,
+) -> None:
+    config = scene_config_at(base_config, scan["parameter"], value)
+    scene = scene_for_sphere(scan["scene"], config, sphere, sphere_record)
+    indenter = afm_indenter(load_levelled_map(levelled_path), scene, levelled_path)
+    record = {
+        "sphere": sphere,
+        "scene": scan["scene"],
+        "parameter": scan["parameter"],
+        "value": value,
+    }
+    try:
+        solution = solve_scene(scene, indenter, threads=threads)
+    except FreeBoundaryError as error:
+        # A value so soft that the contact outgrows the base scene's window (which holds the
+        # measured contact with room to spare) matches the measurement worse than any value
+        # whose contact fits: recorded, never best, and the run goes on.
+        log.warning("%s = %g: %s", scan["parameter"], value, error)
+        write_load_series(fields_path, [], [], {**scene.to_record(), **record})
+        write_json(point_path, {**record, "log_area_distance": None, "outside_window": str(error)})
+        return
+    settings = OtsuSettings.from_config(otsu)
+    rendered = render_load_series(
+        solution.fields,
+        scene.pixel_m,
+        pixel_m=pixel_nm * 1e-9,
+        psf_fwhm_m=read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9,
+        rendering=config["rendering"],
+        confinement_floor_pa=config["confinement_floor_mpa"] * 1e6,
+        otsu=settings,
+    )
+    loads_mn = [row["load_mn"] for row in solution.per_load]
+    images = read_fluorescence_series(
+        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
+    )
+    measured = [image_contact_area(image, settings) for image in images]
+    rows = compare_loads(
+        [f * 1e-3 for f in loads_mn],
+        rendered,
+        measured,
+        [row["area_um2"] * 1e-12 for row in solution.per_load],
+        Registration.from_record(read_json(registration_path)),
+        pixel_nm * 1e-9,
+    )
+    used = [row for row in rows if row.measured_found]
+    distance = log_area_distance(
+        [row.simulated_area_m2 for row in used], [row.measured_area_m2 for row in used]
+    )
+    log.info("%s = %g: D = %.4f over %d loads", scan["parameter"], value, distance, len(used))
+    last = solution.fields[-1]
+    fields = [{"image": r.image} for r in rendered]
+    fields[-1] |= {
+        "plastic_displacement": last["plastic_displacement"].astype("float32"),
+        "deformed_heights": last["deformed_heights"].astype("float32"),
+    }
+    write_load_series(
+        fields_path,
+        fields,
+        [
+            {"load_mn": f, "otsu_threshold": r.otsu.threshold}
+            for f, r in zip(loads_mn, rendered, strict=True)
+        ],
+        {
+            **scene.to_record(),
+            "parameter": scan["parameter"],
+            "value": value,
+            "image_pixel_nm": pixel_nm,
+            "window_centre_in_scan_um": [c * 1e6 for c in indenter.centre_in_scan_m],
+        },
+    )
+    write_json(
+        point_path,
+        {
+            **record,
+            "log_area_distance": distance,
+            "outside_window": None,
+            "loads_used": len(used),
+            "iou_largest": rows[-1].iou,
+            "area_ratio_largest": rows[-1].area_ratio,
+            "wall_time_s": solution.wall_time_s,
+            "loads": [
+                {**row.to_record(), **{k: info[k] for k in ("iterations", "outer_iterations")}}
+                for row, info in zip(rows, solution.per_load, strict=True)
+            ],
+        },
+    )
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821 (injected by Snakemake)
+    run_logged(
+        main,
+        sm.log[0],
+        levelled_path=sm.input.levelled,
+        psf_path=sm.input.psf,
+        registration_path=sm.input.registration,
+        fluorescence=sm.input.fluorescence,
+        fields_path=sm.output.fields,
+        point_path=sm.output.point,
+        scan=sm.params.scan,
+        base_config=sm.params.base,
+        value=float(sm.wildcards.value),
+        sphere=sm.wildcards.sphere,
+        sphere_record=sm.params.sphere_record,
+        pixel_nm=sm.params.pixel_nm,
+        otsu=sm.params.otsu,
+        threads=sm.threads,
+    )
