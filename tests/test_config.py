@@ -348,6 +348,10 @@ def test_run_scenes_must_name_defined_scenes(repo, config_schema, sheet_schema, 
             r"scans\.p_y\.parameter = 'hurst' is not allowed",
         ),
         (
+            lambda c: c["study"].update(run_curvature_pairs=["elastic", "plastic"]),
+            r"study\.run_curvature_pairs names 'plastic', not in study\.curvature_pairs",
+        ),
+        (
             lambda c: c["study"]["curvature_pairs"].update(
                 elastic=["curved_elastic", "flat_elastic"]
             ),

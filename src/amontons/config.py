@@ -407,7 +407,17 @@ def check_scans(config: Mapping, spheres: Mapping[str, dict], source: str) -> No
 
 def check_curvature_pairs(config: Mapping, source: str) -> None:
     """Fig. B.10's pairs: [flat periodic, curved] synthetic scenes of one model, both running."""
-    for model, pair in config["study"]["curvature_pairs"].items():
+    study = config["study"]
+    unknown = [
+        name for name in study["run_curvature_pairs"] if name not in study["curvature_pairs"]
+    ]
+    if unknown:
+        raise ConfigError(
+            f"{source}: study.run_curvature_pairs names {', '.join(map(repr, unknown))}, not in "
+            f"study.curvature_pairs; expected one of {', '.join(study['curvature_pairs'])}"
+        )
+    for model in study["run_curvature_pairs"]:
+        pair = study["curvature_pairs"][model]
         where = f"{source}: study.curvature_pairs.{model}"
         for name, geometry in zip(pair, ("flat_periodic", "sphere"), strict=True):
             if name not in config["run_scenes"]:

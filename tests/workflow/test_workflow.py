@@ -272,13 +272,25 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
     # (Key order is kept: Snakemake compares params dicts in order.)
     _edit_config(project, lambda c: c.update(optics={"psf": {"profile_radius_nm": 1800.0}}))
     changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
-    # The PSF also renders the three optics scenes of each sphere: they follow it.
+    # The PSF also renders the three optics scenes of each sphere and every scan value
+    # (2 spheres x 2 scans x 7 values): they follow it, and so does the study built on them.
+    study = {
+        "best_scan_value": "4",
+        "plot_amontons_study": "1",
+        "plot_flattening_maps": "2",
+        "plot_load_series_maps": "2",
+        "plot_model_curves": "2",
+        "plot_scan_maps": "2",
+        "tabulate_models": "2",
+    }
     assert _job_stats(changed.stdout) == {
         "measure_psf": "2",
         "render_scene": "6",
         "compare_scene": "6",
         "fit_scene": "6",
         "tabulate_scenes": "2",
+        "scan_scene": "28",
+        **study,
         "all": "1",
     }
 
@@ -287,6 +299,8 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
         config.pop("optics")
         config["scenes"] = {"hardening": {"tol": 1.0e-7}}
 
+    # The k scan presses its base scene (hardening) at every value: its 2 x 7 jobs follow,
+    # the p_Y scan's do not.
     _edit_config(project, retune_hardening)
     changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
     assert _job_stats(changed.stdout) == {
@@ -295,6 +309,9 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
         "compare_scene": "2",
         "fit_scene": "2",
         "tabulate_scenes": "2",
+        "scan_scene": "14",
+        **study,
+        "best_scan_value": "2",
         "all": "1",
     }
 
@@ -534,7 +551,7 @@ def _scene_jobs(project, target, **changes):
         config["run_scenes"] = ["probe"]
         config["scenes"] = {"probe": {**PROBE_SCENE, **changes}}
         config["run_scans"] = []  # the scans' base scenes are not selected
-        config["study"] = {"curvature_pairs": {}}
+        config["study"] = {"run_curvature_pairs": []}
 
     _edit_config(project, edit)
     result = snakemake(project, target, "-n", "--configfile", "config/test.yaml")
@@ -828,7 +845,7 @@ def test_b13_csv_normalises_measurement_and_model_at_the_reference_load(small_ru
 def test_without_scans_no_scan_or_study_job_runs(project):
     def edit(config):
         config["run_scans"] = []
-        config["study"] = {"curvature_pairs": {}}
+        config["study"] = {"run_curvature_pairs": []}
 
     _edit_config(project, edit)
     result = snakemake(project, "-n", "--configfile", "config/test.yaml")

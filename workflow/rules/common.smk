@@ -509,7 +509,8 @@ def model_table_layout(material):
 
 
 CURVATURE_PAIRS = {
-    model: pair for model, pair in config["study"]["curvature_pairs"].items()
+    name: config["study"]["curvature_pairs"][name]
+    for name in config["study"]["run_curvature_pairs"]
 }
 STUDY_RESULTS = f"results/{RUN}/study"
 
