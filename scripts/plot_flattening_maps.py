@@ -17,45 +17,25 @@ from amontons.io.files import read_json, write_table
 from amontons.measure.flattening import SMOOTHING_PX
 from amontons.measure.scan_lines import line_levelling_mode
 from amontons.measure.topography import measure_topography
-from amontons.physics.roughness import flattening_depth
 from amontons.runlog import run_logged
+from amontons.simulate.flattening import (
+    flattened_region,
+    offset_from_centre_m,
+    window_slices,
+)
 from amontons.study_figures import MapPanel, plot_height_maps
 
 log = logging.getLogger(__name__)
 
 
-def window_slices(shape, pixel_m: float, centre_m, window_m: float) -> tuple[slice, slice]:
-    """The AFM pixels of the solver window: side ``window_m`` about ``centre_m`` (row, col; m
-    from the scan centre)."""
-    half = window_m / 2 / pixel_m
-    out = []
-    for n, c in zip(shape, centre_m, strict=True):
-        mid = (n - 1) / 2 + c / pixel_m
-        out.append(slice(max(0, int(round(mid - half))), min(n, int(round(mid + half)))))
-    return tuple(out)
-
-
-def flattened_region(drop_m: np.ndarray, smoothing_px: float, floor_m: float):
-    """Depth (m or None), the flattened pixels, and their centre (row, col px)."""
-    depth, core = flattening_depth(drop_m, smoothing_px=smoothing_px, floor_m=floor_m)
-    if depth is None or not core.any():
-        return None, core, None
-    rows, cols = np.nonzero(core)
-    return depth, core, (float(rows.mean()), float(cols.mean()))
-
-
 def describe(name: str, depth, centre, pixel_m: float, shape, area_px: int) -> dict:
     """The CSV row of one panel: depth (nm) and centre (µm from the window centre)."""
-    offset = (
-        [None, None]
-        if centre is None
-        else [(c - (n - 1) / 2) * pixel_m * 1e6 for c, n in zip(centre, shape, strict=True)]
-    )
+    offset = offset_from_centre_m(centre, shape, pixel_m) or (None, None)
     return {
         "panel": name,
         "flattening_depth_nm": None if depth is None else depth * 1e9,
-        "centre_row_um": offset[0],
-        "centre_col_um": offset[1],
+        "centre_row_um": None if offset[0] is None else offset[0] * 1e6,
+        "centre_col_um": None if offset[1] is None else offset[1] * 1e6,
         "flattened_area_um2": area_px * pixel_m**2 * 1e12,
     }
 

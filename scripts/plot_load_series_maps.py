@@ -17,16 +17,10 @@ from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
 from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.register import Registration, warp_to_measured
+from amontons.simulate.render import area_fraction_map
 from amontons.study_figures import MapPanel, crop_box, plot_map_grid
 
 log = logging.getLogger(__name__)
-
-
-def area_fraction_map(profile: dict, shape, centre_px, pixel_m: float) -> np.ndarray:
-    """Greenwood-Tripp's real-area fraction φ(r) on the image grid about ``centre_px``."""
-    rows, cols = np.indices(shape, dtype=float)
-    r_um = np.hypot(rows - centre_px[0], cols - centre_px[1]) * pixel_m * 1e6
-    return np.interp(r_um, profile["r_um"], profile["area_fraction"], right=0.0)
 
 
 def warped_series(path: str, registration: Registration, shape):
@@ -79,7 +73,7 @@ def main(
         rows["experiment"].append(
             MapPanel(images[i].data[box], f"{load:g} mN", measured[i].mask[box])
         )
-        phi = area_fraction_map(gt[i], shape, centre, pixel_m)
+        phi = area_fraction_map(gt[i]["r_um"], gt[i]["area_fraction"], shape, centre, pixel_m)
         rows["greenwood_tripp"].append(MapPanel(phi[box], f"A = {gt[i]['area_um2']:.0f} µm²"))
         records.append(
             {

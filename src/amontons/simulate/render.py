@@ -97,3 +97,14 @@ def render_load_series(
         )
         out.append(Rendered(image, pixel_m, otsu_contact_area(image, pixel_m, otsu)))
     return out
+
+
+def area_fraction_map(
+    r_um: np.ndarray, area_fraction: np.ndarray, shape, centre_px, pixel_m: float
+) -> np.ndarray:
+    """A mean-field model's real-area fraction φ(r) (radii in µm, e.g. Greenwood-Tripp's
+    annulus mid-radii) on an image grid of ``shape`` about ``centre_px`` (row, col): the map a
+    model without asperity geometry gives. Zero beyond its last radius."""
+    rows, cols = np.indices(shape, dtype=float)
+    radius_um = np.hypot(rows - centre_px[0], cols - centre_px[1]) * pixel_m * 1e6
+    return np.interp(radius_um, r_um, area_fraction, right=0.0)
