@@ -88,6 +88,7 @@ rule tabulate_models:
         layout=lambda wc: model_table_layout(wc.material),
         spheres=lambda wc: spheres_of(wc.material),
         models={name: scene["model"] for name, scene in SCENES.items()},
+        data_label=lambda wc: data_label(spheres_of(wc.material)),
     script:
         "../../scripts/tabulate_models.py"
 
