@@ -73,7 +73,7 @@ def main(
         confinement_floor_pa=config["confinement_floor_mpa"] * 1e6,
         otsu=settings,
     )
-    loads_mn = [row["load_mn"] for row in solution.per_load]
+    loads_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
     images = read_fluorescence_series(
         per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
     )
