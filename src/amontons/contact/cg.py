@@ -356,12 +356,26 @@ def polonsky_keer(
             # r - mean_Ic(r): the direction must not change the total force
             rt -= float(np.dot(r, m)) / nc * float(t.sum())
         if not (rt > 0 and np.isfinite(rt)):
-            if big_g == 0.0:
-                # exact solution (e.g. uniform full contact): nothing left to do
-                residual = 0.0
-                history.append(0.0)
+            # no descent direction: the gap on the free set is nil or round-off (uniform
+            # full contact; a one-pixel free set, whose gap is 0 by definition of d under
+            # load control) or conjugacy was lost to round-off. The solution if that gap is
+            # below tol and nothing penetrates off the free set; penetrating points join the
+            # free set at p = 0 and the next (steepest-descent) iteration moves them
+            ol = constraint.violators(p, g, m)
+            pen = float(np.abs(g[ol]).max()) if ol.size else 0.0
+            residual = max(np.sqrt(big_g / nc), pen) / h_scale
+            if residual < tol and since_fresh:
+                # judge it on a freshly convolved u, never the incremental one
+                conv(p, u)
+                since_fresh = 0
+                history.append(residual)
+                continue
+            if residual < tol:
+                history.append(residual)
                 converged = True
                 break
+            m[ol] = 1.0
+            nc += ol.size
             # lost conjugacy to round-off: restart from steepest descent
             delta = 0.0
             g_old = 0.0
