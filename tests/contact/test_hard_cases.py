@@ -29,10 +29,11 @@ DX = 0.2e-6  # grid spacing of the rough-sphere cases, m
 TOL = 1e-8  # the solver's default tolerance (dimensionless)
 MPA_PER_NM = 1e15  # 1 MPa/nm in Pa/m
 # Slack on the solver's own criteria. The CG stops when the rms gap on the contact set and
-# the worst penetration off it are below tol·h_rms (docs/models.md §2.2); the plastic routes
-# measure that on their last bounded sub-problem, whose heights differ from the reported
-# deformed heights by the last increment, so the reported fields get 10x.
-SLACK = 10
+# the worst penetration off it are below tol·h_rms (docs/models.md §2.2), judged before the
+# approach d is re-evaluated on the final field; the plastic routes judge it on their last
+# sub-problem. 2x covers both: over the cases below the largest value of either measure was
+# 0.56 tol (the largest load of the six-decade series).
+SLACK = 2
 
 
 def rough_sphere(shape=(64, 64), rms=30e-9, seed=1):
