@@ -9,7 +9,6 @@ import re
 import shutil
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -167,18 +166,6 @@ def test_bad_config_fails_before_any_job(project, edit, expected):
     assert result.returncode != 0
     assert expected in result.stderr
     assert not (project / "results").exists() and not (project / "resources").exists()
-
-
-@pytest.fixture(scope="module")
-def small_run(tmp_path_factory):
-    """The small-data run (config/test.yaml: PS and glass), once for the tests below."""
-    project = tmp_path_factory.mktemp("small")
-    shutil.copytree(REPO / "config", project / "config")
-    start = time.perf_counter()
-    result = snakemake(project, "--cores", "2", "--configfile", "config/test.yaml")
-    assert result.returncode == 0, result.stderr[-3000:]
-    print(f"small-data run: {time.perf_counter() - start:.1f} s")
-    return project
 
 
 def test_small_data_run(small_run):

@@ -28,6 +28,7 @@ from .plasticity import solve_plastic
 from .result import (
     STALLED,
     CoarseLevel,
+    ContactError,
     ContactInputError,
     ContactResult,
     ConvergenceError,
@@ -246,6 +247,12 @@ def solve_load_series(
     Returns
     -------
     list of ContactResult, one per load.
+
+    Raises
+    ------
+    ContactInputError, ConvergenceError, FreeBoundaryError
+        As in :func:`solve`; an error raised by a step carries a note (``__notes__``) naming
+        the step and its load.
     """
     h = check_heights(heights)
     spacing = check_positive("spacing", spacing, "m")
@@ -270,17 +277,22 @@ def solve_load_series(
     prev = None
     with threadpool_limits(limits=1):  # as in solve
         for i, w in enumerate(arr):
-            res = _solve_step(
-                h,
-                spacing,
-                e_star,
-                opts,
-                load=float(w),
-                displacement=None,
-                warm_start=_scaled_start(prev, w),
-                plastic_prev=plastic,
-                coarse_to_fine=bool(coarse_to_fine) and i == 0,
-            )
+            try:
+                res = _solve_step(
+                    h,
+                    spacing,
+                    e_star,
+                    opts,
+                    load=float(w),
+                    displacement=None,
+                    warm_start=_scaled_start(prev, w),
+                    plastic_prev=plastic,
+                    coarse_to_fine=bool(coarse_to_fine) and i == 0,
+                )
+            except ContactError as err:
+                # the error describes the solve; the caller also needs to know which step
+                err.add_note(f"load step {i + 1} of {arr.size} (W = {w:.6e} N)")
+                raise
             if opts.law is not None:
                 plastic = res.plastic_displacement
             results.append(res)
@@ -477,8 +489,11 @@ def _run_cg(h, spacing, e_star, opts, *, load, displacement, p_init, tol, max_it
     """One Polonsky–Keer solve of the hard-wall problem; returns its outcome, never raises
     on non-convergence."""
     h_scale = float(np.std(h))
-    if not h_scale > 0:
-        h_scale = spacing  # a flat indenter: any length works, the gap is exactly 0
+    if not np.ptp(h) > 0:
+        # a flat indenter: any length works, the gap is round-off. (np.std of a constant
+        # array is round-off too, ~1e-16 of the height, not 0: that scale would turn the
+        # round-off gap into a residual of order 1.)
+        h_scale = spacing
     return polonsky_keer(
         _operator(h.shape, spacing, e_star, opts),
         h,

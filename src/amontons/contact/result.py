@@ -16,7 +16,7 @@ if TYPE_CHECKING:  # pragma: no cover - annotations only
 # Status codes of a solve (ContactResult.status, ConvergenceError.status).
 CONVERGED = 0  # every convergence criterion below tol
 ITERATION_CAP = 1  # stopped at max_iter (CG) or max_outer (plastic updates, active-set rounds)
-STALLED = 2  # stopped for another reason: singular problem, failed load root find
+STALLED = 2  # stopped for another reason: residual stalled, singular problem, failed root find
 
 STATUS_NAMES = {CONVERGED: "converged", ITERATION_CAP: "iteration cap reached", STALLED: "stalled"}
 
@@ -189,9 +189,11 @@ class ContactResult:
     * ``0`` converged: every convergence criterion is below ``tol``;
     * ``1`` iteration cap reached: ``max_iter`` conjugate-gradient iterations, or
       ``max_outer`` plastic updates / active-set rounds, without convergence;
-    * ``2`` stalled: stopped for another reason, e.g. a periodic displacement-controlled
-      solve reached full contact (the mean pressure is then undetermined) or the load
-      control of a plastic solve found no approach that carries the load.
+    * ``2`` stalled: stopped for another reason, e.g. the residual stopped falling (its best
+      value did not halve in 200 iterations, :class:`amontons.contact.cg.StallMonitor`), a
+      periodic displacement-controlled solve reached full contact (the mean pressure is
+      then undetermined) or the load control of a plastic solve found no approach that
+      carries the load.
 
     A result with ``status != 0`` is only returned when ``raise_on_failure=False``; it holds
     the last iterate (finite; not checked against the window edge), and ``message`` says

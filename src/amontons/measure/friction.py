@@ -42,13 +42,38 @@ class FrictionMeasurement:
 # --- the measurement ---------------------------------------------------------------------------
 
 
-def _check_trace(trace: RheometerTrace) -> None:
-    arrays = (trace.time_s, trace.angle_rad, trace.normal_force_n, trace.torque_n_m)
-    sizes = {np.asarray(a).size for a in arrays}
+def _check_trace(trace: RheometerTrace, median_window_s: float) -> None:
+    """Refuse a trace that cannot give a friction force: ragged columns, non-finite samples,
+    time not increasing, or a dropout (a time step longer than both the median window and
+    twice the median step, s: samples missing from the record)."""
+    columns = {
+        "time_s": trace.time_s,
+        "angle_rad": trace.angle_rad,
+        "normal_force_N": trace.normal_force_n,
+        "torque_N_m": trace.torque_n_m,
+    }
+    sizes = {np.asarray(a).size for a in columns.values()}
     if len(sizes) != 1:
         raise RheometerError(f"{trace.source}: columns have different lengths {sorted(sizes)}")
-    if np.any(np.diff(trace.time_s) <= 0):
+    for name, values in columns.items():
+        bad = ~np.isfinite(np.asarray(values, dtype=float))
+        if bad.any():
+            first = int(np.argmax(bad))
+            raise RheometerError(
+                f"{trace.source}: {int(bad.sum())} non-finite {name} samples (dropouts; the "
+                f"first is sample {first}); expected a finite value in every sample"
+            )
+    steps = np.diff(trace.time_s)
+    if np.any(steps <= 0):
         raise RheometerError(f"{trace.source}: time_s is not strictly increasing")
+    longest = int(np.argmax(steps))
+    # a gap as long as the median window can hide the peak the window is meant to find
+    if steps[longest] > max(median_window_s, 2 * float(np.median(steps))):
+        raise RheometerError(
+            f"{trace.source}: {steps[longest]:.3g} s without samples after t = "
+            f"{trace.time_s[longest]:.6g} s (a dropout longer than the {median_window_s:g} s "
+            "median window); expected an evenly sampled record"
+        )
 
 
 def _median_value(values: np.ndarray, index: int, half: int) -> float:
@@ -77,11 +102,12 @@ def static_friction(
     over the window) times the radius. The normal force is the mean over the record.
 
     ``rotation_radius_m`` defaults to the trace's metadata. Raises RheometerError when the
-    torque has no peak followed by sliding (still rising at the end of the record), when the
-    peak does not stand ``min_peak_snr`` noise standard deviations above zero, or when no
-    radius is known.
+    torque has no peak preceded by a rise and followed by sliding (largest at the start or
+    the end of the record: constant, falling or still rising), when the peak does not stand
+    ``min_peak_snr`` noise standard deviations above zero, when no radius is known, or for a
+    record with dropouts (non-finite samples, or a gap longer than the median window).
     """
-    _check_trace(trace)
+    _check_trace(trace, median_window_s)
     radius = rotation_radius_m if rotation_radius_m is not None else trace.rotation_radius_m
     if radius is None or not radius > 0:
         raise RheometerError(
@@ -94,6 +120,13 @@ def static_friction(
     half = window // 2
     smoothed = median_filter(torque, size=window, mode="nearest")
     peak = int(np.argmax(smoothed))
+    if peak < 2 * window:
+        # a constant or falling torque: no loading ramp ends in this maximum
+        raise RheometerError(
+            f"{trace.source}: no static friction peak — the torque is largest at the start of "
+            f"the record (t = {time[peak]:.3g} s of {time[-1]:.3g} s); expected it to rise "
+            "to a peak followed by sliding"
+        )
     if peak >= torque.size - 2 * window:
         raise RheometerError(
             f"{trace.source}: no static friction peak — the torque is largest at the end of the "

@@ -358,10 +358,10 @@ def newton_ring_gap(
     reason, as long as at least ``min_accepted_fraction`` of them remain (roughness on the
     sphere scatters single rings; the rest still measure the average gap).
 
-    Raises NewtonRingError for a centre outside the image, an unknown edge model, a
-    sheet-radius fit without a radius, or when fewer than ``min_accepted_fraction`` of the
-    half-profiles have enough, correctly ordered rings outside their contact edge (the
-    message names the first refused profile's reason).
+    Raises NewtonRingError for a uniform image, a centre outside the image, an unknown edge
+    model, a sheet-radius fit without a radius, or when fewer than ``min_accepted_fraction``
+    of the half-profiles have enough, correctly ordered rings outside their contact edge
+    (the message names the first refused profile's reason).
     """
     image = np.asarray(reflection, dtype=float)
     if image.ndim != 2:
@@ -382,6 +382,13 @@ def newton_ring_gap(
     angles = half_profile_angles(n_profiles)
     edge_radii = _edge_radii(contact_radius_m, angles.size)
     low, high = np.percentile(image, [2, 98])
+    if not high > low:
+        # no intensity range, no prominence threshold: round-off of the smoothing would
+        # otherwise pass for ring maxima
+        raise NewtonRingError(
+            f"reflection image is uniform ({low:g} counts over 96 % of its pixels); expected "
+            "Newton rings around the contact"
+        )
     settings = {
         "prominence": max(
             prominence_fraction * (high - low), min_prominence_sd * robust_noise_sd(image)
