@@ -261,6 +261,19 @@ def _scene_window_um(scene: Mapping, diameter_mm: float, e_star_gpa: float, load
     return scene["window_factor"] * hertz_diameter_um(max(loads), diameter_mm, e_star_gpa)
 
 
+def solver_side_px(scene: Mapping, diameter_mm: float | None, e_star_gpa: float, loads) -> int:
+    """The solver grid side (px, even) of a scene on a sphere of the sheet (or a synthetic
+    one): amontons.simulate.scene's window and pixel in config units, for the DAG (the
+    cluster resources of a solve grow with its grid)."""
+    if scene["side_px"] is not None:
+        n = int(scene["side_px"])
+    else:
+        window_um = _scene_window_um(scene, diameter_mm, e_star_gpa, loads)
+        pixel_um = max(scene["pixel_nm"] * 1e-3, window_um / scene["max_side_px"])
+        n = int(round(window_um / pixel_um))
+    return n + n % 2
+
+
 def _check_scene_window(name: str, scene: Mapping, spheres: Mapping[str, dict], source: str):
     """The window must hold the largest contact the sheet predicts: the Hertz contact at the
     largest load (a rough or hardened contact is larger still; the solver's free-boundary

@@ -132,21 +132,60 @@ def test_stage_targets_include_the_measurements(project, target, expected):
         assert name in result.stdout
 
 
-def test_slurm_profile_dry_run_shows_per_job_resources(project):
+def _slurm_jobs(project, configfile):
+    """(rule, wildcards, resources) of every cluster job of a dry run with the SLURM profile."""
     result = snakemake(
         project,
         "-n",
+        "--forceall",
         "--profile",
         str(REPO / "profiles" / "slurm"),
         "--configfile",
-        "config/test.yaml",
+        configfile,
     )
     assert result.returncode == 0, result.stderr
-    jobs = result.stdout.count("rule generate_virtual_experiment:") + result.stdout.count(
-        "rule generate_virtual_experiment_with_flim:"
-    )
-    assert jobs == 2
-    assert result.stdout.count("runtime=20") >= jobs and "slurm_partition=" in result.stdout
+    jobs = []
+    for block in re.split(r"\n(?=\[.*\]\n(?:local)?rule )", result.stdout):
+        rule = re.search(r"^(local)?rule (\w+):", block, re.M)
+        if rule is None or rule.group(1) or rule.group(2) == "all":
+            continue  # local rules (targets) run in the submitting process
+        wildcards = re.search(r"^\s+wildcards: (.+)$", block, re.M)
+        resources = re.search(r"^\s+resources: (.+)$", block, re.M)
+        jobs.append(
+            (
+                rule.group(2),
+                wildcards.group(1) if wildcards else "",
+                dict(kv.split("=", 1) for kv in resources.group(1).split(", ")),
+            )
+        )
+    return jobs
+
+
+def test_slurm_dry_run_gives_every_job_measured_resources_that_grow_with_the_grid(project):
+    """Every cluster job of the full config carries mem_mb and runtime from the measured
+    runs (workflow/resources.json, no profile default stands in), every rule declares its
+    threads, and a solve asks for more the larger its FFT grid (PMMA-4mm's scenes run on
+    512², PS's on ~250², both non-periodic)."""
+    jobs = _slurm_jobs(project, "config/config.yaml")
+    assert len(jobs) > 150
+    for rule, wildcards, resources in jobs:
+        assert int(resources["mem_mb"]) >= 500 and int(resources["runtime"]) >= 2, (rule, wildcards)
+        assert resources["slurm_partition"] == "YOUR_PARTITION"
+    profile = yaml.safe_load((REPO / "profiles" / "slurm" / "config.yaml").read_text())
+    assert not {"mem_mb", "runtime"} & set(profile["default-resources"])
+    for path in (REPO / "workflow" / "rules").glob("*.smk"):
+        for block in re.split(r"\n(?=rule \w+:)", path.read_text())[1:]:
+            if "localrule: True" not in block:
+                assert "    threads:" in block, block.splitlines()[0]
+    scenes = {
+        wildcards: resources
+        for rule, wildcards, resources in jobs
+        if rule == "simulate_scene" and "scene=penetration_hardness" in wildcards
+    }
+    large = next(r for w, r in scenes.items() if "sphere=PMMA-4mm" in w)
+    small = next(r for w, r in scenes.items() if "sphere=PS," in w)
+    assert int(large["mem_mb"]) > int(small["mem_mb"])
+    assert int(large["runtime"]) > int(small["runtime"])
 
 
 @pytest.mark.parametrize(

@@ -549,3 +549,58 @@ def study_overview_outputs():
     if CURVATURE_PAIRS:
         out += [f"{STUDY_RESULTS}/B10_curvature.{ext}" for ext in ("png", "pdf", "csv")]
     return out
+
+
+# Cluster resources (README, "On a cluster"): each rule's measured wall time and peak memory,
+# and for the solves a model in their FFT grid and loads (amontons.resources), from
+# workflow/resources.json (benchmarks/fit_job_resources.py).
+from amontons.config import solver_side_px
+from amontons.resources import JobResources, fft_points
+
+RESOURCES = JobResources.from_file(
+    os.path.join(workflow.basedir, "workflow", "resources.json")
+)
+
+
+def measured_runtime(rule):
+    return RESOURCES.runtime_min(rule)
+
+
+def measured_mem_mb(rule):
+    return RESOURCES.mem_mb(rule)
+
+
+def solve_size(scene, sphere=None):
+    """(model, FFT grid points, loads) of a scene's solve on ``sphere`` (None: synthetic)."""
+    spec = config["scenes"][scene]
+    if sphere is None:
+        synthetic = spec["synthetic"]
+        diameter = 2 * synthetic.get("radius_mm", 0.0) or None
+        e_star, loads = synthetic["e_star_gpa"], spec["loads"]
+    else:
+        row = sphere_row(sphere)
+        diameter, e_star = row["diameter_mm"], row["e_star_gpa"]
+        loads = row["loads"] if spec["loads"] == "measured" else spec["loads"]
+    side = solver_side_px(spec, diameter, e_star, loads)
+    points = fft_points(side, spec["geometry"] == "flat_periodic")
+    return spec["model"], points, len(loads)
+
+
+def solve_runtime(rule, scene_of):
+    """Runtime (min) of a solve job: ``scene_of(wildcards)`` gives (scene, sphere or None)."""
+
+    def runtime(wildcards):
+        model, points, loads = solve_size(*scene_of(wildcards))
+        return RESOURCES.grid_runtime_min(rule, model, points, loads)
+
+    return runtime
+
+
+def solve_mem_mb(rule, scene_of):
+    """Memory (MB) of a solve job, as :func:`solve_runtime`."""
+
+    def mem_mb(wildcards):
+        model, points, _ = solve_size(*scene_of(wildcards))
+        return RESOURCES.grid_mem_mb(rule, model, points)
+
+    return mem_mb

@@ -14,8 +14,8 @@ rule measure_friction:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("measure_friction"),
+        runtime=measured_runtime("measure_friction"),
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         friction=config_slice("friction"),
@@ -49,8 +49,8 @@ rule plot_amontons_deviation:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("plot_amontons_deviation"),
+        runtime=measured_runtime("plot_amontons_deviation"),
     params:
         spheres=lambda wc: spheres_of(wc.material),
         data_label=lambda wc: data_label(spheres_of(wc.material)),

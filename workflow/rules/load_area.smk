@@ -14,8 +14,8 @@ rule fit_load_area:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("fit_load_area"),
+        runtime=measured_runtime("fit_load_area"),
     params:
         load_area=config_slice("load_area"),
     script:
@@ -43,8 +43,8 @@ rule plot_load_area:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("plot_load_area"),
+        runtime=measured_runtime("plot_load_area"),
     params:
         spheres=lambda wc: spheres_of(wc.material),
         data_label=lambda wc: data_label(spheres_of(wc.material)),

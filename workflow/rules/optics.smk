@@ -22,8 +22,8 @@ rule measure_contact_area:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("measure_contact_area"),
+        runtime=measured_runtime("measure_contact_area"),
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
@@ -53,8 +53,8 @@ rule measure_psf:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("measure_psf"),
+        runtime=measured_runtime("measure_psf"),
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         psf=config_slice("optics", "psf"),
@@ -83,8 +83,8 @@ rule measure_grafting_density:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("measure_grafting_density"),
+        runtime=measured_runtime("measure_grafting_density"),
     params:
         absorbance=config_slice("optics", "absorbance"),
         data_label=lambda wc: data_label([wc.sphere]),
@@ -113,8 +113,8 @@ rule measure_edge_gap:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("measure_edge_gap"),
+        runtime=measured_runtime("measure_edge_gap"),
     params:
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
@@ -148,8 +148,8 @@ rule measure_intensity_pressure:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("measure_intensity_pressure"),
+        runtime=measured_runtime("measure_intensity_pressure"),
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
@@ -174,8 +174,8 @@ rule measure_lifetime:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("measure_lifetime"),
+        runtime=measured_runtime("measure_lifetime"),
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         otsu=otsu_settings(),
@@ -197,8 +197,8 @@ rule check_hertz:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("check_hertz"),
+        runtime=measured_runtime("check_hertz"),
     params:
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
         e_star_gpa=lambda wc: float(sphere_row(wc.sphere)["e_star_gpa"]),

@@ -17,8 +17,8 @@ rule level_afm_map:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=3000,
-        runtime=10,
+        mem_mb=measured_mem_mb("level_afm_map"),
+        runtime=measured_runtime("level_afm_map"),
     params:
         afm=lambda wc: {
             **afm_reading(),
@@ -44,8 +44,8 @@ rule simulate_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=4000,
-        runtime=30,
+        mem_mb=solve_mem_mb("simulate_scene", lambda wc: (wc.scene, wc.sphere)),
+        runtime=solve_runtime("simulate_scene", lambda wc: (wc.scene, wc.sphere)),
     params:
         scene=lambda wc: scene_config(wc.scene),
         sphere=lambda wc: wc.sphere,
@@ -69,8 +69,8 @@ rule simulate_greenwood_tripp:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("simulate_greenwood_tripp"),
+        runtime=measured_runtime("simulate_greenwood_tripp"),
     params:
         scene=lambda wc: scene_config(wc.scene),
         sphere=lambda wc: wc.sphere,
@@ -93,8 +93,8 @@ rule simulate_synthetic_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=4000,
-        runtime=30,
+        mem_mb=solve_mem_mb("simulate_synthetic_scene", lambda wc: (wc.scene, None)),
+        runtime=solve_runtime("simulate_synthetic_scene", lambda wc: (wc.scene, None)),
     params:
         scene=lambda wc: scene_config(wc.scene),
         sphere=None,
@@ -120,8 +120,8 @@ rule render_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("render_scene"),
+        runtime=measured_runtime("render_scene"),
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         rendering=lambda wc: SCENES[wc.scene]["rendering"],
@@ -156,8 +156,8 @@ rule compare_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("compare_scene"),
+        runtime=measured_runtime("compare_scene"),
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
@@ -180,8 +180,8 @@ rule fit_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("fit_scene"),
+        runtime=measured_runtime("fit_scene"),
     params:
         confidence=config["load_area"]["confidence"],
     script:
@@ -201,8 +201,8 @@ rule fit_synthetic_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("fit_synthetic_scene"),
+        runtime=measured_runtime("fit_synthetic_scene"),
     params:
         confidence=config["load_area"]["confidence"],
     script:
@@ -232,8 +232,8 @@ rule tabulate_scenes:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("tabulate_scenes"),
+        runtime=measured_runtime("tabulate_scenes"),
     params:
         spheres=lambda wc: spheres_of(wc.material),
         scenes=scene_names(surface="afm_before"),

@@ -23,8 +23,12 @@ rule scan_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=4000,
-        runtime=30,
+        mem_mb=solve_mem_mb(
+            "scan_scene", lambda wc: (SCANS[wc.scan]["scene"], wc.sphere)
+        ),
+        runtime=solve_runtime(
+            "scan_scene", lambda wc: (SCANS[wc.scan]["scene"], wc.sphere)
+        ),
     params:
         scan=lambda wc: sorted_keys(SCANS[wc.scan]),
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),
@@ -49,8 +53,8 @@ rule best_scan_value:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("best_scan_value"),
+        runtime=measured_runtime("best_scan_value"),
     params:
         confidence=config["load_area"]["confidence"],
     script:
@@ -82,8 +86,8 @@ rule tabulate_models:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("tabulate_models"),
+        runtime=measured_runtime("tabulate_models"),
     params:
         layout=lambda wc: model_table_layout(wc.material),
         spheres=lambda wc: spheres_of(wc.material),
@@ -116,8 +120,8 @@ rule plot_scan_maps:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("plot_scan_maps"),
+        runtime=measured_runtime("plot_scan_maps"),
     params:
         scans=lambda wc: {
             scan: scan_files(wc.material, wc.sphere, scan) for scan in SCANS
@@ -152,8 +156,8 @@ rule plot_load_series_maps:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("plot_load_series_maps"),
+        runtime=measured_runtime("plot_load_series_maps"),
     params:
         elastic=lambda wc: load_series_layout(wc)["elastic"],
         k_scan=study_k_scan,
@@ -187,8 +191,8 @@ rule plot_flattening_maps:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=4000,
-        runtime=10,
+        mem_mb=measured_mem_mb("plot_flattening_maps"),
+        runtime=measured_runtime("plot_flattening_maps"),
     params:
         k_scan=study_k_scan,
         afm=lambda wc: {
@@ -222,8 +226,8 @@ rule plot_model_curves:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("plot_model_curves"),
+        runtime=measured_runtime("plot_model_curves"),
     params:
         scenes=lambda wc: model_curve_layout(wc)["scenes"],
         scans=lambda wc: model_curve_layout(wc)["scans"],
@@ -258,8 +262,8 @@ rule plot_curvature_study:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("plot_curvature_study"),
+        runtime=measured_runtime("plot_curvature_study"),
     params:
         pairs=CURVATURE_PAIRS,
         solves={
@@ -305,8 +309,8 @@ rule plot_amontons_study:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=5,
+        mem_mb=measured_mem_mb("plot_amontons_study"),
+        runtime=measured_runtime("plot_amontons_study"),
     params:
         bests=(
             {

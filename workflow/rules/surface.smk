@@ -22,8 +22,8 @@ rule measure_topography:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=10,
+        mem_mb=measured_mem_mb("measure_topography"),
+        runtime=measured_runtime("measure_topography"),
     params:
         afm_pixel_nm=lambda wc: sheet_value(wc.sphere, "afm_pixel_nm"),
         nan_policy=config["surface"]["afm_nan_policy"],

@@ -23,8 +23,8 @@ rule generate_virtual_experiment:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=4000,
-        runtime=20,
+        mem_mb=measured_mem_mb("generate_virtual_experiment"),
+        runtime=measured_runtime("generate_virtual_experiment"),
     params:
         sphere=lambda wc: wc.sphere,
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
