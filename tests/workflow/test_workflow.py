@@ -145,8 +145,9 @@ def _slurm_jobs(project, configfile):
     )
     assert result.returncode == 0, result.stderr
     jobs = []
-    for block in re.split(r"\n(?=\[.*\]\n(?:local)?rule )", result.stdout):
-        rule = re.search(r"^(local)?rule (\w+):", block, re.M)
+    # group jobs list their members indented
+    for block in re.split(r"\n(?=\s*\[.*\]\n\s*(?:local)?rule )", result.stdout):
+        rule = re.search(r"^\s*(local)?rule (\w+):", block, re.M)
         if rule is None or rule.group(1) or rule.group(2) == "all":
             continue  # local rules (targets) run in the submitting process
         wildcards = re.search(r"^\s+wildcards: (.+)$", block, re.M)
@@ -158,7 +159,7 @@ def _slurm_jobs(project, configfile):
                 dict(kv.split("=", 1) for kv in resources.group(1).split(", ")),
             )
         )
-    return jobs
+    return jobs, result.stdout
 
 
 def test_slurm_dry_run_gives_every_job_measured_resources_that_grow_with_the_grid(project):
@@ -166,8 +167,12 @@ def test_slurm_dry_run_gives_every_job_measured_resources_that_grow_with_the_gri
     runs (workflow/resources.json, no profile default stands in), every rule declares its
     threads, and a solve asks for more the larger its FFT grid (PMMA-4mm's scenes run on
     512², PS's on ~250², both non-periodic)."""
-    jobs = _slurm_jobs(project, "config/config.yaml")
+    jobs, stdout = _slurm_jobs(project, "config/config.yaml")
     assert len(jobs) > 150
+    # the few-second jobs go in bundles (the profile's groups), the solves on their own
+    assert "Group job figures" in stdout and "Group job measurements" in stdout
+    grouped = re.findall(r"^    rule (\w+):", stdout, re.M)
+    assert "fit_scene" in grouped and "scan_scene" not in grouped
     for rule, wildcards, resources in jobs:
         assert int(resources["mem_mb"]) >= 500 and int(resources["runtime"]) >= 2, (rule, wildcards)
         assert resources["slurm_partition"] == "YOUR_PARTITION"
