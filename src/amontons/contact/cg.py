@@ -56,6 +56,7 @@ any symmetric positive-definite linear callable ``op(x, out=...)``, so a Winkler
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 from scipy.linalg.blas import daxpy as _axpy
@@ -203,6 +204,8 @@ def polonsky_keer(
     refresh=25,
     constraint=None,
     raise_on_failure=True,
+    kernels=True,
+    threads=None,
 ) -> CGOutcome:
     """Solve the contact problem by constrained conjugate gradients.
 
@@ -234,12 +237,39 @@ def polonsky_keer(
     raise_on_failure : bool
         Raise :class:`ConvergenceError` when the solve stops without converging (status 1
         or 2); else return the last iterate with that status.
+    kernels : bool
+        True (default): run the iteration's element-wise work in fused numba kernels
+        (:mod:`amontons.contact.fused`); False: the numpy loop below, kept as the reference
+        the tests compare against (same iterates up to round-off).
+    threads : int, optional
+        Threads of the fused kernels (default: the operator's FFTW ``threads``, else 1).
     """
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
     if constraint.bounded and load is not None:
         raise ValueError("a bounded constraint needs displacement control")
+    if kernels:
+        from .fused import fused_polonsky_keer  # numba import and kernel load on first use
+
+        return fused_polonsky_keer(
+            operator,
+            heights,
+            pixel_area=pixel_area,
+            h_scale=h_scale,
+            p_init=p_init,
+            load=load,
+            displacement=displacement,
+            tol=tol,
+            max_iter=max_iter,
+            refresh=refresh,
+            constraint=constraint,
+            raise_on_failure=raise_on_failure,
+            threads=_kernel_threads(operator, threads),
+            sparse_max=None,
+            reset_fraction=RESET_FRACTION,
+            finish=partial(_finish, constraint, tol, raise_on_failure, pixel_area),
+        )
     load_control = load is not None
     shape = heights.shape
     n = heights.size
@@ -439,8 +469,62 @@ def polonsky_keer(
             break
     if since_fresh:
         conv(p, u)
+    return _finish(
+        constraint,
+        tol,
+        raise_on_failure,
+        pixel_area,
+        p=p,
+        u=u,
+        h=h,
+        d=d,
+        load_control=load_control,
+        converged=converged,
+        stalled=stalled,
+        it=it,
+        residual=residual,
+        history=history,
+        calls=calls,
+        resets=resets,
+        shape=shape,
+    )
+
+
+def _kernel_threads(operator, threads):
+    """Threads for the fused kernels: ``threads``, else the operator's, else 1."""
+    if threads is None:
+        base = getattr(operator, "operator", operator)  # a Winkler wrapper's convolution
+        threads = getattr(base, "threads", 1)
+    if not (isinstance(threads, int | np.integer) and threads >= 1):
+        raise ValueError(f"threads must be a positive integer, got {threads!r}")
+    return int(threads)
+
+
+def _finish(
+    constraint,
+    tol,
+    raise_on_failure,
+    pixel_area,
+    *,
+    p,
+    u,
+    h,
+    d,
+    load_control,
+    converged,
+    stalled,
+    it,
+    residual,
+    history,
+    calls,
+    resets,
+    shape,
+):
+    """The CGOutcome of a finished loop (``p`` Pa and ``u = K*p`` m, flat and fresh);
+    raises ConvergenceError on failure when ``raise_on_failure``."""
     if load_control and p.sum() > 0:
-        nc = constraint.free_mask(p, m, bwork)
+        m = np.empty(p.size)
+        nc = constraint.free_mask(p, m, np.empty(p.size, dtype=bool))
         d = float(np.dot(u - h, m) / nc)
     gap = u - h - d
     hist = np.asarray(history)
