@@ -113,3 +113,33 @@ def test_answers_do_not_depend_on_the_bound():
         two = solve(h, dx, e_star, load=1e-3, threads=2)
     scale = np.abs(one.pressure).max()
     assert np.abs(one.pressure - two.pressure).max() <= 1e-10 * scale
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_two_threads_give_the_one_thread_answer(periodic):
+    """threads=2 plans its FFTs with FFTW_MEASURE by default (ESTIMATE's plans do not use a
+    second thread) and runs the fused kernels on two threads; the kernels' sums do not
+    depend on the thread count and the FFT plans differ only in round-off, so the solution
+    is the one-thread one to 1e-10 in contact fraction and approach (over the rms height),
+    far below the 1e-9 solve tolerance."""
+    n = 128
+    if periodic:
+        from amontons.contact import self_affine
+
+        h = self_affine((n, n), 1.0, 0.8, rms_slope=0.1, rng=11)
+        kw = {"load": 0.005 * n * n, "periodic": True}
+    else:
+        h = sphere((n, n), 1.0, 4.0 * n)
+        kw = {"load": 4 * (n / 5) ** 3 / (3 * 4.0 * n)}
+    one = solve(h, 1.0, 1.0, tol=1e-9, threads=1, **kw)
+    two = solve(h, 1.0, 1.0, tol=1e-9, threads=2, **kw)
+    assert (one.info.planner_effort, two.info.planner_effort) == ("FFTW_ESTIMATE", "FFTW_MEASURE")
+    assert abs(one.contact_fraction - two.contact_fraction) <= 1e-10
+    assert abs(one.displacement - two.displacement) <= 1e-10 * h.std()
+    assert abs(one.iterations - two.iterations) <= 0.05 * one.iterations
+
+
+def test_an_explicit_planner_effort_is_kept_on_two_threads():
+    h = sphere((32, 32), 0.01, 1.0)
+    res = solve(h, 0.01, 1.0, load=1e-4, threads=2, planner_effort="FFTW_ESTIMATE")
+    assert res.info.planner_effort == "FFTW_ESTIMATE"

@@ -34,6 +34,12 @@ BACKENDS = ("pyfftw", "numpy")
 # FFTW planner flags, cheapest first; only the first is deterministic.
 PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
 DEFAULT_PLANNER_EFFORT = "FFTW_ESTIMATE"
+# Planner effort of a multi-threaded solve when none is given: FFTW_ESTIMATE's plans do not
+# use a second thread here (1024² pair: 8.50 ms on 1 thread, 8.35 ms on 2), FFTW_MEASURE's
+# do (5.38 ms on 2); benchmarks/README.md, "A second core". The price is the determinism
+# of the plan: results can differ in the last bits from run to run (tests hold them to
+# 1e-10 of the one-thread answer).
+THREADED_PLANNER_EFFORT = "FFTW_MEASURE"
 
 
 def resolve_backend(backend: str | None) -> str:
@@ -68,6 +74,18 @@ def check_planner_effort(planner_effort: str) -> str:
             f"planner_effort must be one of {PLANNER_EFFORTS}, got {planner_effort!r}"
         )
     return planner_effort
+
+
+def resolve_planner_effort(planner_effort: str | None, threads: int, backend: str) -> str:
+    """The planner effort of a solve: ``planner_effort`` if given (checked), else
+    :data:`DEFAULT_PLANNER_EFFORT` on one thread (deterministic) and
+    :data:`THREADED_PLANNER_EFFORT` on several (plans that use them); numpy.fft does not
+    plan, so its effort is always the default."""
+    if planner_effort is not None:
+        return check_planner_effort(planner_effort)
+    if threads > 1 and backend == "pyfftw":
+        return THREADED_PLANNER_EFFORT
+    return DEFAULT_PLANNER_EFFORT
 
 
 def empty(shape, dtype, backend: str) -> np.ndarray:

@@ -34,6 +34,8 @@ from .result import CONVERGED, STALLED, ConvergenceError
 # convolution and ~35 ms for a padded one (benchmarks/README.md, "Fewer convolutions"), so
 # the break-even is ~15 points periodic and ~40 padded; the limits stay below it.
 SPARSE_MAX_PERIODIC = 12
+# Largest Σa²/G of the one-pass moments about the previous approach (see _centred_moments).
+RECENTRE = 1e3
 SPARSE_MAX_PADDED = 32
 
 
@@ -166,6 +168,7 @@ def _loop(
     g_old = 1.0
     since_fresh = 0
     resets = 0
+    recentres = 0  # second moment passes (see _centred_moments)
     history = []
     d = 0.0 if load_control else float(displacement)
     residual = np.inf
@@ -215,15 +218,11 @@ def _loop(
             m[:] = 0
             m[start] = 1
             t[:] = 0.0
-        s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d)
         if load_control:
-            mean = s1 / nc
-            d += mean
-            big_g = max(s2 - s1 * mean, 0.0)
-            gt_old = st - mean * tsum
+            d, big_g, gt_old, recentred = _centred_moments(u, sigma, h, m, t, d, nc)
+            recentres += recentred
         else:
-            big_g = s2
-            gt_old = st
+            _, big_g, gt_old, _ = _k.gap_moments(u, sigma, h, m, t, d)
         beta = delta * big_g / g_old if g_old > 0 else 0.0
         g_dot_t = big_g + beta * gt_old if beta else big_g
         tsum = _k.direction(u, sigma, h, m, t, d, beta, p, p_max, bounded, violators)
@@ -343,6 +342,7 @@ def _loop(
         history=history,
         calls=calls,
         resets=resets,
+        extra={"moment_recentres": recentres},
         shape=shape,
     )
 
@@ -355,6 +355,27 @@ def _copy(src, dst):
 def conv_t(base_op, t, r, shape):
     """``r = K*t`` with the plain convolution (a Winkler term is added by ``step_dots``)."""
     base_op(t.reshape(shape), out=r.reshape(shape))
+
+
+def _centred_moments(u, sigma, h, m, t, d_old, nc):
+    """Load control: the approach ``d`` (m, the mean of ``sigma·u - h`` on the free set),
+    ``G = Σ_Ic g²`` (m²) and ``Σ g·t`` with ``g`` centred on it, and whether a second pass
+    was needed.
+
+    One pass takes the moments about the previous approach; when that is far from the new
+    one (the first iteration, a warm start), ``G = Σa² - (Σa)²/nc`` would cancel
+    catastrophically (relative error ~ 1e-16 · Σa²/G), so the moments are taken again about
+    the new approach whenever ``Σa² > RECENTRE · G``: G is then good to ~1e-13.
+    """
+    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d_old)
+    mean = s1 / nc
+    d = d_old + mean
+    big_g = max(s2 - s1 * mean, 0.0)
+    if s2 <= RECENTRE * big_g:
+        return d, big_g, st - mean * tsum, 0
+    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d)
+    mean = s1 / nc
+    return d + mean, max(s2 - s1 * mean, 0.0), st - mean * tsum, 1
 
 
 def _changed_points(counts, idx_buf, val_buf):

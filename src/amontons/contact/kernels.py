@@ -119,8 +119,10 @@ def gap_moments(u, sigma, h, m, t, shift):
 
 
 @numba.njit(**_INNER)
-def _direction_hard(u, sigma, h, m, t, d, beta, p):
-    """A chunk of ``direction`` under the hard wall: ``(Σ t, violators)``."""
+def _direction_hard(u, sigma, h, m, t, d, beta):
+    """A chunk of ``direction`` under the hard wall: ``(Σ t, violators)``. A constrained
+    point has ``p = 0`` here (points leave the free set only by clipping to 0), so the
+    pressure need not be read."""
     acc = 0.0
     k = 0
     for i in range(u.size):
@@ -129,7 +131,7 @@ def _direction_hard(u, sigma, h, m, t, d, beta, p):
         t[i] = v
         acc += v
         # unloaded and penetrating (branch-free)
-        k += (m[i] == 0) & (p[i] <= 0.0) & (g < 0.0)
+        k += (m[i] == 0) & (g < 0.0)
     return acc, k
 
 
@@ -169,7 +171,7 @@ def direction(u, sigma, h, m, t, d, beta, p, p_max, bounded, violators):
         if bounded:
             acc, k = _direction_bounded(uc, sigma, hc, mc, tc, d, beta, pc, p_max[lo:hi])
         else:
-            acc, k = _direction_hard(uc, sigma, hc, mc, tc, d, beta, pc)
+            acc, k = _direction_hard(uc, sigma, hc, mc, tc, d, beta)
         part[c] = acc
         violators[c] = k
     total = 0.0
