@@ -39,7 +39,7 @@ from threadpoolctl import threadpool_limits
 
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
-from amontons.contact.fft import DEFAULT_PLANNER_EFFORT, RealFFT2Pair
+from amontons.contact.fft import RealFFT2Pair, resolve_planner_effort
 
 
 class TimedOperator:
@@ -87,6 +87,7 @@ def solve_once(op, h, load, kernels, threads):
 
 def run(n, periodic, path, threads, effort, repeats):
     h, load = problem(n, periodic)
+    effort = resolve_planner_effort(effort, threads, "pyfftw")
     op = get_operator(
         h.shape, 1.0, E_STAR, periodic=periodic, threads=threads, planner_effort=effort
     )
@@ -113,6 +114,7 @@ def run(n, periodic, path, threads, effort, repeats):
         "bc": "periodic" if periodic else "non-periodic",
         "path": path,
         "threads": threads,
+        "effort": effort.removeprefix("FFTW_"),
         "iterations": out.iterations,
         "ms / iteration": statistics.median(per_it) * 1e3,
         "convolutions / iteration": conv_per_it,
@@ -140,7 +142,11 @@ def main():
     ap.add_argument(
         "--thread-counts", type=int, nargs="*", default=None, help="overrides --threads"
     )
-    ap.add_argument("--effort", default=DEFAULT_PLANNER_EFFORT, help="FFTW planner effort")
+    ap.add_argument(
+        "--effort",
+        default=None,
+        help="FFTW planner effort (default: the solver's, ESTIMATE on 1 thread, MEASURE on more)",
+    )
     ap.add_argument("--paths", nargs="*", default=["fused", "numpy"], choices=["fused", "numpy"])
     ap.add_argument(
         "--bc",
@@ -159,7 +165,17 @@ def main():
                 for path in args.paths:
                     rows.append(run(n, bc == "periodic", path, threads, args.effort, repeats))
                     print(rows[-1], file=sys.stderr, flush=True)
-    table(rows, list(rows[0]))
+    _speed_ups(rows)
+    table(rows, list(rows[0]) + ["speed-up vs 1 thread"])
+
+
+def _speed_ups(rows):
+    """Add, to each row on more than one thread, its speed over the same case on one."""
+    one = {(r["grid"], r["bc"], r["path"]): r for r in rows if r["threads"] == 1}
+    for r in rows:
+        base = one.get((r["grid"], r["bc"], r["path"]))
+        if base is not None and r["threads"] > 1:
+            r["speed-up vs 1 thread"] = base["ms / iteration"] / r["ms / iteration"]
 
 
 if __name__ == "__main__":

@@ -42,6 +42,14 @@ def _sphere():
     return sphere((64, 64), 1e-6, 1e-3), 1e-6, 1e9
 
 
+@pytest.fixture(scope="module", autouse=True)
+def pools_loaded():
+    """One solve first: the kernels' OpenMP runtime (numba) loads on its first parallel
+    call, and a pool that appears during a call had no caller's limit to restore."""
+    h, dx, e_star = _sphere()
+    solve(h, dx, e_star, load=1e-3, threads=2)
+
+
 def test_there_is_a_pool_to_bound():
     # Without a native pool the tests below could not fail.
     assert _limits(), "no native thread pool loaded (numpy without BLAS?)"
@@ -143,3 +151,22 @@ def test_an_explicit_planner_effort_is_kept_on_two_threads():
     h = sphere((32, 32), 0.01, 1.0)
     res = solve(h, 0.01, 1.0, load=1e-4, threads=2, planner_effort="FFTW_ESTIMATE")
     assert res.info.planner_effort == "FFTW_ESTIMATE"
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "PASSIVE"), ("ACTIVE", "ACTIVE")])
+def test_idle_openmp_workers_sleep_unless_the_user_says_otherwise(given, expected):
+    """FFTW's threads (pyfftw) and the kernels' are OpenMP; spinning idle workers took the
+    cores from the next parallel region (1024² pair on 2 threads: 48-780 ms instead of
+    11 ms), so importing the solver sets OMP_WAIT_POLICY=PASSIVE before pyfftw loads its
+    libgomp, and keeps a value the user has set. Checked in a fresh process."""
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    code = "import os, sys, amontons.contact; print(os.environ['OMP_WAIT_POLICY'])"
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    )
+    assert out.stdout.strip() == expected

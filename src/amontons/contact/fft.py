@@ -17,9 +17,19 @@ gain (512²: ~5 % per periodic convolution, ~25 % per pruned non-periodic one, f
 
 from __future__ import annotations
 
-import numpy as np
+import os
 
-from .result import ContactInputError
+# pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
+# kernels (.kernels). libgomp's default lets idle workers spin after each parallel region;
+# on a 2-core machine those spinning threads take the cores from the next region's: a 1024²
+# FFT pair on 2 threads took 48-780 ms instead of 11 ms (benchmarks/README.md, "A second
+# core"). PASSIVE makes idle workers sleep. libgomp reads it when it is loaded, so it is
+# set before pyfftw is imported; a value the user has set is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import numpy as np  # noqa: E402
+
+from .result import ContactInputError  # noqa: E402
 
 try:  # pyfftw is optional: numpy.fft is the fallback
     import pyfftw
