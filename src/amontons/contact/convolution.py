@@ -33,6 +33,7 @@ from functools import lru_cache
 import numpy as np
 
 from . import fft as _fft
+from . import kernels as _kernels
 from .greens import hockney_multiplier, periodic_multiplier
 
 
@@ -116,7 +117,7 @@ class PeriodicConvolution(_MultiplierMixin):
                 # zero-copy: the r2c plan does not modify its input, the c2r plan writes out
                 self._fwd.update_arrays(p, self._spec)
                 self._fwd.execute()
-                self._spec *= self._mult_scaled
+                self._multiply()
                 self._inv.update_arrays(self._spec, out)
                 self._inv.execute()
                 return out
@@ -124,7 +125,7 @@ class PeriodicConvolution(_MultiplierMixin):
             self._inv.update_arrays(self._spec, self._real)
             self._real[...] = p
             self._fwd.execute()
-            self._spec *= self._mult_scaled
+            self._multiply()
             self._inv.execute()
             result = self._real
         else:
@@ -133,6 +134,15 @@ class PeriodicConvolution(_MultiplierMixin):
             return result.copy()
         out[...] = result
         return out
+
+    def _multiply(self) -> None:
+        """``spec *= multiplier`` on the operator's threads (numba kernel when threads > 1:
+        numpy's multiply is serial and would be the one serial step of the convolution)."""
+        if self.threads > 1:
+            with _kernels.kernel_threads(self.threads):
+                _kernels.multiply_spectrum(self._spec, self._mult_scaled)
+        else:
+            self._spec *= self._mult_scaled
 
     def real_space_kernel(self) -> np.ndarray:
         """The periodic kernel ``G = irfft2(2/(E*|q|))`` on the grid, m/Pa (built once)."""

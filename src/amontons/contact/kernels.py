@@ -450,3 +450,15 @@ def add_point_responses(u, green, idx, values):
                 row[j] += v * g[j - b]
             for j in range(b):
                 row[j] += v * g[big1 - b + j]
+
+
+@numba.njit(**_JIT)
+def multiply_spectrum(spec, multiplier):
+    """``spec *= multiplier`` in place (complex half-spectrum times the real kernel spectrum,
+    m/Pa), rows in parallel: the one step of a periodic convolution outside FFTW, which
+    numpy runs on one thread."""
+    for i in prange(spec.shape[0]):
+        row = spec[i]
+        mrow = multiplier[i]
+        for j in range(row.size):
+            row[j] = row[j] * mrow[j]
