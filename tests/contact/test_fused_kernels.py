@@ -97,16 +97,25 @@ def test_winkler_term_matches_numpy(rough):
     _assert_same_fixed_point(ref, new, h)
 
 
-def test_kernels_give_the_same_bits_on_one_and_two_threads(rough):
+@pytest.mark.parametrize("case", ["load", "bounded", "winkler"])
+def test_kernels_give_the_same_bits_on_one_and_two_threads(case):
     """Sums are taken over fixed chunks (kernels.CHUNK), so the thread count cannot change a
-    single bit; a 600² grid has 22 chunks, enough to split across threads."""
+    single bit; a 600² grid has 22 chunks, enough to split across threads. The hard wall
+    under load control, the bounded projection and the Winkler term each have their own
+    kernel variants."""
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("numba has one thread here")
     n = 600
     h = self_affine((n, n), 1.0, 0.8, rms_slope=0.1, rng=5)
     op = get_operator(h.shape, 1.0, 1.0, periodic=True)
-    kw = {"pixel_area": 1.0, "h_scale": float(h.std()), "p_init": np.ones_like(h)}
-    kw.update(load=0.005 * n * n, tol=1e-30, max_iter=15, raise_on_failure=False)
+    kw = {"pixel_area": 1.0, "h_scale": float(h.std()), "tol": 1e-30, "max_iter": 15}
+    kw.update(raise_on_failure=False, p_init=np.ones_like(h))
+    if case == "bounded":
+        kw.update(displacement=-1.0 * h.std(), constraint=BoundedWall(0.02))
+    else:
+        kw.update(load=0.005 * n * n)
+    if case == "winkler":
+        op = _WinklerOperator(op, np.full(h.shape, 1.0 / 0.05))
     one = polonsky_keer(op, h, threads=1, **kw)
     two = polonsky_keer(op, h, threads=2, **kw)
     assert np.array_equal(one.pressure, two.pressure)
