@@ -124,6 +124,12 @@ def run(n, periodic, path, threads, effort, repeats):
         "in conv (pairs)": conv,
         "element-wise (pairs)": ratio - conv,
         "area": float(np.mean(out.pressure > 0)),
+        # how u followed each step: linear (no changed point), point responses, or a full
+        # convolution because too many points changed / for the periodic refresh
+        "u updates (lin/pts/full chg/full refresh)": "/".join(
+            str(v) for v in out.info.get("u_updates", {}).values()
+        )
+        or "-",
     }
 
 

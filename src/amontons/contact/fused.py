@@ -169,6 +169,8 @@ def _loop(
     since_fresh = 0
     resets = 0
     recentres = 0  # second moment passes (see _centred_moments)
+    # how u was updated after each step (for benchmarks/bench_iteration.py)
+    updates = dict.fromkeys(("linear", "point responses", "full: changes", "full: refresh"), 0)
     history = []
     d = 0.0 if load_control else float(displacement)
     residual = np.inf
@@ -285,7 +287,9 @@ def _loop(
         if since_fresh >= refresh or (changes and not (sparse_ok and changes <= sparse_max)):
             conv(p, u)
             since_fresh = 0
+            updates["full: changes" if changes > sparse_max else "full: refresh"] += 1
         else:
+            updates["point responses" if changes else "linear"] += 1
             if changes:
                 # u (stored, scale sigma_old) += K*c / sigma_old; u = K*p holds for the stored
                 # pair whatever their common scale, so the new scale needs no pass
@@ -342,7 +346,7 @@ def _loop(
         history=history,
         calls=calls,
         resets=resets,
-        extra={"moment_recentres": recentres},
+        extra={"moment_recentres": recentres, "u_updates": updates},
         shape=shape,
     )
 
