@@ -47,6 +47,12 @@ convergence is declared, ``u`` is recomputed from scratch. The free set is updat
 sparsely (see :class:`HardWall`), the axpy updates use BLAS, and work arrays are
 SIMD-aligned so the FFTW plans run on them without copies.
 
+Two implementations of the same loop: the default runs the element-wise work in four fused
+numba sweeps (:mod:`amontons.contact.fused`, :mod:`amontons.contact.kernels`; point
+responses for up to 12 periodic / 32 non-periodic changed points, sums independent of the
+thread count); ``kernels=False`` runs the numpy loop below, the reference the tests compare
+against (benchmarks/README.md, benchmark 1).
+
 Extension points: the constraint is an object with three methods (:class:`HardWall`;
 :class:`BoundedWall` for ``0 <= p <= p_max``, displacement control), and the operator is
 any symmetric positive-definite linear callable ``op(x, out=...)``, so a Winkler term
