@@ -7,11 +7,17 @@ timing is the median of several runs and compared with a floor measured in the s
 from __future__ import annotations
 
 import os
+import sys
 
-# BLAS level-1 calls (dot, axpy) in the CG would otherwise use OpenBLAS's own threads, which
-# spin on a shared 2-core machine: the benchmarks pin them to --threads (default 1) via
-# the environment, before numpy is imported (see README).
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# The benchmarks time a plain process, as a user runs the solver (no thread environment
+# variables): solve() bounds the native pools itself (threadpoolctl). `--pinned` pins
+# OpenBLAS/OpenMP to one thread through the environment instead, before numpy is imported,
+# for comparison with the tables measured that way (README); tables say which they are.
+os.environ.update(
+    dict.fromkeys(("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"), "1")
+    if "--pinned" in sys.argv
+    else {}
+)
 
 import argparse
 import datetime
@@ -22,6 +28,8 @@ import time
 import numpy as np
 
 from amontons.contact import self_affine, sphere
+
+PINNED = "--pinned" in sys.argv
 
 # The periodic benchmark surface: Hurst 0.8, rms slope 0.1, mean pressure 0.005 E*
 # (about 10 % contact by the κ ≈ 2 law, A/A0 = κ p̄ / (E* h')).
@@ -41,6 +49,11 @@ def parser(description: str) -> argparse.ArgumentParser:
     ap.add_argument("--repeats", type=int, default=None, help="timing repeats (median)")
     ap.add_argument("--threads", type=int, default=1, help="FFTW threads")
     ap.add_argument("--sizes", type=int, nargs="*", default=None, help="grid sizes n (n x n)")
+    ap.add_argument(
+        "--pinned",
+        action="store_true",
+        help="pin OpenBLAS/OpenMP to 1 thread by the environment (default: a plain process)",
+    )
     return ap
 
 
@@ -49,7 +62,8 @@ def header(title: str, args) -> None:
     print(
         f"# {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M UTC}, {platform.node()}, "
         f"{os.cpu_count()} cores, python {platform.python_version()}, numpy {np.__version__}, "
-        f"threads={args.threads}"
+        f"threads={args.threads}, "
+        + ("PINNED by environment (OPENBLAS/OMP/MKL_NUM_THREADS=1)" if PINNED else "plain process")
     )
 
 

@@ -1,15 +1,22 @@
-"""Benchmark 1: time per CG iteration as a multiple of one FFT pair of the padded grid.
+"""Benchmark 1: time per CG iteration as a multiple of one FFT pair of the convolution's grid.
 
-The floor is one forward + one inverse real 2-D FFT (pyfftw, same threads) of the grid the
-convolution works on: n² periodic, (2n)² non-periodic (Hockney padding). Floor and
-convolutions are planned with FFTW_MEASURE, passed explicitly (planner_effort=). Both are
-measured in the same run, alternating, and the median of several runs
-is quoted. The CG runs a fixed number of iterations on a realistic problem (rough periodic
-surface at ~10 % contact; rough sphere for the non-periodic case), and the time spent inside
-the convolutions is measured separately to say where the rest goes.
+For each grid a full load-controlled solve (tol 1e-8, cold start) is timed; per iteration:
+milliseconds, convolutions, and the ratio to one pyfftw r2c + c2r pair of the grid the
+convolution works on (n² periodic, (2n)² non-periodic: Hockney padding), planned with the
+same effort and threads and timed in the same process, alternating with the solves. The
+remainder is ratio minus convolutions per iteration: everything an iteration does besides
+its FFT pairs (element-wise work, spectrum multiply, point responses). "in conv" is the
+time inside the operator calls (the FFT pairs plus their spectrum multiply) in pairs per
+iteration, so "ratio − in conv" is the element-wise work alone. Medians of --repeats.
 
-    python benchmarks/bench_iteration.py            # 1024², 2048²
-    python benchmarks/bench_iteration.py --quick     # 256², 512²
+Paths: ``fused`` (numba kernels, the default of the solver) and ``numpy`` (the reference
+loop, ``kernels=False``). The solve runs inside ``threadpool_limits(1)`` as
+:func:`amontons.contact.solve` does, in a plain process (no thread environment variables,
+unless ``--pinned``).
+
+    python benchmarks/bench_iteration.py                    # 1024², 2048²
+    python benchmarks/bench_iteration.py --sizes 512 1024 2048 --threads 1 2
+    python benchmarks/bench_iteration.py --quick            # 256², 512²
 """
 
 from __future__ import annotations
@@ -21,7 +28,6 @@ import time
 import numpy as np
 from _common import (
     E_STAR,
-    TIMING_EFFORT,
     header,
     parser,
     rough_load,
@@ -29,17 +35,22 @@ from _common import (
     sphere_problem,
     table,
 )
+from threadpoolctl import threadpool_limits
 
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
-from amontons.contact.fft import RealFFT2Pair
+from amontons.contact.fft import RealFFT2Pair, resolve_planner_effort
 
 
 class TimedOperator:
-    """Wraps a convolution operator and accumulates the time spent in it."""
+    """Wraps a convolution operator and accumulates the time spent in its calls (the sparse
+    point responses are forwarded untimed: they are element-wise work)."""
 
     def __init__(self, op):
-        self.op, self.seconds, self.periodic = op, 0.0, op.periodic
+        self.op, self.seconds = op, 0.0
+
+    def __getattr__(self, name):
+        return getattr(self.op, name)
 
     def __call__(self, x, out=None):
         t0 = time.perf_counter()
@@ -48,79 +59,129 @@ class TimedOperator:
         return r
 
 
-def run(n, periodic, iterations, repeats, threads):
+def problem(n, periodic):
+    """Heights (m) and load (N) of the benchmark problem (README)."""
     if periodic:
-        h, load = rough_surface(n), rough_load(n)
-    else:
-        h, load = sphere_problem(n)
-    op = get_operator(
-        h.shape, 1.0, E_STAR, periodic=periodic, threads=threads, planner_effort=TIMING_EFFORT
-    )
-    fft_shape = h.shape if periodic else (2 * n, 2 * n)
-    pair = RealFFT2Pair(fft_shape, threads=threads, planner_effort=TIMING_EFFORT)
-    pair.real[...] = np.random.default_rng(0).random(pair.shape)
-    # warm start: a few iterations first, so the timed ones are mid-solve iterations
-    warm = polonsky_keer(
-        op,
-        h,
-        pixel_area=1.0,
-        h_scale=h.std(),
-        p_init=np.ones_like(h),
-        load=load,
-        tol=1e-30,
-        max_iter=20,
-        raise_on_failure=False,
-    )
-    per_iter, pair_t, conv_share, conv_per_it = [], [], [], []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(5):
-            pair()
-        pair_t.append((time.perf_counter() - t0) / 5)
-        timed = TimedOperator(op)
-        t0 = time.perf_counter()
+        return rough_surface(n), rough_load(n)
+    return sphere_problem(n)
+
+
+def solve_once(op, h, load, kernels, threads):
+    timed = TimedOperator(op)
+    t0 = time.perf_counter()
+    with threadpool_limits(limits=1):
         out = polonsky_keer(
             timed,
             h,
             pixel_area=1.0,
             h_scale=h.std(),
-            p_init=warm.pressure,
+            p_init=np.ones_like(h),
             load=load,
-            tol=1e-30,
-            max_iter=iterations,
-            raise_on_failure=False,
+            tol=1e-8,
+            max_iter=5000,
+            kernels=kernels,
+            threads=threads,
         )
-        dt = time.perf_counter() - t0
-        per_iter.append(dt / iterations)
-        conv_share.append(timed.seconds / dt)
-        conv_per_it.append(out.convolutions / iterations)
-    it_t, fl_t = statistics.median(per_iter), statistics.median(pair_t)
-    ratios = [a / b for a, b in zip(per_iter, pair_t, strict=True)]
+    return time.perf_counter() - t0, timed.seconds, out
+
+
+def run(n, periodic, path, threads, effort, repeats):
+    h, load = problem(n, periodic)
+    effort = resolve_planner_effort(effort, threads, "pyfftw")
+    op = get_operator(
+        h.shape, 1.0, E_STAR, periodic=periodic, threads=threads, planner_effort=effort
+    )
+    fft_shape = h.shape if periodic else (2 * n, 2 * n)
+    pair = RealFFT2Pair(fft_shape, threads=threads, planner_effort=effort)
+    pair.real[...] = np.random.default_rng(0).random(pair.shape)
+    kernels = path == "fused"
+    solve_once(op, h, load, kernels, threads)  # warm-up: plans, kernels, caches
+    ratios, per_it, pairs, in_conv = [], [], [], []
+    for _ in range(repeats):
+        pair_t = _pair_time(pair)
+        dt, conv_s, out = solve_once(op, h, load, kernels, threads)
+        pair_t = 0.5 * (pair_t + _pair_time(pair))
+        it = out.iterations
+        per_it.append(dt / it)
+        pairs.append(pair_t)
+        ratios.append(dt / it / pair_t)
+        in_conv.append(conv_s / it / pair_t)
+    conv_per_it = out.convolutions / out.iterations
+    ratio = statistics.median(ratios)
+    conv = statistics.median(in_conv)
     return {
         "grid": f"{n}²",
         "bc": "periodic" if periodic else "non-periodic",
-        "FFT grid": f"{h.shape[0] * (1 if periodic else 2)}²",
-        "iteration ms": it_t * 1e3,
-        "FFT pair ms": fl_t * 1e3,
-        "ratio (median of per-run ratios)": statistics.median(ratios),
-        "convolutions / iteration": statistics.median(conv_per_it),
-        "share in convolutions": statistics.median(conv_share),
+        "path": path,
+        "threads": threads,
+        "effort": effort.removeprefix("FFTW_"),
+        "iterations": out.iterations,
+        "ms / iteration": statistics.median(per_it) * 1e3,
+        "convolutions / iteration": conv_per_it,
+        "FFT pair ms": statistics.median(pairs) * 1e3,
+        "ratio": ratio,
+        "remainder": ratio - conv_per_it,
+        "in conv (pairs)": conv,
+        "element-wise (pairs)": ratio - conv,
+        "area": float(np.mean(out.pressure > 0)),
+        # how u followed each step: linear (no changed point), point responses, or a full
+        # convolution because too many points changed / for the periodic refresh
+        "u updates (lin/pts/full chg/full refresh)": "/".join(
+            str(v) for v in out.info.get("u_updates", {}).values()
+        )
+        or "-",
     }
 
 
+def _pair_time(pair, calls=5):
+    """Median time of one FFT pair over ``calls`` calls, s."""
+    ts = []
+    for _ in range(calls):
+        t0 = time.perf_counter()
+        pair()
+        ts.append(time.perf_counter() - t0)
+    return statistics.median(ts)
+
+
 def main():
-    args = parser(__doc__.splitlines()[0]).parse_args()
+    ap = parser(__doc__.splitlines()[0])
+    ap.add_argument(
+        "--thread-counts", type=int, nargs="*", default=None, help="overrides --threads"
+    )
+    ap.add_argument(
+        "--effort",
+        default=None,
+        help="FFTW planner effort (default: the solver's, ESTIMATE on 1 thread, MEASURE on more)",
+    )
+    ap.add_argument("--paths", nargs="*", default=["fused", "numpy"], choices=["fused", "numpy"])
+    ap.add_argument(
+        "--bc",
+        nargs="*",
+        default=["periodic", "non-periodic"],
+        choices=["periodic", "non-periodic"],
+    )
+    args = ap.parse_args()
     sizes = args.sizes or ([256, 512] if args.quick else [1024, 2048])
-    repeats = args.repeats or (3 if args.quick else 5)
+    repeats = args.repeats or 3
     header("Benchmark 1: CG iteration time / FFT pair", args)
     rows = []
     for n in sizes:
-        for periodic in (True, False):
-            iterations = 20 if n <= 1024 else 10
-            rows.append(run(n, periodic, iterations, repeats, args.threads))
-            print(rows[-1], file=sys.stderr, flush=True)
-    cols = list(rows[0])
-    table(rows, cols)
+        for bc in args.bc:
+            for threads in args.thread_counts or [args.threads]:
+                for path in args.paths:
+                    rows.append(run(n, bc == "periodic", path, threads, args.effort, repeats))
+                    print(rows[-1], file=sys.stderr, flush=True)
+    _speed_ups(rows)
+    table(rows, list(rows[0]) + ["speed-up vs 1 thread"])
+
+
+def _speed_ups(rows):
+    """Add, to each row on more than one thread, its speed over the same case on one."""
+    one = {(r["grid"], r["bc"], r["path"]): r for r in rows if r["threads"] == 1}
+    for r in rows:
+        base = one.get((r["grid"], r["bc"], r["path"]))
+        if base is not None and r["threads"] > 1:
+            r["speed-up vs 1 thread"] = base["ms / iteration"] / r["ms / iteration"]
 
 
 if __name__ == "__main__":

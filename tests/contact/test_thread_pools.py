@@ -42,6 +42,14 @@ def _sphere():
     return sphere((64, 64), 1e-6, 1e-3), 1e-6, 1e9
 
 
+@pytest.fixture(scope="module", autouse=True)
+def pools_loaded():
+    """One solve first: the kernels' OpenMP runtime (numba) loads on its first parallel
+    call, and a pool that appears during a call had no caller's limit to restore."""
+    h, dx, e_star = _sphere()
+    solve(h, dx, e_star, load=1e-3, threads=2)
+
+
 def test_there_is_a_pool_to_bound():
     # Without a native pool the tests below could not fail.
     assert _limits(), "no native thread pool loaded (numpy without BLAS?)"
@@ -113,3 +121,52 @@ def test_answers_do_not_depend_on_the_bound():
         two = solve(h, dx, e_star, load=1e-3, threads=2)
     scale = np.abs(one.pressure).max()
     assert np.abs(one.pressure - two.pressure).max() <= 1e-10 * scale
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_two_threads_give_the_one_thread_answer(periodic):
+    """threads=2 plans its FFTs with FFTW_MEASURE by default (ESTIMATE's plans do not use a
+    second thread) and runs the fused kernels on two threads; the kernels' sums do not
+    depend on the thread count and the FFT plans differ only in round-off, so the solution
+    is the one-thread one to 1e-10 in contact fraction and approach (over the rms height),
+    far below the 1e-9 solve tolerance."""
+    n = 128
+    if periodic:
+        from amontons.contact import self_affine
+
+        h = self_affine((n, n), 1.0, 0.8, rms_slope=0.1, rng=11)
+        kw = {"load": 0.005 * n * n, "periodic": True}
+    else:
+        h = sphere((n, n), 1.0, 4.0 * n)
+        kw = {"load": 4 * (n / 5) ** 3 / (3 * 4.0 * n)}
+    one = solve(h, 1.0, 1.0, tol=1e-9, threads=1, **kw)
+    two = solve(h, 1.0, 1.0, tol=1e-9, threads=2, **kw)
+    assert (one.info.planner_effort, two.info.planner_effort) == ("FFTW_ESTIMATE", "FFTW_MEASURE")
+    assert abs(one.contact_fraction - two.contact_fraction) <= 1e-10
+    assert abs(one.displacement - two.displacement) <= 1e-10 * h.std()
+    assert abs(one.iterations - two.iterations) <= 0.05 * one.iterations
+
+
+def test_an_explicit_planner_effort_is_kept_on_two_threads():
+    h = sphere((32, 32), 0.01, 1.0)
+    res = solve(h, 0.01, 1.0, load=1e-4, threads=2, planner_effort="FFTW_ESTIMATE")
+    assert res.info.planner_effort == "FFTW_ESTIMATE"
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "PASSIVE"), ("ACTIVE", "ACTIVE")])
+def test_idle_openmp_workers_sleep_unless_the_user_says_otherwise(given, expected):
+    """FFTW's threads (pyfftw) and the kernels' are OpenMP; spinning idle workers took the
+    cores from the next parallel region (1024² pair on 2 threads: 48-780 ms instead of
+    11 ms), so importing the solver sets OMP_WAIT_POLICY=PASSIVE before pyfftw loads its
+    libgomp, and keeps a value the user has set. Checked in a fresh process."""
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    code = "import os, sys, amontons.contact; print(os.environ['OMP_WAIT_POLICY'])"
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    )
+    assert out.stdout.strip() == expected

@@ -57,10 +57,10 @@ Options
     increments, exact elastic-plus-Winkler; the default there) or ``"appendix"`` (the
     appendix's iterative scheme; the only route for penetration hardness and
     volume-conserving increments); None picks the default. ``planner_effort``: FFTW
-    planner effort, default ``"FFTW_ESTIMATE"`` (deterministic: the same bytes in every
-    run); ``"FFTW_MEASURE"`` plans by timing (faster convolutions, not reproducible bit for
-    bit). An unknown value of either raises :class:`ContactInputError` naming the allowed
-    values.
+    planner effort; None (default) is ``"FFTW_ESTIMATE"`` on one thread (deterministic: the
+    same bytes in every run) and ``"FFTW_MEASURE"`` with ``threads > 1`` (plans that use
+    the threads; chosen by timing, so not reproducible bit for bit). An unknown value of
+    either raises :class:`ContactInputError` naming the allowed values.
 
 Warnings
     :class:`IgnoredOptionWarning` (a ``UserWarning``), once per call, for an option given

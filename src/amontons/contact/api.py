@@ -62,7 +62,7 @@ def solve(
     plastic_displacement=None,
     method=None,
     max_outer=None,
-    planner_effort=DEFAULT_PLANNER_EFFORT,
+    planner_effort=None,
     raise_on_failure=True,
 ) -> ContactResult:
     """Solve the frictionless contact of a rigid rough indenter on an elastic half-space.
@@ -120,11 +120,14 @@ def solve(
         Cap on the outer loop of a plastic solve: plastic updates per approach
         (``"appendix"``, default 200) or active-set rounds (``"winkler"``, default 50).
         Ignored, with a warning, by an elastic solve.
-    planner_effort : {"FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE"}
-        FFTW planner effort. The default ``"FFTW_ESTIMATE"`` is deterministic (same plan,
-        same result bytes in every run); ``"FFTW_MEASURE"`` times candidate plans, which is
-        faster per convolution but not reproducible bit for bit (benchmarks/README.md).
-        Operators are cached per effort. Ignored, with a warning, by the numpy backend.
+    planner_effort : str, optional
+        FFTW planner effort, one of "FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT",
+        "FFTW_EXHAUSTIVE". None (default): ``"FFTW_ESTIMATE"`` on one thread, which is
+        deterministic (same plan, same result bytes in every run), and ``"FFTW_MEASURE"``
+        with ``threads > 1``, whose plans use the threads (ESTIMATE's do not) but are
+        chosen by timing, so the last bits can change from run to run (the answer agrees
+        with the one-thread one to 1e-10; benchmarks/README.md). Operators are cached per
+        effort. An effort given with the numpy backend is ignored, with a warning.
     raise_on_failure : bool
         True (default): a solve that does not converge raises :class:`ConvergenceError`.
         False: it returns a :class:`ContactResult` with ``success=False``, its ``status``
@@ -220,7 +223,7 @@ def solve_load_series(
     plasticity=None,
     method=None,
     max_outer=None,
-    planner_effort=DEFAULT_PLANNER_EFFORT,
+    planner_effort=None,
     raise_on_failure=True,
 ) -> list[ContactResult]:
     """Solve for increasing loads, each step warm-started from the previous pressure.

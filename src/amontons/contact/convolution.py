@@ -33,6 +33,7 @@ from functools import lru_cache
 import numpy as np
 
 from . import fft as _fft
+from . import kernels as _kernels
 from .greens import hockney_multiplier, periodic_multiplier
 
 
@@ -116,7 +117,7 @@ class PeriodicConvolution(_MultiplierMixin):
                 # zero-copy: the r2c plan does not modify its input, the c2r plan writes out
                 self._fwd.update_arrays(p, self._spec)
                 self._fwd.execute()
-                self._spec *= self._mult_scaled
+                self._multiply()
                 self._inv.update_arrays(self._spec, out)
                 self._inv.execute()
                 return out
@@ -124,7 +125,7 @@ class PeriodicConvolution(_MultiplierMixin):
             self._inv.update_arrays(self._spec, self._real)
             self._real[...] = p
             self._fwd.execute()
-            self._spec *= self._mult_scaled
+            self._multiply()
             self._inv.execute()
             result = self._real
         else:
@@ -134,6 +135,21 @@ class PeriodicConvolution(_MultiplierMixin):
         out[...] = result
         return out
 
+    def _multiply(self) -> None:
+        """``spec *= multiplier`` on the operator's threads (numba kernel when threads > 1:
+        numpy's multiply is serial and would be the one serial step of the convolution)."""
+        if self.threads > 1:
+            with _kernels.kernel_threads(self.threads):
+                _kernels.multiply_spectrum(self._spec, self._mult_scaled)
+        else:
+            self._spec *= self._mult_scaled
+
+    def real_space_kernel(self) -> np.ndarray:
+        """The periodic kernel ``G = irfft2(2/(E*|q|))`` on the grid, m/Pa (built once)."""
+        if self._green is None:
+            self._green = np.fft.irfft2(self.multiplier, s=self.shape)
+        return self._green
+
     def add_point_responses(self, out: np.ndarray, idx, values) -> None:
         """``out += Σ_j values_j · G(x - x_j)``: displacement (m) of uniform pressures
         ``values`` (Pa) on the single pixels with flat indices ``idx``, added in place.
@@ -142,9 +158,7 @@ class PeriodicConvolution(_MultiplierMixin):
         operator as the FFT path, so results agree to round-off); each point costs a few
         passes over the grid, which beats a convolution for a handful of points.
         """
-        if self._green is None:
-            self._green = np.fft.irfft2(self.multiplier, s=self.shape)
-        g = self._green
+        g = self.real_space_kernel()
         n0, n1 = self.shape
         for k, v in zip(np.asarray(idx).tolist(), np.asarray(values).tolist(), strict=True):
             a, b = divmod(k, n1)
@@ -198,6 +212,7 @@ class NonPeriodicConvolution(_MultiplierMixin):
         self.pruned = bool(pruned)
         self.planner_effort = _fft.check_planner_effort(planner_effort)
         self._multiplier = hockney_multiplier(self.shape, spacing, e_star)
+        self._green = None  # real-space kernel on the padded grid, built on first use
         self.ncalls = 0
         n0, n1 = self.shape
         be = self.backend
@@ -235,6 +250,15 @@ class NonPeriodicConvolution(_MultiplierMixin):
             self._scale = 1.0 / (4 * n0 * n1)
             self._mult_scaled = _scaled(self._multiplier, self._scale)
             self._multiplier = None  # keep one copy only (memory)
+
+    def real_space_kernel(self) -> np.ndarray:
+        """The kernel of the padded circular convolution, ``(2n0, 2n1)``, m/Pa (built once):
+        the response at ``x`` of a unit pressure on the pixel at the origin is
+        ``G[x mod 2n]``, the same discrete operator as the FFT path. 4 n0·n1 floats."""
+        if self._green is None:
+            n0, n1 = self.shape
+            self._green = np.fft.irfft2(self.multiplier, s=(2 * n0, 2 * n1))
+        return self._green
 
     def __call__(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Return the displacement (m) of pressure ``p`` (Pa); writes into ``out`` if given."""

@@ -17,9 +17,19 @@ gain (512²: ~5 % per periodic convolution, ~25 % per pruned non-periodic one, f
 
 from __future__ import annotations
 
-import numpy as np
+import os
 
-from .result import ContactInputError
+# pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
+# kernels (.kernels). libgomp's default lets idle workers spin after each parallel region;
+# on a 2-core machine those spinning threads take the cores from the next region's: a 1024²
+# FFT pair on 2 threads took 48-780 ms instead of 11 ms (benchmarks/README.md, "A second
+# core"). PASSIVE makes idle workers sleep. libgomp reads it when it is loaded, so it is
+# set before pyfftw is imported; a value the user has set is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import numpy as np  # noqa: E402
+
+from .result import ContactInputError  # noqa: E402
 
 try:  # pyfftw is optional: numpy.fft is the fallback
     import pyfftw
@@ -34,6 +44,12 @@ BACKENDS = ("pyfftw", "numpy")
 # FFTW planner flags, cheapest first; only the first is deterministic.
 PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
 DEFAULT_PLANNER_EFFORT = "FFTW_ESTIMATE"
+# Planner effort of a multi-threaded solve when none is given: FFTW_ESTIMATE's plans do not
+# use a second thread here (1024² pair: 8.50 ms on 1 thread, 8.35 ms on 2), FFTW_MEASURE's
+# do (5.38 ms on 2); benchmarks/README.md, "A second core". The price is the determinism
+# of the plan: results can differ in the last bits from run to run (tests hold them to
+# 1e-10 of the one-thread answer).
+THREADED_PLANNER_EFFORT = "FFTW_MEASURE"
 
 
 def resolve_backend(backend: str | None) -> str:
@@ -68,6 +84,18 @@ def check_planner_effort(planner_effort: str) -> str:
             f"planner_effort must be one of {PLANNER_EFFORTS}, got {planner_effort!r}"
         )
     return planner_effort
+
+
+def resolve_planner_effort(planner_effort: str | None, threads: int, backend: str) -> str:
+    """The planner effort of a solve: ``planner_effort`` if given (checked), else
+    :data:`DEFAULT_PLANNER_EFFORT` on one thread (deterministic) and
+    :data:`THREADED_PLANNER_EFFORT` on several (plans that use them); numpy.fft does not
+    plan, so its effort is always the default."""
+    if planner_effort is not None:
+        return check_planner_effort(planner_effort)
+    if threads > 1 and backend == "pyfftw":
+        return THREADED_PLANNER_EFFORT
+    return DEFAULT_PLANNER_EFFORT
 
 
 def empty(shape, dtype, backend: str) -> np.ndarray:

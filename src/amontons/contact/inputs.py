@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .fft import check_planner_effort, resolve_backend
+from .fft import resolve_backend, resolve_planner_effort
 from .plasticity import (
     ContactHardening,
     PenetrationHardness,
@@ -63,7 +63,7 @@ def solve_options(
     max_iter = default_max_iter(shape) if max_iter is None else check_count("max_iter", max_iter)
     threads = check_threads(threads)
     backend = resolve_backend(backend)
-    planner_effort = check_planner_effort(planner_effort)
+    planner_effort = resolve_planner_effort(planner_effort, threads, backend)
     check_method(method)
     law = None if plasticity is None else check_law(plasticity)
     route = "elastic" if law is None else resolve_route(law, method)

@@ -280,6 +280,24 @@ def _appendix_state(out, h_pl, displacement, tally, outer):
     )
 
 
+class _SolvedTrials:
+    """Pressures (Pa) of converged trial approaches (m) of a root find, the ``KEEP`` most
+    recent, to warm-start each new trial from the nearest one in approach."""
+
+    KEEP = 4  # the bracket's ends and their last refinements; each is one grid of floats
+
+    def __init__(self):
+        self.trials = []
+
+    def add(self, d: float, pressure: np.ndarray) -> None:
+        self.trials = [*self.trials[-(self.KEEP - 1) :], (d, pressure)]
+
+    def nearest(self, d: float, default: np.ndarray) -> np.ndarray:
+        if not self.trials:
+            return default
+        return min(self.trials, key=lambda trial: abs(trial[0] - d))[1]
+
+
 class _Found(Exception):
     def __init__(self, state):
         self.state = state
@@ -543,10 +561,15 @@ def solve_plastic(
     if displacement is not None:
         return at(float(displacement), p_init)
     last = {"p": p_init}
+    solved = _SolvedTrials()
 
     def evaluate(d):
-        state = at(d, last["p"])
+        # start from the converged trial nearest in approach (the pressure is continuous in
+        # d), else from the last one tried
+        state = at(d, solved.nearest(d, last["p"]))
         last["p"] = state.pressure
+        if state.converged:
+            solved.add(d, state.pressure)
         return float(state.pressure.sum()) * pixel_area, state
 
     span = float(np.ptp(heights)) or spacing

@@ -1,0 +1,406 @@
+"""The Polonsky–Keer CG loop on fused kernels (the default path of
+:func:`amontons.contact.cg.polonsky_keer`; ``kernels=False`` there runs the numpy reference).
+
+Same algorithm, same iterates up to round-off, as the numpy loop in :mod:`.cg` (its module
+docstring and docs/models.md §2.2 describe it); what differs is how the element-wise work is
+done. One iteration is four sweeps over the grid plus the convolution ``r = K*t``
+(:mod:`.kernels`):
+
+1. ``gap_moments``: approach ``d`` (load control), ``G = Σ_Ic g²`` and ``Σ g t_old``;
+2. ``direction``: ``t = g·m + β t``;
+3. ``step_dots``: ``Σ r t`` and ``Σ_Ic r`` (plus the Winkler term of a hardening solve);
+4. ``update``: step, projection, violators, free-set update, ``Σ p`` and ``u -= τ r``.
+
+Load control rescales ``p`` (and so ``u``) to the target force every iteration. Here that
+rescale costs no pass: the stored pressure ``P`` and displacement ``U`` carry one common
+scale ``sigma`` (true ``p = sigma·P``, ``u = sigma·U``); ``u = K*p`` is linear, so
+``U = K*P`` stays true when only ``sigma`` changes.
+
+Convergence, status codes, the full-convolution refresh and the sparse point-response
+update are those of :mod:`.cg`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import fft as _fft
+from . import kernels as _k
+from .result import CONVERGED, STALLED, ConvergenceError
+
+# Most changed points (clipped + added) applied to u as point responses instead of a full
+# convolution. One point costs a sweep of the real-space kernel (kernels.add_point_responses,
+# ~0.6 ms at 1024² periodic, ~0.9 ms at 1024² non-periodic) against ~9 ms for a periodic
+# convolution and ~35 ms for a padded one (benchmarks/README.md, "Fewer convolutions"), so
+# the break-even is ~15 points periodic and ~40 padded; the limits stay below it.
+SPARSE_MAX_PERIODIC = 12
+# Largest Σa²/G of the one-pass moments about the previous approach (see _centred_moments).
+RECENTRE = 1e3
+SPARSE_MAX_PADDED = 32
+
+
+def fused_polonsky_keer(
+    operator,
+    heights,
+    *,
+    pixel_area,
+    h_scale,
+    p_init,
+    load,
+    displacement,
+    tol,
+    max_iter,
+    refresh,
+    constraint,
+    raise_on_failure,
+    threads,
+    sparse_max,
+    reset_fraction,
+    finish,
+):
+    """Fused-kernel version of :func:`amontons.contact.cg.polonsky_keer` (arguments
+    validated there; ``finish`` builds its :class:`~amontons.contact.cg.CGOutcome`)."""
+    with _k.kernel_threads(threads):
+        return _loop(
+            operator,
+            heights,
+            pixel_area=pixel_area,
+            h_scale=h_scale,
+            p_init=p_init,
+            load=load,
+            displacement=displacement,
+            tol=tol,
+            max_iter=max_iter,
+            refresh=refresh,
+            constraint=constraint,
+            raise_on_failure=raise_on_failure,
+            sparse_max=sparse_max,
+            reset_fraction=reset_fraction,
+            finish=finish,
+        )
+
+
+def _winkler_parts(operator):
+    """``(convolution, compliance)`` of an elastic-plus-Winkler operator (compliance m/Pa,
+    added inside :func:`.kernels.step_dots`), or ``(operator, None)``."""
+    compliance = getattr(operator, "compliance", None)
+    base = getattr(operator, "operator", None)
+    if compliance is None or base is None:
+        return operator, None
+    return base, np.ascontiguousarray(compliance, dtype=np.float64).ravel()
+
+
+def _bound_array(constraint, n):
+    """``(p_max per point, bounded flag)`` for the kernels (Pa)."""
+    if not constraint.bounded:
+        return np.full(1, np.inf), False
+    p_max = np.broadcast_to(np.asarray(constraint.p_max, dtype=np.float64), (n,))
+    return np.ascontiguousarray(p_max), True
+
+
+def _loop(
+    operator,
+    heights,
+    *,
+    pixel_area,
+    h_scale,
+    p_init,
+    load,
+    displacement,
+    tol,
+    max_iter,
+    refresh,
+    constraint,
+    raise_on_failure,
+    sparse_max,
+    reset_fraction,
+    finish,
+):
+    load_control = load is not None
+    shape = heights.shape
+    n = heights.size
+    backend = "pyfftw" if _fft.HAVE_PYFFTW else "numpy"
+
+    def buf():
+        # SIMD-aligned work arrays let the FFT plans run on them without copies
+        return _fft.empty(n, np.float64, backend)
+
+    base_op, compliance = _winkler_parts(operator)
+    winkler = compliance is not None
+    comp_arg = compliance if winkler else np.zeros(1)
+    p_max, bounded = _bound_array(constraint, n)
+    h = buf()
+    h[:] = np.ravel(heights)
+    p = buf()
+    p[:] = np.ravel(p_init)
+    if p.min() < 0:
+        raise ValueError("p_init must be >= 0")
+    if bounded:
+        np.minimum(p, p_max, out=p)
+    calls = 0
+
+    def conv(x, out):
+        nonlocal calls
+        calls += 1
+        operator(x.reshape(shape), out=out.reshape(shape))
+        return out
+
+    if load_control:
+        total = p.sum()
+        if not total > 0:
+            p[:] = 1.0
+            total = p.size
+        p *= load / (pixel_area * total)
+    u, r = buf(), buf()
+    p_old = None  # a copy of p, taken only when the step may converge
+    t = buf()
+    t[:] = 0.0
+    m = np.empty(n, dtype=np.uint8)
+    nch = _k.n_chunks(n)
+    idx_buf = np.zeros((nch, _k.SLOTS), dtype=np.int64)
+    val_buf = np.zeros((nch, _k.SLOTS))
+    counts = np.zeros((nch, 2), dtype=np.int64)
+    violators = np.zeros(nch, dtype=np.int64)
+    conv(p, u)
+    sigma = 1.0  # true p = sigma·p, u = sigma·u (module docstring)
+    nc = int(_k.free_mask(p, m, p_max, bounded))
+    delta = 0.0
+    g_old = 1.0
+    since_fresh = 0
+    resets = 0
+    recentres = 0  # second moment passes (see _centred_moments)
+    # how u was updated after each step (for benchmarks/bench_iteration.py)
+    updates = dict.fromkeys(("linear", "point responses", "full: changes", "full: refresh"), 0)
+    history = []
+    d = 0.0 if load_control else float(displacement)
+    residual = np.inf
+    converged = False
+    stalled = None
+    it = 0
+    singular_full = getattr(operator, "periodic", False) and not load_control
+    # every operator of .convolution offers its real-space kernel; a custom one may not
+    sparse_ok = hasattr(base_op, "real_space_kernel")
+    if sparse_max is None:
+        sparse_max = (
+            SPARSE_MAX_PERIODIC if getattr(base_op, "periodic", False) else SPARSE_MAX_PADDED
+        )
+    green = None
+    while it < max_iter:
+        it += 1
+        if singular_full and nc == n:
+            stalled = (
+                "periodic displacement-controlled solve reached full contact: the mean "
+                "pressure is then undetermined (the q = 0 mode is the rigid mode); use load "
+                f"control or a smaller displacement (d = {d:.3e} m)"
+            )
+            if raise_on_failure:
+                raise ConvergenceError(
+                    stalled,
+                    iterations=it,
+                    residual=float(residual),
+                    tol=tol,
+                    residual_history=np.asarray(history),
+                    status=STALLED,
+                )
+            it -= 1
+            break
+        if nc == 0:
+            # displacement control only (module doc of .cg): start the free set from the
+            # points the constraint says should be free
+            g = sigma * u - h - d
+            mf = np.zeros(n)
+            start = constraint.violators(sigma * p, g, mf)
+            nc = int(start.size)
+            if nc == 0:
+                residual = 0.0
+                history.append(0.0)
+                converged = True
+                since_fresh = 1
+                break
+            m[:] = 0
+            m[start] = 1
+            t[:] = 0.0
+        if load_control:
+            d, big_g, gt_old, recentred = _centred_moments(u, sigma, h, m, t, d, nc)
+            recentres += recentred
+        else:
+            _, big_g, gt_old, _ = _k.gap_moments(u, sigma, h, m, t, d)
+        beta = delta * big_g / g_old if g_old > 0 else 0.0
+        g_dot_t = big_g + beta * gt_old if beta else big_g
+        tsum = _k.direction(u, sigma, h, m, t, d, beta, p, p_max, bounded, violators)
+        g_old = big_g
+        conv_t(base_op, t, r, shape)
+        calls += 1
+        rt, rm = _k.step_dots(r, t, m, comp_arg, winkler)
+        if load_control:
+            rt -= rm / nc * tsum
+        if not (rt > 0 and np.isfinite(rt)):
+            if big_g == 0.0:
+                residual = 0.0
+                history.append(0.0)
+                converged = True
+                break
+            delta = 0.0
+            g_old = 0.0
+            history.append(residual)
+            continue
+        tau = g_dot_t / rt
+        rms_ok = np.sqrt(big_g / max(nc, 1)) / h_scale < tol
+        if rms_ok:
+            # the convergence test below needs the pressure change: keep the old field
+            # (this pass is paid only in the last iterations; otherwise p is updated in place)
+            p_old = np.copy(p) if p_old is None else _copy(p, p_old)
+        psum, pen = _k.update(
+            p,
+            p,
+            u,
+            r,
+            t,
+            h,
+            m,
+            p_max,
+            bounded,
+            sigma,
+            d,
+            tau,
+            violators,
+            idx_buf,
+            val_buf,
+            counts,
+        )
+        n_clip = int(counts[:, 0].sum())
+        n_add = int(counts[:, 1].sum())
+        if n_add:
+            if n_add > reset_fraction * nc:
+                delta = 0.0
+                resets += 1
+            else:
+                delta = 1.0
+        else:
+            delta = 1.0
+        nc_start = nc
+        nc += n_add - n_clip
+        sigma_old = sigma
+        if load_control:
+            sigma = load / (pixel_area * psum)
+        changes = n_clip + n_add
+        if since_fresh >= refresh or (changes and not (sparse_ok and changes <= sparse_max)):
+            conv(p, u)
+            since_fresh = 0
+            updates["full: changes" if changes > sparse_max else "full: refresh"] += 1
+        else:
+            updates["point responses" if changes else "linear"] += 1
+            if changes:
+                # u (stored, scale sigma_old) += K*c / sigma_old; u = K*p holds for the stored
+                # pair whatever their common scale, so the new scale needs no pass
+                idx, vals = _changed_points(counts, idx_buf, val_buf)
+                if green is None:
+                    green = base_op.real_space_kernel()
+                _k.add_point_responses(u.reshape(shape), green, idx, vals / sigma_old)
+                if winkler:
+                    # a point clipped and re-added appears twice: add.at sums both
+                    np.add.at(u, idx, compliance[idx] * vals / sigma_old)
+            since_fresh += 1
+        comp = max(np.sqrt(big_g / max(nc_start, 1)), pen) / h_scale
+        residual = comp
+        if comp < tol and rms_ok:
+            change, psum_true = _k.relative_change(p, sigma, p_old, sigma_old)
+            change = float(change / psum_true) if psum_true > 0 else 0.0
+            residual = max(change, comp)
+            if change < tol:
+                # settle the scale into the fields (two passes, only here)
+                p *= sigma
+                if since_fresh:
+                    conv(p, u)
+                    since_fresh = 0
+                else:
+                    u *= sigma
+                sigma = 1.0
+                comp_now, d_now, nc = _final_complementarity(
+                    u, h, p, d, load_control, m, t, p_max, bounded
+                )
+                comp_now /= h_scale
+                residual = max(change, comp_now)
+                if comp_now < tol:
+                    d = d_now
+                    converged = True
+                t *= m  # the fresh mask replaces the sparsely maintained one
+        history.append(residual)
+        if converged:
+            break
+    if sigma != 1.0:
+        p *= sigma
+        u *= sigma
+    if since_fresh:
+        conv(p, u)
+    return finish(
+        p=p,
+        u=u,
+        h=h,
+        d=d,
+        load_control=load_control,
+        converged=converged,
+        stalled=stalled,
+        it=it,
+        residual=residual,
+        history=history,
+        calls=calls,
+        resets=resets,
+        extra={"moment_recentres": recentres, "u_updates": updates},
+        shape=shape,
+    )
+
+
+def _copy(src, dst):
+    np.copyto(dst, src)
+    return dst
+
+
+def conv_t(base_op, t, r, shape):
+    """``r = K*t`` with the plain convolution (a Winkler term is added by ``step_dots``)."""
+    base_op(t.reshape(shape), out=r.reshape(shape))
+
+
+def _centred_moments(u, sigma, h, m, t, d_old, nc):
+    """Load control: the approach ``d`` (m, the mean of ``sigma·u - h`` on the free set),
+    ``G = Σ_Ic g²`` (m²) and ``Σ g·t`` with ``g`` centred on it, and whether a second pass
+    was needed.
+
+    One pass takes the moments about the previous approach; when that is far from the new
+    one (the first iteration, a warm start), ``G = Σa² - (Σa)²/nc`` would cancel
+    catastrophically (relative error ~ 1e-16 · Σa²/G), so the moments are taken again about
+    the new approach whenever ``Σa² > RECENTRE · G``: G is then good to ~1e-13.
+    """
+    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d_old)
+    mean = s1 / nc
+    d = d_old + mean
+    big_g = max(s2 - s1 * mean, 0.0)
+    if s2 <= RECENTRE * big_g:
+        return d, big_g, st - mean * tsum, 0
+    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d)
+    mean = s1 / nc
+    return d + mean, max(s2 - s1 * mean, 0.0), st - mean * tsum, 1
+
+
+def _changed_points(counts, idx_buf, val_buf):
+    """Flat indices and added pressures (Pa) of the points ``update`` recorded."""
+    per = counts.sum(axis=1)
+    rows = np.flatnonzero(per)
+    idx = np.concatenate([idx_buf[c, : per[c]] for c in rows])
+    vals = np.concatenate([val_buf[c, : per[c]] for c in rows])
+    return idx, vals
+
+
+def _final_complementarity(u, h, p, d, load_control, m, t, p_max, bounded):
+    """Complementarity (m), approach (m) and free-set size for the final ``p`` (fresh mask)."""
+    nc = int(_k.free_mask(p, m, p_max, bounded))
+    if load_control and nc:
+        s1, _, _, _ = _k.gap_moments(u, 1.0, h, m, t, 0.0)
+        d = s1 / nc
+    s1, s2, _, _ = _k.gap_moments(u, 1.0, h, m, t, d)
+    rms = np.sqrt(max(s2, 0.0) / nc) if nc else 0.0
+    pen = _k.worst_violation(p, u, h, d, m, p_max, bounded)
+    return max(rms, pen), d, nc
+
+
+__all__ = ["CONVERGED", "fused_polonsky_keer"]

@@ -1,0 +1,464 @@
+"""Fused element-wise kernels of one Polonsky–Keer CG iteration (numba).
+
+The numpy path of :func:`amontons.contact.cg.polonsky_keer` spends ~40 passes over the grid
+per iteration on masks, axpys, reductions, the projection and the violator search. These
+kernels do the same arithmetic in four sweeps (docs/models.md §2.2 gives the algorithm):
+
+``gap_moments``   moments of the gap on the free set (approach, ``G``, ``Σ g t_old``);
+``direction``     the conjugate direction ``t = g·m + β t`` and ``Σ t``;
+``step_dots``     ``Σ r t`` and ``Σ_Ic r`` after the convolution (and the Winkler term
+                  ``r += t/k``, so a hardening solve needs no extra pass);
+``update``        pressure step, projection onto ``0 <= p <= p_max``, violator search,
+                  free-set update, ``Σ p`` and the displacement axpy ``u -= τ r``, in one
+                  sweep, recording the few changed points for the sparse update.
+
+Arrays are flat float64 (the free set ``m`` is uint8). Sums are taken over fixed chunks of
+``CHUNK`` points and the partial sums added in chunk order, so every result is the same bit
+for bit whatever the number of threads (``threads`` only decides who computes which
+chunk). Kernels are compiled with ``parallel=True`` and cached on disk (``cache=True``):
+the first call in a fresh environment compiles them (a few seconds, benchmarks/README.md),
+later processes load them. The thread count is set per call through
+:func:`numba.set_num_threads` (see :func:`kernel_threads`).
+
+Units: pressures in Pa, lengths in m; ``sigma`` is the dimensionless scale of the stored
+pressure and displacement (true value = ``sigma`` × stored), which lets load control rescale
+the field without a pass (see :mod:`amontons.contact.fused`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+
+import numba
+import numpy as np
+from numba import prange
+
+# Points per chunk of a reduction: fixed, so partial sums (and results) do not depend on the
+# thread count; small enough to balance 2-8 threads from 512² on, large enough that the
+# per-chunk overhead vanishes.
+CHUNK = 16384
+# Changed points (clipped + added) recorded per chunk. The fused solver applies changes as
+# point responses only when there are at most this many in total (.fused.SPARSE_MAX), so a
+# chunk never needs more slots than that.
+SLOTS = 64
+
+# fastmath "reassoc" only: it lets LLVM vectorise the reductions (several partial sums per
+# chunk instead of one serial chain, ~4x faster here); the summation order is then fixed by
+# the compiled code, the same on every call and thread count. No "contract" (FMA) or
+# "nnan": results stay those of plain IEEE products and sums, and NaN propagates.
+_JIT = {"cache": True, "parallel": True, "nogil": True, "fastmath": {"reassoc", "nsz"}}
+
+
+def n_chunks(n: int) -> int:
+    """Number of reduction chunks for ``n`` points."""
+    return (n + CHUNK - 1) // CHUNK
+
+
+@contextlib.contextmanager
+def kernel_threads(threads: int):
+    """Run the kernels on ``threads`` threads (clipped to numba's pool) within the block."""
+    old = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(old)
+
+
+_FM = {"reassoc", "nsz"}
+_INNER = {"cache": True, "fastmath": _FM, "inline": "always"}
+
+
+# Each kernel is a prange over fixed chunks calling an inner loop on the chunk's slices:
+# a loop over a slice's own range vectorises, one over ``range(lo, hi)`` of the whole array
+# did not (measured 5x slower: LLVM cannot prove the indices non-negative).
+
+
+@numba.njit(**_INNER)
+def _moments(u, sigma, h, m, t, shift):
+    s1 = 0.0
+    s2 = 0.0
+    st = 0.0
+    tt = 0.0
+    for i in range(u.size):
+        ti = t[i]
+        tt += ti
+        # branch-free (vectorises): the mask as a 0/1 factor
+        a = (sigma * u[i] - h[i] - shift) * m[i]
+        s1 += a
+        s2 += a * a
+        st += a * ti
+    return s1, s2, st, tt
+
+
+@numba.njit(**_JIT)
+def gap_moments(u, sigma, h, m, t, shift):
+    """Moments of ``a = sigma·u - h - shift`` (m) on the free set ``m``.
+
+    Returns ``(Σ_m a, Σ_m a², Σ_m a·t, Σ t)``. With ``shift`` the previous approach, the
+    approach is ``shift + Σa/nc`` and ``G = Σa² - (Σa)²/nc`` without cancellation (the
+    shift is close to the mean).
+    """
+    n = u.size
+    nch = (n + CHUNK - 1) // CHUNK
+    part = np.zeros((nch, 4))
+    for c in prange(nch):
+        lo = c * CHUNK
+        hi = min(n, lo + CHUNK)
+        s1, s2, st, tt = _moments(u[lo:hi], sigma, h[lo:hi], m[lo:hi], t[lo:hi], shift)
+        part[c, 0] = s1
+        part[c, 1] = s2
+        part[c, 2] = st
+        part[c, 3] = tt
+    out = np.zeros(4)
+    for c in range(nch):
+        for k in range(4):
+            out[k] += part[c, k]
+    return out[0], out[1], out[2], out[3]
+
+
+@numba.njit(**_INNER)
+def _direction_hard(u, sigma, h, m, t, d, beta):
+    """A chunk of ``direction`` under the hard wall: ``(Σ t, violators)``. A constrained
+    point has ``p = 0`` here (points leave the free set only by clipping to 0), so the
+    pressure need not be read."""
+    acc = 0.0
+    k = 0
+    for i in range(u.size):
+        g = sigma * u[i] - h[i] - d
+        v = (g + beta * t[i]) * m[i]
+        t[i] = v
+        acc += v
+        # unloaded and penetrating (branch-free)
+        k += (m[i] == 0) & (g < 0.0)
+    return acc, k
+
+
+@numba.njit(**_INNER)
+def _direction_bounded(u, sigma, h, m, t, d, beta, p, p_max):
+    """A chunk of ``direction`` under ``0 <= p <= p_max``: ``(Σ t, violators)``."""
+    acc = 0.0
+    k = 0
+    for i in range(u.size):
+        g = sigma * u[i] - h[i] - d
+        v = (g + beta * t[i]) * m[i]
+        t[i] = v
+        acc += v
+        q = sigma * p[i]
+        ub = p_max[i]
+        rise = (q <= 0.0) & (g < 0.0) & (q < ub)
+        fall = (q >= ub) & (g > 0.0) & (q > 0.0)
+        k += (m[i] == 0) & (rise | fall)
+    return acc, k
+
+
+@numba.njit(**_JIT)
+def direction(u, sigma, h, m, t, d, beta, p, p_max, bounded, violators):
+    """``t ← m·(sigma·u - h - d) + beta·t`` in place (m); returns ``Σ t``.
+
+    Also counts, per chunk into ``violators``, the constrained points that should be free
+    (the violator test of ``update``, which does not depend on the step: ``t = 0`` there),
+    so ``update`` visits with its scalar loop only the chunks that have one.
+    """
+    n = u.size
+    nch = (n + CHUNK - 1) // CHUNK
+    part = np.zeros(nch)
+    for c in prange(nch):
+        lo = c * CHUNK
+        hi = min(n, lo + CHUNK)
+        uc, hc, mc, tc, pc = u[lo:hi], h[lo:hi], m[lo:hi], t[lo:hi], p[lo:hi]
+        if bounded:
+            acc, k = _direction_bounded(uc, sigma, hc, mc, tc, d, beta, pc, p_max[lo:hi])
+        else:
+            acc, k = _direction_hard(uc, sigma, hc, mc, tc, d, beta)
+        part[c] = acc
+        violators[c] = k
+    total = 0.0
+    for c in range(nch):
+        total += part[c]
+    return total
+
+
+@numba.njit(**_INNER)
+def _dots(r, t, m):
+    rt = 0.0
+    rm = 0.0
+    for i in range(r.size):
+        rt += r[i] * t[i]
+        rm += r[i] * m[i]
+    return rt, rm
+
+
+@numba.njit(**_INNER)
+def _dots_winkler(r, t, m, compliance):
+    rt = 0.0
+    rm = 0.0
+    for i in range(r.size):
+        ri = r[i] + compliance[i] * t[i]
+        r[i] = ri
+        rt += ri * t[i]
+        rm += ri * m[i]
+    return rt, rm
+
+
+@numba.njit(**_JIT)
+def step_dots(r, t, m, compliance, winkler):
+    """After ``r = K*t``: with ``winkler`` add the Winkler term ``r += compliance·t``
+    (compliance m/Pa) in place; return ``(Σ r·t, Σ_m r)``."""
+    n = r.size
+    nch = (n + CHUNK - 1) // CHUNK
+    part = np.zeros((nch, 2))
+    for c in prange(nch):
+        lo = c * CHUNK
+        hi = min(n, lo + CHUNK)
+        if winkler:
+            rt, rm = _dots_winkler(r[lo:hi], t[lo:hi], m[lo:hi], compliance[lo:hi])
+        else:
+            rt, rm = _dots(r[lo:hi], t[lo:hi], m[lo:hi])
+        part[c, 0] = rt
+        part[c, 1] = rm
+    out = np.zeros(2)
+    for c in range(nch):
+        out[0] += part[c, 0]
+        out[1] += part[c, 1]
+    return out[0], out[1]
+
+
+@numba.njit(**_JIT)
+def update(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, idx, val, counts):
+    """One CG step in one sweep (stored fields, true value = ``sigma`` × stored).
+
+    For each point, with the gap ``g = sigma·u - h - d`` (m) of this iteration:
+    free points step to ``p - tau·t`` and are projected onto ``[0, p_max]`` (a clipped
+    point leaves the free set and its direction is zeroed); then a constrained point that
+    should be free (unloaded and penetrating with room to rise, or at ``p_max`` and open)
+    moves by ``-tau·g`` and joins the free set, as in :class:`amontons.contact.cg.HardWall`
+    and :class:`~amontons.contact.cg.BoundedWall`. ``u`` gets ``-tau/sigma·r`` in place.
+
+    ``p_max`` (Pa) has one entry per point when ``bounded`` is 1, else one entry, ignored
+    (no upper bound). Changed points are recorded per chunk in ``idx[c, :]`` (flat index)
+    and ``val[c, :]`` (pressure added on top of the step, Pa), up to ``SLOTS`` per chunk;
+    ``counts[c, 0/1]`` get the number clipped / added in chunk ``c``.
+
+    Each chunk is first checked for clipped points by a vectorised pass (its violators were
+    counted by ``direction`` into ``violators``); the few chunks with an event run the
+    scalar loop that records them, the rest a vectorised step.
+
+    Returns ``(Σ p_new, max |g| over the added points)`` (stored units, m).
+    """
+    n = p.size
+    nch = (n + CHUNK - 1) // CHUNK
+    part = np.zeros((nch, 2))
+    step = tau / sigma
+    for c in prange(nch):
+        lo = c * CHUNK
+        hi = min(n, lo + CHUNK)
+        pc, pnc, uc, rc = p[lo:hi], p_new[lo:hi], u[lo:hi], r[lo:hi]
+        tc, hc, mc = t[lo:hi], h[lo:hi], m[lo:hi]
+        if bounded:
+            ubc = p_max[lo:hi]
+            events = violators[c] or _clips_bounded(pc, tc, mc, ubc, sigma, step)
+        else:
+            ubc = p_max
+            events = violators[c] or _clips_hard(pc, tc, mc, step)
+        if events:
+            acc, pen, nclip, nadd = _chunk_with_events(
+                pc, pnc, uc, rc, tc, hc, mc, ubc, bounded, sigma, d, tau, idx[c], val[c], lo
+            )
+        else:
+            acc = _chunk_step(pc, pnc, uc, rc, tc, step)
+            pen, nclip, nadd = 0.0, 0, 0
+        part[c, 0] = acc
+        part[c, 1] = pen
+        counts[c, 0] = nclip
+        counts[c, 1] = nadd
+    total = 0.0
+    pen = 0.0
+    for c in range(nch):
+        total += part[c, 0]
+        pen = max(pen, part[c, 1])
+    return total, pen
+
+
+@numba.njit(**_INNER)
+def _clips_hard(p, t, m, step):
+    """Free points of a chunk the step drives below 0 (branch-free, vectorises)."""
+    k = 0
+    for i in range(p.size):
+        k += (m[i] != 0) & (p[i] - step * t[i] < 0.0)
+    return k
+
+
+@numba.njit(**_INNER)
+def _clips_bounded(p, t, m, p_max, sigma, step):
+    """Free points of a chunk the step drives out of ``[0, p_max]`` (Pa)."""
+    k = 0
+    for i in range(p.size):
+        q = sigma * (p[i] - step * t[i])
+        k += (m[i] != 0) & ((q < 0.0) | (q > p_max[i]))
+    return k
+
+
+@numba.njit(**_INNER)
+def _chunk_step(p, p_new, u, r, t, step):
+    """Event-free step of a chunk: ``p_new = p - step·t``, ``u -= step·r``; ``Σ p_new``."""
+    acc = 0.0
+    for i in range(p.size):
+        q = p[i] - step * t[i]
+        p_new[i] = q
+        acc += q
+        u[i] -= step * r[i]
+    return acc
+
+
+@numba.njit(cache=True)
+def _chunk_with_events(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, idx, val, lo):
+    """The step of a chunk starting at flat index ``lo``, with its projection and violators
+    recorded (``update``)."""
+    step = tau / sigma
+    acc = 0.0
+    pen = 0.0
+    nclip = 0
+    nadd = 0
+    for i in range(p.size):
+        ub = p_max[i] if bounded else math.inf
+        free = m[i] != 0
+        q = p[i] - step * t[i]
+        pn = sigma * q
+        if free:
+            cval = 0.0
+            if pn < 0.0:
+                cval = -pn
+                pn = 0.0
+                free = False
+            elif pn > ub:
+                cval = ub - pn
+                pn = ub
+                free = False
+            if not free:
+                q = pn / sigma
+                m[i] = 0
+                t[i] = 0.0
+                k = nclip + nadd
+                if k < SLOTS:
+                    idx[k] = lo + i
+                    val[k] = cval
+                nclip += 1
+        if not free:
+            g = sigma * u[i] - h[i] - d
+            rise = pn <= 0.0 and g < 0.0 and pn < ub
+            fall = pn >= ub and g > 0.0 and pn > 0.0
+            if rise or fall:
+                q = (pn - tau * g) / sigma
+                m[i] = 1
+                k = nclip + nadd
+                if k < SLOTS:
+                    idx[k] = lo + i
+                    val[k] = -tau * g
+                nadd += 1
+                pen = max(pen, abs(g))
+        p_new[i] = q
+        acc += q
+        u[i] -= step * r[i]
+    return acc, pen, nclip, nadd
+
+
+@numba.njit(**_INNER)
+def _change(p_new, s_new, p, s_old):
+    a = 0.0
+    b = 0.0
+    for i in range(p.size):
+        q = s_new * p_new[i]
+        a += abs(q - s_old * p[i])
+        b += q
+    return a, b
+
+
+@numba.njit(**_JIT)
+def relative_change(p_new, s_new, p, s_old):
+    """``(Σ|s_new·p_new - s_old·p|, Σ s_new·p_new)``, Pa (stored fields and their scales)."""
+    n = p.size
+    nch = (n + CHUNK - 1) // CHUNK
+    part = np.zeros((nch, 2))
+    for c in prange(nch):
+        lo = c * CHUNK
+        hi = min(n, lo + CHUNK)
+        a, b = _change(p_new[lo:hi], s_new, p[lo:hi], s_old)
+        part[c, 0] = a
+        part[c, 1] = b
+    out = np.zeros(2)
+    for c in range(nch):
+        out[0] += part[c, 0]
+        out[1] += part[c, 1]
+    return out[0], out[1]
+
+
+@numba.njit(**_JIT)
+def free_mask(p, m, p_max, bounded):
+    """``m ← (0 < p < p_max)`` (uint8); returns its size."""
+    n = p.size
+    k = 0
+    for i in prange(n):
+        ub = p_max[i] if bounded else math.inf
+        f = p[i] > 0.0 and p[i] < ub
+        m[i] = 1 if f else 0
+        k += 1 if f else 0
+    return k
+
+
+@numba.njit(**_JIT)
+def worst_violation(p, u, h, d, m, p_max, bounded):
+    """Largest ``|g|`` (m) over constrained points that should be free (``update``'s test),
+    with ``g = u - h - d``; 0 when there are none."""
+    n = p.size
+    pen = 0.0
+    for i in prange(n):
+        ub = p_max[i] if bounded else math.inf
+        g = u[i] - h[i] - d
+        pi = p[i]
+        rise = pi <= 0.0 and g < 0.0 and pi < ub
+        fall = pi >= ub and g > 0.0 and pi > 0.0
+        if m[i] == 0 and (rise or fall):
+            pen = max(pen, abs(g))
+    return pen
+
+
+@numba.njit(**_JIT)
+def add_point_responses(u, green, idx, values):
+    """``u[i, j] += Σ_k values_k · green[(i - a_k) mod N0, (j - b_k) mod N1]`` in place, with
+    ``(a_k, b_k)`` the 2-D position of flat index ``idx[k]`` on ``u``'s grid.
+
+    ``u`` (n0, n1), m; ``green`` (N0, N1) the real-space kernel of the convolution, m/Pa
+    (periodic: N = n; Hockney-padded: N = 2n, the same discrete operator as the FFT path);
+    ``values`` Pa. One sweep over ``u`` whatever the number of points (each row adds every
+    point's kernel row while it is in cache), rows in parallel; each element sums the points
+    in the same order, so the result does not depend on the thread count.
+    """
+    n0, n1 = u.shape
+    big0, big1 = green.shape
+    npts = idx.size
+    for i in prange(n0):
+        row = u[i]
+        for k in range(npts):
+            a = idx[k] // n1
+            b = idx[k] - a * n1
+            v = values[k]
+            g = green[(i - a) % big0]
+            # columns j >= b read g[j - b]; columns j < b wrap to g[big1 - b + j]
+            for j in range(b, n1):
+                row[j] += v * g[j - b]
+            for j in range(b):
+                row[j] += v * g[big1 - b + j]
+
+
+@numba.njit(**_JIT)
+def multiply_spectrum(spec, multiplier):
+    """``spec *= multiplier`` in place (complex half-spectrum times the real kernel spectrum,
+    m/Pa), rows in parallel: the one step of a periodic convolution outside FFTW, which
+    numpy runs on one thread."""
+    for i in prange(spec.shape[0]):
+        row = spec[i]
+        mrow = multiplier[i]
+        for j in range(row.size):
+            row[j] = row[j] * mrow[j]
