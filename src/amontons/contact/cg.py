@@ -35,7 +35,7 @@ with a freshly convolved ``u`` (never the incrementally updated one); the report
 residual is the larger of the two. The outcome's ``status`` is 0 (converged), 1
 (``max_iter`` reached) or 2 (stalled: a periodic displacement-controlled solve reached full
 contact, where the mean pressure is undetermined, or the best residual has not fallen by
-``STALL_FACTOR`` in ``STALL_WINDOW`` iterations, see :class:`StallMonitor`); see
+``STALL_FACTOR`` in ``STALL_WINDOW`` iterations, see :class:`.stall.StallMonitor`); see
 :class:`amontons.contact.ContactResult`.
 
 Cost: ``r = K*t`` is one convolution per iteration. ``u = K*p`` would be a second one, but
@@ -70,6 +70,7 @@ from scipy.linalg.blas import daxpy as _axpy
 
 from . import fft as _fft
 from .result import CONVERGED, ITERATION_CAP, STALLED, ConvergenceError
+from .stall import StallMonitor
 
 _ALIGNED_BACKEND = "pyfftw" if _fft.HAVE_PYFFTW else "numpy"
 
@@ -616,51 +617,3 @@ def _final_complementarity(u, h, p, d, load_control, constraint, m, g, gm, bwork
     ol = constraint.violators(p, g, m)
     pen = float(np.abs(g[ol]).max()) if ol.size else 0.0
     return max(rms, pen), d
-
-
-# --- stall detection ----------------------------------------------------------------------
-
-# A solve has stalled when its best residual has not fallen by STALL_FACTOR in STALL_WINDOW
-# iterations. Conservative by design: over the 3781 convergent CG solves of the test suite
-# and rough periodic, free and plastic solves up to 1024² (rms slope 0.1-1, 1e-4 to 5 % of
-# E* h'), the longest stretch without a 2x fall of the best residual was 26 iterations
-# (without a 10x fall, 36); 200 is 8x that, and a fifth of the smallest default max_iter.
-STALL_WINDOW = 200
-STALL_FACTOR = 2.0
-
-
-class StallMonitor:
-    """Watches the residual history of one solve and says when it has stopped falling.
-
-    Keeps the best residual so far and the best at the start of the current stretch (the
-    mark); a fall of the best to ``mark / factor`` starts a new stretch. Stalled: a stretch
-    of ``window`` iterations. (This fires no earlier than the sliding-window test "best now
-    > best ``window`` iterations ago / factor", which it implies.) Residuals are
-    dimensionless; inf and NaN never count as a fall.
-    """
-
-    def __init__(self, window: int = STALL_WINDOW, factor: float = STALL_FACTOR):
-        self.window = window
-        self.factor = factor
-        self.best = np.inf
-        self.mark = np.inf
-        self.stretch = 0
-
-    def update(self, residual: float) -> bool:
-        """Record one iteration's residual; True once the solve has stalled."""
-        if residual < self.best:
-            self.best = residual
-        if self.best * self.factor < self.mark:  # also the first finite residual
-            self.mark = self.best
-            self.stretch = 0
-        else:
-            self.stretch += 1
-        return self.stretch >= self.window
-
-    def message(self) -> str:
-        """Why the solve stopped, with the numbers of the criterion."""
-        return (
-            f"the residual stalled: its best value {self.best:.3e} has not fallen by "
-            f"{self.factor:g}x in {self.window} iterations (below the floor that round-off or "
-            "the problem allows; a larger tol converges)"
-        )

@@ -27,6 +27,7 @@ import numpy as np
 from . import fft as _fft
 from . import kernels as _k
 from .result import CONVERGED, STALLED, ConvergenceError
+from .stall import StallMonitor
 
 # Most changed points (clipped + added) applied to u as point responses instead of a full
 # convolution. One point costs a sweep of the real-space kernel (kernels.add_point_responses,
@@ -185,7 +186,11 @@ def _loop(
             SPARSE_MAX_PERIODIC if getattr(base_op, "periodic", False) else SPARSE_MAX_PADDED
         )
     green = None
+    monitor = StallMonitor()  # as in cg.polonsky_keer
     while it < max_iter:
+        if history and monitor.update(history[-1]):
+            stalled = monitor.message()
+            break
         it += 1
         if singular_full and nc == n:
             stalled = (
@@ -235,14 +240,26 @@ def _loop(
         if load_control:
             rt -= rm / nc * tsum
         if not (rt > 0 and np.isfinite(rt)):
-            if big_g == 0.0:
-                residual = 0.0
-                history.append(0.0)
+            # no descent direction (cg.polonsky_keer says when): the solution if the gap on
+            # the free set is below tol and nothing penetrates off it, judged on a freshly
+            # convolved u; penetrating points join the free set at p = 0 and the next
+            # (steepest-descent) iteration moves them
+            g = sigma * u - h - d
+            ol = constraint.violators(sigma * p, g, m.astype(np.float64))
+            pen = float(np.abs(g[ol]).max()) if ol.size else 0.0
+            residual = max(np.sqrt(big_g / nc), pen) / h_scale
+            history.append(residual)
+            if residual < tol and since_fresh:
+                conv(p, u)
+                since_fresh = 0
+                continue
+            if residual < tol:
                 converged = True
                 break
+            m[ol] = 1
+            nc += int(ol.size)
             delta = 0.0
             g_old = 0.0
-            history.append(residual)
             continue
         tau = g_dot_t / rt
         rms_ok = np.sqrt(big_g / max(nc, 1)) / h_scale < tol

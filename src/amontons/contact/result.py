@@ -190,7 +190,7 @@ class ContactResult:
     * ``1`` iteration cap reached: ``max_iter`` conjugate-gradient iterations, or
       ``max_outer`` plastic updates / active-set rounds, without convergence;
     * ``2`` stalled: stopped for another reason, e.g. the residual stopped falling (its best
-      value did not halve in 200 iterations, :class:`amontons.contact.cg.StallMonitor`), a
+      value did not halve in 200 iterations, :class:`amontons.contact.stall.StallMonitor`), a
       periodic displacement-controlled solve reached full contact (the mean pressure is
       then undetermined) or the load control of a plastic solve found no approach that
       carries the load.
