@@ -106,8 +106,13 @@ def main() -> None:
                     continue
                 points = fft_points(int(solve["side_px"]), solve["geometry"] == "flat_periodic")
                 grid_rows.append(
-                    {"rule": rule, **solve, "points": points, "s": float(last["s"]),
-                     "max_rss": float(last["max_rss"])}
+                    {
+                        "rule": rule,
+                        **solve,
+                        "points": points,
+                        "s": float(last["s"]),
+                        "max_rss": float(last["max_rss"]),
+                    }
                 )
     grid = pd.DataFrame(grid_rows)
     record = {
