@@ -28,6 +28,7 @@ include: "workflow/rules/friction.smk"
 include: "workflow/rules/surface.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/study.smk"
+include: "workflow/rules/accuracy.smk"
 
 
 # Default target: every output of every selected material.

@@ -79,7 +79,9 @@ def test_misspelled_key_is_named_with_the_allowed_keys(repo, config_schema):
 def test_unknown_top_level_key(repo, config_schema):
     config = _config(repo)
     config["virtual_experment"] = {}
-    with pytest.raises(ConfigError, match="'virtual_experment'.*allowed keys: friction, load_area"):
+    with pytest.raises(
+        ConfigError, match="'virtual_experment'.*allowed keys: accuracy, friction, load_area"
+    ):
         validate(config, config_schema, "my.yaml")
 
 
@@ -374,4 +376,45 @@ def test_bad_scans_and_study_pairs_stop_before_any_job(
     config = _config(repo, "test.yaml")
     edit(config)
     with pytest.raises(ConfigError, match=expected):
+        load_workflow_config(config, config_schema, sheet_schema, "my.yaml")
+
+
+def test_scenes_take_their_preset_where_they_give_no_solver_key(
+    repo, config_schema, sheet_schema, monkeypatch
+):
+    """docs/accuracy.md, "Presets": a scene's own key wins, then its preset, then
+    solver_preset; the small data set runs draft."""
+    monkeypatch.chdir(repo)
+    config = _config(repo, "test.yaml")
+    config["scenes"]["hardening"]["preset"] = "publication"
+    config["scenes"]["elastic"]["tol"] = 1e-9
+    load_workflow_config(config, config_schema, sheet_schema, "my.yaml")
+    presets = config["solver_presets"]
+    assert config["solver_preset"] == "draft"
+    hardening, elastic = config["scenes"]["hardening"], config["scenes"]["elastic"]
+    assert {k: hardening[k] for k in presets["publication"]} == presets["publication"]
+    assert elastic["tol"] == 1e-9
+    assert elastic["pixel_nm"] == presets["draft"]["pixel_nm"]
+    assert elastic["preset"] == "draft"
+
+
+def test_an_unknown_preset_is_refused_naming_the_scene(
+    repo, config_schema, sheet_schema, monkeypatch
+):
+    monkeypatch.chdir(repo)
+    config = _config(repo)
+    config["scenes"]["elastic"]["preset"] = "fastest"
+    with pytest.raises(
+        ConfigError, match=r"scene elastic: preset 'fastest' is not in solver_presets"
+    ):
+        load_workflow_config(config, config_schema, sheet_schema, "my.yaml")
+
+
+def test_the_accuracy_sphere_must_be_selected(repo, config_schema, sheet_schema, monkeypatch):
+    monkeypatch.chdir(repo)
+    config = _config(repo, "test.yaml")
+    config["accuracy"]["sphere"] = "PTFE"
+    with pytest.raises(
+        ConfigError, match=r"accuracy.sphere = 'PTFE' is not a sphere of the selected"
+    ):
         load_workflow_config(config, config_schema, sheet_schema, "my.yaml")

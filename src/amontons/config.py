@@ -102,7 +102,7 @@ _BOOLEAN_WORDS = {"true": True, "false": False, "yes": True, "no": False, "1": T
 # second rule of that name (each material gets its own target, `snakemake PS`).
 RESERVED_NAMES = frozenset(
     {"all", "optics", "surface", "friction", "fits", "figures", "virtual_experiment", "scenes"}
-    | {"scans", "study"}
+    | {"scans", "study", "accuracy"}
     | {"synthetic"}  # the folder of the synthetic scenes, results/<run>/synthetic/
 )
 
@@ -236,6 +236,7 @@ def load_workflow_config(
     """Validate a config mapping and its sample sheet; return the sheet records (sphere id →
     record) of the selected materials."""
     validate(config, config_schema, source)
+    resolve_scene_presets(config, source)
     sheet = read_sample_sheet(config["materials_sheet"], sheet_schema)
     check_selected_materials(config["materials"], sheet, source)
     selected = {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
@@ -243,6 +244,7 @@ def load_workflow_config(
     check_scenes(config, selected, source)
     check_scans(config, selected, source)
     check_curvature_pairs(config, source)
+    check_accuracy_study(config, sheet, source)
     return selected
 
 
@@ -352,6 +354,27 @@ def _check_one_scene(name: str, scene: Mapping, spheres: Mapping[str, dict], sou
     if not synthetic:
         _check_scene_window(name, scene, spheres, source)
         _check_scene_parameters(name, scene, spheres, source)
+
+
+PRESET_KEYS = ("pixel_nm", "max_side_px", "window_factor", "tol")
+
+
+def resolve_scene_presets(config: dict, source: str) -> None:
+    """Fill each scene's solver keys (PRESET_KEYS) that it does not give from its preset: its
+    own ``preset`` or the config's ``solver_preset`` (docs/accuracy.md, "Presets"). Explicit
+    keys win. Resolved in place, so every rule sees the same resolved scene."""
+    presets = config["solver_presets"]
+    for name, scene in config["scenes"].items():
+        preset = scene.get("preset") or config["solver_preset"]
+        if preset not in presets:
+            raise ConfigError(
+                f"{source}: scene {name}: preset {preset!r} is not in solver_presets; expected "
+                f"one of {', '.join(presets)}"
+            )
+        for key in PRESET_KEYS:
+            if scene.get(key) is None:
+                scene[key] = presets[preset][key]
+        scene["preset"] = preset
 
 
 def check_scenes(config: Mapping, spheres: Mapping[str, dict], source: str) -> None:
@@ -473,3 +496,22 @@ def read_config(base: str | Path, *overlays: str | Path) -> dict:
         with open(overlay, encoding="utf-8") as stream:
             config = merge_config(config, yaml.safe_load(stream) or {})
     return config
+
+
+def check_accuracy_study(config: Mapping, sheet: Mapping[str, dict], source: str) -> None:
+    """The accuracy study's sphere must be a sphere of a selected material, and its grid and
+    reference must make sense (amontons.accuracy.settings.check_accuracy)."""
+    from amontons.accuracy.settings import AccuracyConfigError, check_accuracy
+
+    study = config["accuracy"]
+    record = sheet.get(study["sphere"])
+    if record is None or record["material"] not in config["materials"]:
+        raise ConfigError(
+            f"{source}: accuracy.sphere = {study['sphere']!r} is not a sphere of the selected "
+            f"materials {list(config['materials'])}; expected one of "
+            f"{', '.join(s for s, r in sheet.items() if r['material'] in config['materials'])}"
+        )
+    try:
+        check_accuracy(study, source)
+    except AccuracyConfigError as error:
+        raise ConfigError(str(error)) from error

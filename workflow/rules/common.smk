@@ -1,6 +1,7 @@
 # Helpers shared by the workflow files: validated config, the sample sheet and path lookups.
 # They import only amontons.config and amontons.io.layout (no numerical stack), so that
 # building the DAG stays fast.
+import json
 import os
 
 from amontons.config import load_schema, load_workflow_config
@@ -555,7 +556,13 @@ def study_overview_outputs():
 # and for the solves a model in their FFT grid and loads (amontons.resources), from
 # workflow/resources.json (benchmarks/fit_job_resources.py).
 from amontons.config import solver_side_px
-from amontons.resources import JobResources, fft_points
+from amontons.accuracy.timing import predict
+from amontons.resources import JobResources, mem_mb_of, runtime_min
+
+# The accuracy study's timing model (workflow/timing_model.json, a copy of
+# results/full/accuracy/timing_model.json): what a solve costs, from its grid and tolerance.
+with open(os.path.join(workflow.basedir, "workflow", "timing_model.json")) as _stream:
+    TIMING_MODEL = json.load(_stream)
 
 RESOURCES = JobResources.from_file(
     os.path.join(workflow.basedir, "workflow", "resources.json")
@@ -571,7 +578,8 @@ def measured_mem_mb(rule):
 
 
 def solve_size(scene, sphere=None):
-    """(model, FFT grid points, loads) of a scene's solve on ``sphere`` (None: synthetic)."""
+    """(model, solver grid side px, periodic, loads, tol) of a scene's solve on ``sphere``
+    (None: synthetic)."""
     spec = config["scenes"][scene]
     if sphere is None:
         synthetic = spec["synthetic"]
@@ -582,16 +590,22 @@ def solve_size(scene, sphere=None):
         diameter, e_star = row["diameter_mm"], row["e_star_gpa"]
         loads = row["loads"] if spec["loads"] == "measured" else spec["loads"]
     side = solver_side_px(spec, diameter, e_star, loads)
-    points = fft_points(side, spec["geometry"] == "flat_periodic")
-    return spec["model"], points, len(loads)
+    periodic = spec["geometry"] == "flat_periodic"
+    return spec["model"], side, periodic, len(loads), spec["tol"]
+
+
+def predicted_solve(scene_of, wildcards):
+    """(wall time s, peak memory MB) the timing model predicts for a scene's solve."""
+    model, side, periodic, loads, tol = solve_size(*scene_of(wildcards))
+    return predict(TIMING_MODEL, model, side_px=side, periodic=periodic, loads=loads, tol=tol)
 
 
 def solve_runtime(rule, scene_of):
-    """Runtime (min) of a solve job: ``scene_of(wildcards)`` gives (scene, sphere or None)."""
+    """Runtime (min) of a solve job: ``scene_of(wildcards)`` gives (scene, sphere or None);
+    the timing model's prediction (docs/accuracy.md) with the resources' safety factor."""
 
     def runtime(wildcards):
-        model, points, loads = solve_size(*scene_of(wildcards))
-        return RESOURCES.grid_runtime_min(rule, model, points, loads)
+        return runtime_min(predicted_solve(scene_of, wildcards)[0])
 
     return runtime
 
@@ -600,7 +614,24 @@ def solve_mem_mb(rule, scene_of):
     """Memory (MB) of a solve job, as :func:`solve_runtime`."""
 
     def mem_mb(wildcards):
-        model, points, _ = solve_size(*scene_of(wildcards))
-        return RESOURCES.grid_mem_mb(rule, model, points)
+        return mem_mb_of(predicted_solve(scene_of, wildcards)[1])
 
     return mem_mb
+
+
+# The accuracy study (docs/accuracy.md): its problems and settings by name.
+from amontons.accuracy.settings import problem_kind, settings_by_name
+
+
+def accuracy_geometry(problem):
+    return problem_kind(problem)[1]
+
+
+def accuracy_files(name):
+    """``name`` of every problem at every setting (the reference included)."""
+    study = config["accuracy"]
+    return [
+        f"{RESULTS}/accuracy/{problem}/{setting}/{name}"
+        for problem in study["problems"]
+        for setting in settings_by_name(problem, study)
+    ]

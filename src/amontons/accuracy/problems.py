@@ -1,0 +1,138 @@
+"""The accuracy study's problems on the grid of one setting (docs/accuracy.md, "Problems").
+
+Every setting of a problem sees the same surface: the rough spheres are one virtual sphere's
+levelled AFM map, area-averaged onto each setting's grid about the fitted apex (as a scene
+does, :func:`amontons.simulate.surface.afm_indenter`); the periodic surface is synthesised
+once at the finest pixel and block-averaged to coarser ones (each coarse pixel holds the mean
+of the fine pixels it covers). So a coarser setting differs from the reference only by what
+its pixel, window, tolerance and start do to the solve.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from amontons.accuracy.settings import Setting, problem_kind
+from amontons.contact import ContactResult, solve_load_series
+from amontons.contact.surfaces import self_affine
+from amontons.simulate.scene import Scene, scene_for_sphere
+from amontons.simulate.surface import LevelledMap, afm_indenter
+
+# the sphere's whole load series on one grid: no cap on the window's pixels
+UNCAPPED_SIDE_PX = 1 << 20
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One problem at one setting: heights (m, rigid indenter, larger = closer), pixel (m),
+    E* (Pa), loads (N), periodic, the plasticity law (None: elastic), the window side (m) and
+    the finest pixel of the study (m)."""
+
+    heights: np.ndarray
+    pixel_m: float
+    e_star_pa: float
+    loads_n: tuple[float, ...]
+    periodic: bool
+    plasticity: object
+    window_m: float
+    finest_pixel_m: float
+
+
+def sphere_scene(problem: str, setting: Setting, levelled: LevelledMap, record: Mapping) -> Scene:
+    """The scene of a rough-sphere problem at ``setting``: the sphere's measured loads, its
+    sheet E* and k, the pixel ``pixel_factor`` × the AFM map's."""
+    model, _ = problem_kind(problem)
+    config = {
+        "surface": "afm_before",
+        "geometry": "sphere",
+        "model": model,
+        "loads": "measured",
+        "pixel_nm": setting.pixel_factor * levelled.pixel_m * 1e9,
+        "window_factor": setting.window_factor,
+        "side_px": None,
+        "max_side_px": UNCAPPED_SIDE_PX,
+        "tol": setting.tol,
+        "optics": "none",
+        "rendering": "emission",
+        "p_y_mpa": None,
+        "k_mpa_per_nm": None,
+    }
+    return scene_for_sphere(f"accuracy:{problem}", config, record["sphere"], record)
+
+
+def sphere_problem(problem: str, setting: Setting, levelled: LevelledMap, record, source: str):
+    """The rough sphere at ``setting`` (its AFM map on the setting's grid)."""
+    scene = sphere_scene(problem, setting, levelled, record)
+    indenter = afm_indenter(levelled, scene, source)
+    return Problem(
+        heights=indenter.heights,
+        pixel_m=scene.pixel_m,
+        e_star_pa=scene.e_star_pa,
+        loads_n=scene.loads_n,
+        periodic=False,
+        plasticity=scene.plasticity,
+        window_m=scene.side_px * scene.pixel_m,
+        finest_pixel_m=levelled.pixel_m,
+    )
+
+
+def periodic_surface(spec: Mapping) -> tuple[np.ndarray, float]:
+    """The periodic self-affine surface at the finest pixel (heights m, pixel m)."""
+    pixel_m = spec["pixel_nm"] * 1e-9
+    n = int(round(spec["side_um"] * 1e-6 / pixel_m))
+    heights = self_affine(
+        (n, n),
+        pixel_m,
+        spec["hurst"],
+        rms_height=spec["rms_height_nm"] * 1e-9,
+        short_cutoff=spec["short_cutoff_um"] * 1e-6,
+        long_cutoff=spec["long_cutoff_um"] * 1e-6,
+        rng=spec["seed"],
+    )
+    return heights, pixel_m
+
+
+def block_average(heights: np.ndarray, factor: int) -> np.ndarray:
+    """Mean over ``factor`` × ``factor`` blocks (the side must be a multiple of it)."""
+    n0, n1 = heights.shape
+    if n0 % factor or n1 % factor:
+        raise ValueError(f"a {n0} × {n1} grid has no whole {factor} × {factor} blocks")
+    return heights.reshape(n0 // factor, factor, n1 // factor, factor).mean(axis=(1, 3))
+
+
+def periodic_problem(setting: Setting, spec: Mapping) -> Problem:
+    """The periodic surface at ``setting``, elastic, at the spec's loads."""
+    fine, fine_pixel = periodic_surface(spec)
+    heights = block_average(fine, setting.pixel_factor)
+    return Problem(
+        heights=heights - heights.max(),
+        pixel_m=fine_pixel * setting.pixel_factor,
+        e_star_pa=spec["e_star_gpa"] * 1e9,
+        loads_n=tuple(f * 1e-3 for f in spec["loads_mn"]),
+        periodic=True,
+        plasticity=None,
+        window_m=fine.shape[0] * fine_pixel,
+        finest_pixel_m=fine_pixel,
+    )
+
+
+def solve_problem(problem: Problem, setting: Setting) -> tuple[list[ContactResult], float]:
+    """The load series at ``setting`` and its wall time (s): one thread, as a scene job."""
+    start = time.perf_counter()
+    with threadpool_limits(limits=1):
+        results = solve_load_series(
+            problem.heights,
+            problem.pixel_m,
+            problem.e_star_pa,
+            list(problem.loads_n),
+            periodic=problem.periodic,
+            tol=setting.tol,
+            plasticity=problem.plasticity,
+            coarse_to_fine=setting.coarse_to_fine,
+        )
+    return results, time.perf_counter() - start

@@ -1,0 +1,127 @@
+# What accuracy costs in time (docs/accuracy.md): the same problems solved at every setting of
+# the grid in config `accuracy`, each setting a job of its own, compared with a converged
+# reference; the table, the error-versus-time figure with its Pareto fronts, the presets the
+# fronts propose, and the timing model. Target: `snakemake accuracy`.
+ACCURACY = f"{RESULTS}/accuracy"
+ACCURACY_LOGS = f"{LOGS}/accuracy"
+ACCURACY_SPHERE = config["accuracy"]["sphere"]
+
+
+def accuracy_sphere_inputs(wildcards):
+    """The AFM map a rough-sphere problem presses and the PSF every problem is rendered with."""
+    sphere = ACCURACY_SPHERE
+    material = sphere_row(sphere)["material"]
+    inputs = {"psf": measured(material, sphere, "psf.json")}
+    if accuracy_geometry(wildcards.problem) == "sphere":
+        inputs["levelled"] = measured(material, sphere, "afm_before_levelled.h5")
+    return inputs
+
+
+rule solve_accuracy_setting:
+    input:
+        unpack(accuracy_sphere_inputs),
+    output:
+        summary=f"{ACCURACY}/{{problem}}/{{setting}}/summary.json",
+        fields=f"{ACCURACY}/{{problem}}/{{setting}}/pressure.h5",
+    log:
+        f"{ACCURACY_LOGS}/{{problem}}/{{setting}}/solve_accuracy_setting.log",
+    benchmark:
+        f"{ACCURACY_LOGS}/{{problem}}/{{setting}}/solve_accuracy_setting.benchmark.tsv"
+    wildcard_constraints:
+        problem=names_pattern(config["accuracy"]["problems"]),
+        setting=r"reference|px[0-9]+_tol[0-9e.+-]+(_w[0-9.]+)?_c2f[01]",
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=measured_mem_mb("solve_accuracy_setting"),
+        runtime=measured_runtime("solve_accuracy_setting"),
+    params:
+        # what a solve needs of the study (not the preset budgets: a new budget re-runs no solve)
+        study=lambda wc: sorted_keys(
+            {k: config["accuracy"][k] for k in ("grid", "reference", "periodic")}
+        ),
+        record=lambda wc: {**scene_sphere_record(ACCURACY_SPHERE), "sphere": ACCURACY_SPHERE},
+        fluorescence_pixel_nm=pixel_nm(ACCURACY_SPHERE),
+        otsu=otsu_settings(),
+    script:
+        "../../scripts/solve_accuracy_setting.py"
+
+
+rule tabulate_accuracy:
+    input:
+        summaries=accuracy_files("summary.json"),
+        fields=accuracy_files("pressure.h5"),
+    output:
+        table=f"{ACCURACY}/accuracy.csv",
+        presets=f"{ACCURACY}/presets.json",
+    log:
+        f"{ACCURACY_LOGS}/tabulate_accuracy.log",
+    benchmark:
+        f"{ACCURACY_LOGS}/tabulate_accuracy.benchmark.tsv"
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=measured_mem_mb("tabulate_accuracy"),
+        runtime=measured_runtime("tabulate_accuracy"),
+    params:
+        budgets=config["accuracy"]["preset_budgets"],
+        preset_problems=[p for p in config["accuracy"]["problems"] if p.endswith("_sphere")],
+    script:
+        "../../scripts/tabulate_accuracy.py"
+
+
+rule plot_accuracy:
+    input:
+        table=f"{ACCURACY}/accuracy.csv",
+    output:
+        png=report(
+            f"{ACCURACY}/accuracy.png",
+            caption="../report/accuracy.rst",
+            category="Accuracy",
+        ),
+        pdf=f"{ACCURACY}/accuracy.pdf",
+    log:
+        f"{ACCURACY_LOGS}/plot_accuracy.log",
+    benchmark:
+        f"{ACCURACY_LOGS}/plot_accuracy.benchmark.tsv"
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=measured_mem_mb("plot_accuracy"),
+        runtime=measured_runtime("plot_accuracy"),
+    params:
+        sphere=ACCURACY_SPHERE,
+        data_label=data_label([ACCURACY_SPHERE]),
+    script:
+        "../../scripts/plot_accuracy.py"
+
+
+rule fit_timing_model:
+    input:
+        summaries=accuracy_files("summary.json"),
+    output:
+        model=f"{ACCURACY}/timing_model.json",
+    log:
+        f"{ACCURACY_LOGS}/fit_timing_model.log",
+    benchmark:
+        f"{ACCURACY_LOGS}/fit_timing_model.benchmark.tsv"
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=measured_mem_mb("fit_timing_model"),
+        runtime=measured_runtime("fit_timing_model"),
+    script:
+        "../../scripts/fit_timing_model.py"
+
+
+rule accuracy:
+    input:
+        f"{ACCURACY}/accuracy.csv",
+        f"{ACCURACY}/presets.json",
+        f"{ACCURACY}/accuracy.png",
+        f"{ACCURACY}/timing_model.json",
+    localrule: True
