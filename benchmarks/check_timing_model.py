@@ -72,9 +72,8 @@ def main() -> None:
     jobs["ratio"] = jobs["predicted_s"] / jobs["measured_s"]
     within = (jobs["ratio"] >= 0.5) & (jobs["ratio"] <= 2.0)
     print(f"timing model {args.model} on run {args.run}: {len(jobs)} solver jobs")
-    print(
-        f"{'kind':6s} {'model':22s} {'jobs':>5s} {'median':>7s} {'min':>6s} {'max':>6s} {'in 2x':>6s}"
-    )
+    header = ("kind", "model", "jobs", "median", "min", "max", "in 2x")
+    print("{:6s} {:22s} {:>5s} {:>7s} {:>6s} {:>6s} {:>6s}".format(*header))
     for (kind, model), group in jobs.groupby(["kind", "model"]):
         ok = within[group.index]
         print(

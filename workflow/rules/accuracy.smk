@@ -41,7 +41,10 @@ rule solve_accuracy_setting:
         study=lambda wc: sorted_keys(
             {k: config["accuracy"][k] for k in ("grid", "reference", "periodic")}
         ),
-        record=lambda wc: {**scene_sphere_record(ACCURACY_SPHERE), "sphere": ACCURACY_SPHERE},
+        record=lambda wc: {
+            **scene_sphere_record(ACCURACY_SPHERE),
+            "sphere": ACCURACY_SPHERE,
+        },
         fluorescence_pixel_nm=pixel_nm(ACCURACY_SPHERE),
         otsu=otsu_settings(),
     script:
@@ -67,7 +70,9 @@ rule tabulate_accuracy:
         runtime=measured_runtime("tabulate_accuracy"),
     params:
         budgets=config["accuracy"]["preset_budgets"],
-        preset_problems=[p for p in config["accuracy"]["problems"] if p.endswith("_sphere")],
+        preset_problems=[
+            p for p in config["accuracy"]["problems"] if p.endswith("_sphere")
+        ],
     script:
         "../../scripts/tabulate_accuracy.py"
 

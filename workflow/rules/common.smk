@@ -597,12 +597,15 @@ def solve_size(scene, sphere=None):
 def predicted_solve(scene_of, wildcards):
     """(wall time s, peak memory MB) the timing model predicts for a scene's solve."""
     model, side, periodic, loads, tol = solve_size(*scene_of(wildcards))
-    return predict(TIMING_MODEL, model, side_px=side, periodic=periodic, loads=loads, tol=tol)
+    return predict(
+        TIMING_MODEL, model, side_px=side, periodic=periodic, loads=loads, tol=tol
+    )
 
 
 def solve_runtime(rule, scene_of):
     """Runtime (min) of a solve job: ``scene_of(wildcards)`` gives (scene, sphere or None);
-    the timing model's prediction (docs/accuracy.md) with the resources' safety factor."""
+    the timing model's prediction (docs/accuracy.md) with the resources' safety factor.
+    """
 
     def runtime(wildcards):
         return runtime_min(predicted_solve(scene_of, wildcards)[0])
