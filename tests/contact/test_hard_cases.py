@@ -51,15 +51,17 @@ def assert_sound(res, load=None, p_y=None):
 
     * finite pressure, gap and displacements;
     * force balance: A0 Σp equals the imposed load to 1e-10 relative for an elastic solve
-      (load control rescales p exactly), to tol for a plastic one (its root find on the
-      approach stops there), or to one pixel at p_Y where the load is a staircase of the
-      approach (a fully plastic contact; docs/models.md §2.3);
+      and the bounded route of penetration hardness (load control rescales p exactly), to
+      tol for the other plastic routes (their root find on the approach stops there), or
+      to one pixel at p_Y where the load is a staircase of the approach (a fully plastic
+      contact; docs/models.md §2.3);
     * no penetration off the contact set: gap >= -SLACK·tol·h_rms where p = 0;
     * complementarity: Σ|g|·p <= SLACK·tol·h_rms·sqrt(n_c Σp²), which is what the rms-gap
       criterion on the contact set gives by Cauchy–Schwarz (n_c contact pixels);
     * bound 0 <= p <= p_Y (to 1e-12 relative, the bound is applied by clipping);
-    * converged, within its caps (iterations <= max_iter for an elastic solve, outer rounds
-      <= max_outer for a plastic one).
+    * converged, within its caps (iterations <= max_iter for an elastic solve or the
+      one bounded solve of penetration hardness, outer rounds <= max_outer for the other
+      plastic routes).
     """
     heights = res.deformed_heights
     h_rms = float(np.std(res.heights)) or res.spacing
@@ -67,15 +69,20 @@ def assert_sound(res, load=None, p_y=None):
         assert np.isfinite(getattr(res, name)).all(), name
     assert np.isfinite(res.displacement)
     assert res.success and res.status == 0, res.message
-    if res.info.route == "elastic":
+    if res.info.route in ("elastic", "bounded"):
+        # one CG solve; the bounded route's one solve-and-update is its only outer round
         assert res.iterations <= res.info.max_iter
+        assert res.info.outer_iterations == (res.info.route == "bounded")
     else:
         assert res.info.outer_iterations <= res.info.max_outer
     p = res.pressure
-    if load is not None:
-        rel = 1e-10 if res.info.route == "elastic" else TOL
+    if load is not None and res.info.route in ("elastic", "bounded"):
+        # load control imposes the load on the field itself (a rescale, of the free points
+        # on the bounded route): exact to round-off
+        assert abs(p.sum() * res.spacing**2 - load) <= 1e-10 * load
+    elif load is not None:
         pixel = 0.0 if p_y is None else float(np.max(p_y)) * res.spacing**2
-        assert abs(p.sum() * res.spacing**2 - load) <= max(rel * load, pixel)
+        assert abs(p.sum() * res.spacing**2 - load) <= max(TOL * load, pixel)
     assert p.min() >= 0
     if p_y is not None:
         assert (p <= np.asarray(p_y) * (1 + 1e-12)).all()

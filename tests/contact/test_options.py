@@ -49,7 +49,9 @@ def no_ignored_option_warnings():
 @pytest.mark.parametrize("law", [None, ContactHardening(K_PMMA)])
 def test_unknown_method_is_an_input_error_naming_the_allowed_values(law):
     h, dx = rough_sphere(32)
-    with pytest.raises(ContactInputError, match=r"'winkler', 'appendix'.*got 'iterative'"):
+    with pytest.raises(
+        ContactInputError, match=r"'winkler', 'bounded', 'appendix'.*got 'iterative'"
+    ):
         solve(h, dx, E_PMMA, load=1e-5, plasticity=law, method="iterative")
 
 
@@ -62,6 +64,38 @@ def test_winkler_method_is_refused_where_it_does_not_apply(law):
     h, dx = rough_sphere(32)
     with pytest.raises(ContactInputError, match="method='winkler'"):
         solve(h, dx, E_PMMA, load=1e-5, plasticity=law, method="winkler")
+
+
+@pytest.mark.parametrize(
+    "law",
+    [
+        ContactHardening(K_PMMA),
+        PenetrationHardness(50e6, increment="volume", alpha=0.5),
+    ],
+    ids=["contact-hardening", "volume-increments"],
+)
+def test_bounded_method_is_refused_where_it_does_not_apply(law):
+    """The one-solve route is exact for penetration hardness with local increments only:
+    pile-up (eq. B.3) moves points that did not yield, and contact hardening's bound grows
+    with the flow."""
+    h, dx = rough_sphere(32)
+    with pytest.raises(ContactInputError, match="method='bounded'"):
+        solve(h, dx, E_PMMA, load=1e-5, plasticity=law, method="bounded")
+
+
+def test_default_method_is_bounded_for_local_penetration_hardness():
+    """method=None and method="bounded" are the same solve, bit for bit; max_outer has no
+    loop to cap there, so it is ignored with a warning and reported as None."""
+    h, dx = rough_sphere(32)
+    law = PenetrationHardness(50e6)
+    default = solve(h, dx, E_PMMA, load=1e-5, plasticity=law)
+    explicit = solve(h, dx, E_PMMA, load=1e-5, plasticity=law, method="bounded")
+    assert default.info.route == explicit.info.route == "bounded"
+    np.testing.assert_array_equal(default.pressure, explicit.pressure)
+    assert default.info.max_outer is None and default.info.outer_iterations == 1
+    with pytest.warns(IgnoredOptionWarning, match="max_outer=3 is ignored.*'bounded'"):
+        capped = solve(h, dx, E_PMMA, load=1e-5, plasticity=law, max_outer=3)
+    assert capped.info.max_outer is None
 
 
 def test_appendix_method_for_contact_hardening_needs_alpha_below_one():

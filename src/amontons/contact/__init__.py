@@ -46,16 +46,17 @@ Status codes (``ContactResult.status``, ``ConvergenceError.status``)
     converged solution (a non-converged iterate's edge pressure is not checked).
 
 Diagnostics (``ContactResult.info``: :class:`SolveInfo`, frozen, the same fields on every route)
-    ``route`` ("elastic", "winkler" or "appendix"), ``convolutions``,
+    ``route`` ("elastic", "winkler", "bounded" or "appendix"), ``convolutions``,
     ``steepest_descent_resets``, ``outer_iterations`` (0 for elastic solves),
     ``coarse_levels`` (tuple of :class:`CoarseLevel`), ``plasticity``, ``backend``,
     ``threads``, ``planner_effort``, ``tol``, ``max_iter``, ``max_outer`` (None for elastic
-    solves), ``wall_time_s`` (s).
+    solves and the "bounded" route), ``wall_time_s`` (s).
 
 Options
     ``method``: route of a plastic solve, ``"winkler"`` (contact hardening with local
-    increments, exact elastic-plus-Winkler; the default there) or ``"appendix"`` (the
-    appendix's iterative scheme; the only route for penetration hardness and
+    increments, exact elastic-plus-Winkler; the default there), ``"bounded"`` (penetration
+    hardness with local increments, one bounded CG under the force constraint; the default
+    there) or ``"appendix"`` (the appendix's iterative scheme; the only route for
     volume-conserving increments); None picks the default. ``planner_effort``: FFTW
     planner effort; None (default) is ``"FFTW_ESTIMATE"`` on one thread (deterministic: the
     same bytes in every run) and ``"FFTW_MEASURE"`` with ``threads > 1`` (plans that use
@@ -64,7 +65,8 @@ Options
 
 Warnings
     :class:`IgnoredOptionWarning` (a ``UserWarning``), once per call, for an option given
-    to a solve that has no effect on it: ``method`` or ``max_outer`` on an elastic solve;
+    to a solve that has no effect on it: ``method`` or ``max_outer`` on an elastic solve,
+    ``max_outer`` on the "bounded" route;
     ``coarse_to_fine=True`` with plasticity, with a ``warm_start`` or on a grid without a
     coarse level; ``threads > 1`` or a non-default ``planner_effort`` with the numpy
     backend.

@@ -109,17 +109,22 @@ def solve(
         where material flowed) and ``deformed_heights`` is h + h_pl.
     plastic_displacement : array_like, optional
         Plastic displacement left by earlier loading, m (the history of a load series).
-    method : {"winkler", "appendix", None}
+    method : {"winkler", "bounded", "appendix", None}
         Route of a plastic solve. ``"winkler"``: contact hardening with local increments
         solved exactly as an elastic half-space plus a Winkler layer (docs/models.md §2.4);
-        ``"appendix"``: the appendix's iterative scheme (bounded solve, plastic increment,
-        repeat; needs ``alpha < 1`` for contact hardening). None (default): ``"winkler"``
-        where it applies, else ``"appendix"`` (penetration hardness, volume-conserving
-        increments). Ignored, with a warning, by an elastic solve.
+        ``"bounded"``: penetration hardness with local increments in one bounded CG
+        (0 <= p <= p_Y) under the force or approach constraint, the plastic displacement
+        being the penetration where p = p_Y (docs/models.md §2.3); ``"appendix"``: the
+        appendix's iterative scheme (bounded solve, plastic increment, repeat, and under
+        load control a root find on the approach; needs ``alpha < 1`` for contact
+        hardening). None (default): ``"winkler"`` or ``"bounded"`` where they apply, else
+        ``"appendix"`` (volume-conserving increments). Ignored, with a warning, by an
+        elastic solve.
     max_outer : int, optional
         Cap on the outer loop of a plastic solve: plastic updates per approach
         (``"appendix"``, default 200) or active-set rounds (``"winkler"``, default 50).
-        Ignored, with a warning, by an elastic solve.
+        Ignored, with a warning, by an elastic solve and by the ``"bounded"`` route (no
+        outer loop).
     planner_effort : str, optional
         FFTW planner effort, one of "FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT",
         "FFTW_EXHAUSTIVE". None (default): ``"FFTW_ESTIMATE"`` on one thread, which is
@@ -337,6 +342,11 @@ def _ignored_options(opts, shape, *, method, max_outer, coarse_to_fine, warm_sta
         notes.append(
             f"max_outer={max_outer!r} is ignored: it caps the outer loop of a plastic solve "
             "and this solve is elastic (plasticity=None)"
+        )
+    if opts.route == "bounded" and max_outer is not None:
+        notes.append(
+            f"max_outer={max_outer!r} is ignored: the 'bounded' route of penetration hardness "
+            "is one bounded solve with no outer loop"
         )
     if coarse_to_fine:
         reason = _coarse_to_fine_obstacle(opts, shape, warm_start)

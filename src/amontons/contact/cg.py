@@ -125,8 +125,10 @@ class BoundedWall(HardWall):
 
     Free set ``0 < p < p_max`` (a free point that reaches ``p_max`` exactly stays free
     until it crosses it); points at ``p_max`` are constrained and become violators
-    when their gap opens (``g > 0``). Displacement control only: a load-controlled rescale
-    of the whole field would push points through the bound.
+    when their gap opens (``g > 0``). Load control runs on the fused loop only, which
+    imposes the load on the free points and leaves those at the bound
+    (:func:`amontons.contact.fused.impose_bounded_load`); a rescale of the whole field, as
+    the numpy loop does, would push points through the bound.
     """
 
     bounded = True
@@ -259,8 +261,14 @@ def polonsky_keer(
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
-    if constraint.bounded and load is not None:
-        raise ValueError("a bounded constraint needs displacement control")
+    if constraint.bounded and load is not None and not kernels:
+        # the fused loop imposes the load on the free points (fused.impose_bounded_load);
+        # the numpy reference loop only rescales the whole field, which would push points
+        # at the bound through it
+        raise ValueError(
+            "a bounded constraint under load control needs the fused loop (kernels=True); "
+            "the numpy loop takes displacement control"
+        )
     if kernels:
         from .fused import fused_polonsky_keer  # numba import and kernel load on first use
 
@@ -556,7 +564,13 @@ def _finish(
     if load_control and p.sum() > 0:
         m = np.empty(p.size)
         nc = constraint.free_mask(p, m, np.empty(p.size, dtype=bool))
-        d = float(np.dot(u - h, m) / nc)
+        if nc:
+            d = float(np.dot(u - h, m) / nc)
+        else:
+            # bounded, every loaded point at the bound: the force does not fix d
+            from .fused import fully_bound_approach
+
+            d = fully_bound_approach(u, h, p, d)
     gap = u - h - d
     hist = np.asarray(history)
     status, message = _status_message(converged, stalled, it, residual, tol, shape, p)

@@ -152,11 +152,17 @@ def _loop(
             p[:] = 1.0
             total = p.size
         p *= load / (pixel_area * total)
-    u, r = buf(), buf()
-    p_old = None  # a copy of p, taken only when the step may converge
+    # bounded load control: the force is imposed on the free points only (module docstring)
+    bounded_load = bounded and load_control
+    target = load / pixel_area if load_control else 0.0  # Σp, Pa
     t = buf()
     t[:] = 0.0
     m = np.empty(n, dtype=np.uint8)
+    if bounded_load:
+        _k.free_mask(p, m, p_max, bounded)
+        impose_bounded_load(p, m, t, p_max, target, np.zeros(n), h)
+    u, r = buf(), buf()
+    p_old = None  # a copy of p, taken only when the step may converge
     nch = _k.n_chunks(n)
     idx_buf = np.zeros((nch, _k.SLOTS), dtype=np.int64)
     val_buf = np.zeros((nch, _k.SLOTS))
@@ -171,7 +177,9 @@ def _loop(
     resets = 0
     recentres = 0  # second moment passes (see _centred_moments)
     # how u was updated after each step (for benchmarks/bench_iteration.py)
-    updates = dict.fromkeys(("linear", "point responses", "full: changes", "full: refresh"), 0)
+    updates = dict.fromkeys(
+        ("linear", "point responses", "full: changes", "full: refresh", "full: bounded load"), 0
+    )
     history = []
     d = 0.0 if load_control else float(displacement)
     residual = np.inf
@@ -210,8 +218,11 @@ def _loop(
             it -= 1
             break
         if nc == 0:
-            # displacement control only (module doc of .cg): start the free set from the
-            # points the constraint says should be free
+            # displacement control, or bounded load control with every loaded point at the
+            # bound (module doc of .cg): start the free set from the points the constraint
+            # says should be free
+            if load_control:
+                d = fully_bound_approach(sigma * u, h, p, d)
             g = sigma * u - h - d
             mf = np.zeros(n)
             start = constraint.violators(sigma * p, g, mf)
@@ -267,27 +278,36 @@ def _loop(
             # the convergence test below needs the pressure change: keep the old field
             # (this pass is paid only in the last iterations; otherwise p is updated in place)
             p_old = np.copy(p) if p_old is None else _copy(p, p_old)
-        psum, pen = _k.update(
-            p,
-            p,
-            u,
-            r,
-            t,
-            h,
-            m,
-            p_max,
-            bounded,
-            sigma,
-            d,
-            tau,
-            violators,
-            idx_buf,
-            val_buf,
-            counts,
-        )
-        n_clip = int(counts[:, 0].sum())
-        n_add = int(counts[:, 1].sum())
-        if n_add:
+        if bounded_load:
+            n_clip, n_add, pen, backtracked = bounded_load_step(
+                p, u, h, m, t, p_max, d, tau, target
+            )
+        else:
+            psum, pen = _k.update(
+                p,
+                p,
+                u,
+                r,
+                t,
+                h,
+                m,
+                p_max,
+                bounded,
+                sigma,
+                d,
+                tau,
+                violators,
+                idx_buf,
+                val_buf,
+                counts,
+            )
+            n_clip = int(counts[:, 0].sum())
+            n_add = int(counts[:, 1].sum())
+            backtracked = False
+        if backtracked:
+            delta = 0.0
+            resets += 1
+        elif n_add:
             if n_add > reset_fraction * nc:
                 delta = 0.0
                 resets += 1
@@ -298,10 +318,17 @@ def _loop(
         nc_start = nc
         nc += n_add - n_clip
         sigma_old = sigma
-        if load_control:
+        if load_control and not bounded_load:
             sigma = load / (pixel_area * psum)
         changes = n_clip + n_add
-        if since_fresh >= refresh or (changes and not (sparse_ok and changes <= sparse_max)):
+        if bounded_load:
+            # sigma stays 1 and the step rescaled the free points only (bounded_load_step):
+            # that changes u by a field of its own, so u is recomputed (a second
+            # convolution per iteration)
+            conv(p, u)
+            since_fresh = 0
+            updates["full: bounded load"] += 1
+        elif since_fresh >= refresh or (changes and not (sparse_ok and changes <= sparse_max)):
             conv(p, u)
             since_fresh = 0
             updates["full: changes" if changes > sparse_max else "full: refresh"] += 1
@@ -368,6 +395,156 @@ def _loop(
     )
 
 
+# Rounds of rescale-and-clip allowed to impose the load on the free points; each round clips
+# at least one point at p_max or ends, and one or two suffice in practice.
+MAX_LOAD_ROUNDS = 50
+
+
+def impose_bounded_load(p, m, t, p_max, target, u, h):
+    """Bounded load control: make ``Σp = target`` (Pa) keeping ``0 <= p <= p_max``.
+
+    The points at ``p_max`` keep their pressure; the free ones (``0 < p < p_max``) are
+    scaled by the common factor that makes the sum right: the load control of the hard wall
+    restricted to the points whose pressure no bound fixes. A free point the scale pushes
+    past ``p_max`` is clipped there and leaves the free set (``m = 0``, ``t = 0``), and the
+    scale is taken again; a negative pressure (a point falling from the bound by more than
+    its pressure) is clipped to 0 first. Two cases leave nothing to scale and restart the
+    field (the caller rebuilds ``m`` and resets the conjugation):
+
+    * every loaded point at the bound and load missing: the deficit goes to the unloaded
+      points next to touch, largest ``u - h`` first (``u``, ``h`` in m; ``u`` may be the
+      step's linear update, it only orders the candidates), each up to its ``p_max`` —
+      what raising the approach until they touch would do;
+    * the points at the bound alone carry more than the load: the excess is taken off the
+      points at the bound that are most open, largest ``u - h`` first, each down to 0 —
+      what lowering the approach until they leave contact would do.
+
+    Flat arrays, in place; ``m`` is uint8. Returns ``(points clipped, restarted)``.
+    """
+    clipped = 0
+    restarted = False
+    negative = np.flatnonzero(p < 0.0) if p.min() < 0.0 else None
+    if negative is not None:
+        p[negative] = 0.0
+        m[negative] = 0
+        t[negative] = 0.0
+        clipped += int(negative.size)
+    for _ in range(MAX_LOAD_ROUNDS):
+        below = p < p_max
+        free_sum = float(p.sum(where=below))
+        rest = target - float(p.sum(where=~below))
+        if rest < 0.0:
+            _release_bound_points(p, p_max, float(p.sum()) - target, u, h)
+            restarted = True
+            continue
+        if not free_sum > 0.0:
+            if rest > 0.0:
+                _fill_next_points(p, p_max, rest, u, h)
+                restarted = True
+            return clipped, restarted
+        scale = rest / free_sum
+        if scale == 1.0:
+            return clipped, restarted
+        p[below] *= scale
+        over = np.flatnonzero(below & (p > p_max))
+        if not over.size:
+            return clipped, restarted
+        p[over] = p_max[over]
+        m[over] = 0
+        t[over] = 0.0
+        clipped += int(over.size)
+    return clipped, restarted
+
+
+# Halvings of the step allowed in bounded_load_step before the load is imposed by moving
+# points on or off the bound instead.
+MAX_BACKTRACK = 30
+
+
+def bounded_load_step(p, u, h, m, t, p_max, d, tau, target):
+    """One CG step under ``0 <= p <= p_max`` and ``Σp = target`` (bounded load control).
+
+    As ``kernels.update`` (free points step to ``p - τ t``, constrained points that should be
+    free move by ``-τ g`` and join, everything is projected onto ``[0, p_max]``), then the
+    load is imposed on the free points (:func:`impose_bounded_load`). A step that clips so
+    many free points to ``p_max`` that the bound alone carries more than the load (or none
+    is left free to carry a deficit) is halved until it does not: the step that leaves the
+    previous, admissible field (τ → 0) always qualifies. ``u`` (m) must be ``K*p`` of the
+    current ``p`` (Pa); the free set ``m`` is rebuilt from the new field and ``t`` is zeroed
+    off it. Flat arrays, in place.
+
+    Returns ``(points that left the free set, points that joined it, max |g| over the
+    joining points (m), whether the step was shortened or the load imposed by a
+    restart)``: either way the conjugation is reset.
+    """
+    g = u - h - d
+    free = m != 0
+    rise = ~free & (p <= 0.0) & (g < 0.0) & (p_max > 0.0)
+    fall = ~free & (p >= p_max) & (g > 0.0) & (p > 0.0)
+    add = np.flatnonzero(rise | fall)
+    pen = float(np.abs(g[add]).max()) if add.size else 0.0
+    step = tau
+    shortened = False
+    for _ in range(MAX_BACKTRACK):
+        q = p - step * t
+        q[add] = p[add] - step * g[add]
+        np.clip(q, 0.0, p_max, out=q)
+        below = q < p_max
+        rest = target - float(q.sum(where=~below))
+        if rest >= 0.0 and (rest == 0.0 or float(q.sum(where=below)) > 0.0):
+            break
+        step *= 0.5
+        shortened = True
+    p[:] = q
+    _, restarted = impose_bounded_load(p, m, t, p_max, target, u, h)
+    new = (p > 0.0) & (p < p_max)
+    left = int(np.count_nonzero(free & ~new))
+    joined = int(np.count_nonzero(~free & new))
+    m[:] = new
+    t *= m
+    return left, joined, pen, shortened or restarted
+
+
+def _fill_next_points(p, p_max, deficit, u, h):
+    """Put ``deficit`` (Pa, summed) on the unloaded points next to touch, smallest gap
+    ``u - h - d`` (so smallest ``u - h``) first, each up to its ``p_max``
+    (impose_bounded_load)."""
+    cand = np.flatnonzero((p <= 0.0) & (p_max > 0.0))
+    order = cand[np.argsort(u[cand] - h[cand], kind="stable")]
+    room = np.cumsum(p_max[order])
+    k = int(np.searchsorted(room, deficit)) + 1  # points needed
+    take = order[:k]
+    p[take] = p_max[take]
+    # the last one takes what is left (its room minus the overshoot)
+    p[take[-1]] -= room[k - 1] - deficit if k <= room.size else 0.0
+
+
+def _release_bound_points(p, p_max, excess, u, h):
+    """Take ``excess`` (Pa, summed) off the points at the bound that open first as the
+    approach falls, largest gap ``u - h - d`` (so largest ``u - h``) first, each down to 0
+    (impose_bounded_load)."""
+    cand = np.flatnonzero(p >= p_max)
+    order = cand[np.argsort(h[cand] - u[cand], kind="stable")]
+    held = np.cumsum(p[order])
+    k = min(int(np.searchsorted(held, excess)) + 1, held.size)  # points to release
+    take = order[:k]
+    p[take[-1]] = held[k - 1] - excess if held[k - 1] > excess else 0.0
+    p[take[:-1]] = 0.0
+
+
+def fully_bound_approach(u, h, p, d):
+    """Approach (m) of a load-controlled bounded solve without free points: every loaded
+    point sits at ``p_max``, so the force does not fix the approach; any ``d`` with
+    ``g = u - h - d <= 0`` on the loaded points and ``>= 0`` on the others is a solution.
+    The smallest, ``max(u - h)`` over the loaded points, is taken: the least penetration
+    (for penetration hardness, the least plastic flow that carries the load). ``d`` is
+    returned unchanged when no point is loaded."""
+    loaded = p > 0.0
+    if not loaded.any():
+        return d
+    return float(np.max(u[loaded] - h[loaded]))
+
+
 def _copy(src, dst):
     np.copyto(dst, src)
     return dst
@@ -414,6 +591,8 @@ def _final_complementarity(u, h, p, d, load_control, m, t, p_max, bounded):
     if load_control and nc:
         s1, _, _, _ = _k.gap_moments(u, 1.0, h, m, t, 0.0)
         d = s1 / nc
+    elif load_control:
+        d = fully_bound_approach(u, h, p, d)
     s1, s2, _, _ = _k.gap_moments(u, 1.0, h, m, t, d)
     rms = np.sqrt(max(s2, 0.0) / nc) if nc else 0.0
     pen = _k.worst_violation(p, u, h, d, m, p_max, bounded)

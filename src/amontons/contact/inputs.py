@@ -29,7 +29,8 @@ class SolveOptions:
     """Validated options shared by every load step of a solve (SI units).
 
     ``max_iter`` is resolved from the grid; ``route`` is ``"elastic"`` without a law, else
-    the plastic route; ``max_outer`` is resolved for plastic solves and None for elastic ones.
+    the plastic route; ``max_outer`` is resolved for plastic solves and None for elastic ones
+    and the ``"bounded"`` route (no outer loop).
     """
 
     periodic: bool
@@ -69,8 +70,8 @@ def solve_options(
     route = "elastic" if law is None else resolve_route(law, method)
     if max_outer is not None:
         max_outer = check_count("max_outer", max_outer)
-    if law is None:
-        max_outer = None
+    if law is None or route == "bounded":
+        max_outer = None  # no outer loop (a given value is ignored, with a warning)
     elif max_outer is None:
         max_outer = default_max_outer(route)
     return SolveOptions(

@@ -15,16 +15,22 @@ directly, with one extension that keeps it exact when a point unloads under a la
 plastic displacement of earlier steps is a floor, so each point either flows (Winkler, on the
 undeformed heights) or stays elastic on its earlier deformation; an active-set loop picks
 which (it is the convex problem with dissipation potential φ'(p) = max(|h_pl,prev|, p/k)).
-This is the ``"winkler"`` route, the default for local increments. The appendix's iterative
-scheme (bounded CG, gap, increment, repeat; docs/models.md §2.3) is the ``"appendix"``
-route: taken by penetration hardness, by volume-conserving increments (where pile-up breaks
-the Winkler picture) and on request (``method="appendix"``, the test oracle).
+This is the ``"winkler"`` route, the default for contact hardening with local increments.
+Penetration hardness with local increments needs no outer loop either: the appendix scheme
+at a fixed approach stops once every point at p = p_Y has had its penetration removed, which
+leaves the bounded solution unchanged, so the state is one bounded CG on h + h_pl,prev under
+the load (the approach is the Lagrange multiplier of the force) followed by one update
+h_pl += g·θ(−g) where p = p_Y. This is the ``"bounded"`` route (docs/models.md §2.3), the
+default there. The appendix's iterative scheme (bounded CG, gap, increment, repeat) is the
+``"appendix"`` route: taken by volume-conserving increments (where pile-up moves the
+heights of points that did not yield) and on request (``method="appendix"``, the test
+oracle of both exact routes).
 
 Failures do not raise here: every route returns a :class:`PlasticState` whose ``status``
 (0 converged, 1 iteration cap, 2 stalled) and ``message`` say how it stopped, holding the
 last iterate; :func:`amontons.contact.solve` decides whether to raise.
 
-Load control of the iterative schemes is a root find on the rigid-body approach (the load is a
+Load control of the appendix scheme is a root find on the rigid-body approach (the load is a
 continuous, non-decreasing function of it), each trial starting from the previous step's
 plastic state.
 
@@ -45,7 +51,7 @@ from .plastic_increments import local_increment, volume_conserving_increment
 from .result import CONVERGED, ITERATION_CAP, STALLED, ContactInputError
 
 Increment = Literal["local", "volume"]
-METHODS = ("winkler", "appendix")
+METHODS = ("winkler", "bounded", "appendix")
 
 # Default caps on the outer loop (max_outer=None): plastic updates per approach of the
 # appendix scheme, and active-set rounds of the Winkler route.
@@ -152,26 +158,34 @@ def check_method(method) -> None:
 
 
 def resolve_route(law, method) -> str:
-    """The route of a plastic solve, ``"winkler"`` or ``"appendix"``.
+    """The route of a plastic solve, ``"winkler"``, ``"bounded"`` or ``"appendix"``.
 
     ``method=None`` picks the law's default: ``"winkler"`` for contact hardening with local
-    increments (exact), ``"appendix"`` otherwise (the only route there).
+    increments (exact), ``"bounded"`` for penetration hardness with local increments (one
+    bounded CG, exact), ``"appendix"`` otherwise (the only route there).
 
     Raises
     ------
     ContactInputError
-        An unknown method; ``"winkler"`` for a law it cannot solve; ``"appendix"`` for
-        contact hardening with ``alpha = 1``.
+        An unknown method; ``"winkler"`` or ``"bounded"`` for a law it cannot solve;
+        ``"appendix"`` for contact hardening with ``alpha = 1``.
     """
     check_method(method)
     winkler_ok = isinstance(law, ContactHardening) and law.increment == "local"
+    bounded_ok = isinstance(law, PenetrationHardness) and law.increment == "local"
     if method is None:
-        method = "winkler" if winkler_ok else "appendix"
+        method = "winkler" if winkler_ok else "bounded" if bounded_ok else "appendix"
     if method == "winkler" and not winkler_ok:
         raise ContactInputError(
             "method='winkler' (the exact elastic-plus-Winkler route) only solves "
             f"ContactHardening with local increments, not {law!r}; use method='appendix' or "
             "None"
+        )
+    if method == "bounded" and not bounded_ok:
+        raise ContactInputError(
+            "method='bounded' (one bounded CG under the force constraint) only solves "
+            f"PenetrationHardness with local increments, not {law!r}; use "
+            "method='appendix' or None"
         )
     if method == "appendix" and isinstance(law, ContactHardening) and law.alpha == 1:
         # with p_Y = k|h_pl| and α = 1 the first update closes every gap at zero pressure,
@@ -182,8 +196,11 @@ def resolve_route(law, method) -> str:
     return method
 
 
-def default_max_outer(route: str) -> int:
-    """Cap on the outer loop of a route when ``max_outer`` is None."""
+def default_max_outer(route: str) -> int | None:
+    """Cap on the outer loop of a route when ``max_outer`` is None (None: the route has no
+    outer loop)."""
+    if route == "bounded":
+        return None
     return MAX_ACTIVE_SET_ROUNDS if route == "winkler" else MAX_PLASTIC_UPDATES
 
 
@@ -493,9 +510,11 @@ def solve_plastic(
     """One load step of a plasticity law, starting from the plastic state ``plastic_prev``.
 
     ``route`` comes from :func:`resolve_route`: ``"winkler"`` (contact hardening with local
-    increments, exact) or ``"appendix"`` (the appendix's iterative scheme). ``max_outer``
+    increments, exact), ``"bounded"`` (penetration hardness with local increments, one
+    bounded CG, exact) or ``"appendix"`` (the appendix's iterative scheme). ``max_outer``
     caps the active-set rounds or the plastic updates per approach (None:
-    :func:`default_max_outer`). Returns a :class:`PlasticState`, converged or not.
+    :func:`default_max_outer`; unused by ``"bounded"``). Returns a :class:`PlasticState`,
+    converged or not.
     """
     pixel_area = spacing**2
     h_scale = float(np.std(heights)) or spacing
@@ -530,6 +549,20 @@ def solve_plastic(
             raise ContactInputError(
                 f"load {load:.3e} N needs more than the whole window at the hardness "
                 f"(Σ p_Y·Δx² = {capacity:.3e} N); lower the load or enlarge the window"
+            )
+        if route == "bounded":
+            return _hardness_bounded(
+                operator,
+                heights,
+                pixel_area,
+                h_scale,
+                p_y,
+                plastic_prev,
+                load=load,
+                displacement=displacement,
+                p_init=p_init,
+                tol=tol,
+                max_iter=max_iter,
             )
 
         def bound(h_pl):
@@ -604,6 +637,73 @@ def solve_plastic(
     # a fully plastic contact's load is a near-staircase in d: one pixel's worth is allowed
     pixel_worth = float(np.max(bound(plastic_prev))) * pixel_area
     return _find_approach(evaluate, load, d_guess, 1e-3 * span, load_tol=tol, load_atol=pixel_worth)
+
+
+def _hardness_bounded(
+    operator,
+    heights,
+    pixel_area,
+    h_scale,
+    p_y,
+    plastic_prev,
+    *,
+    load,
+    displacement,
+    p_init,
+    tol,
+    max_iter,
+):
+    """Penetration hardness with local increments (eq. B.2) in one bounded CG.
+
+    The appendix scheme at a fixed approach ends where every point at ``p = p_Y`` has had
+    its penetration removed: with local increments that is one bounded solve on
+    ``h + h_pl,prev`` and one update, since lowering a point at the bound to zero gap leaves
+    the bounded solution unchanged (p = p_Y with g = 0 is admissible). So the bounded solve
+    (0 <= p <= p_Y, Pa) is run under the load itself, with the approach as the Lagrange
+    multiplier of the force (fused.impose_bounded_load), instead of a root find on the
+    approach; then ``h_pl = h_pl,prev + g·θ(−g)`` where ``p = p_Y`` (m) and the gap there
+    closes to ``max(g, 0)``. The plastic history enters only through the heights. Units:
+    heights, gaps, ``h_pl`` in m; ``p_y`` (per pixel) in Pa.
+    """
+    out = polonsky_keer(
+        operator,
+        heights + plastic_prev,
+        pixel_area=pixel_area,
+        h_scale=h_scale,
+        p_init=p_init,
+        load=load,
+        displacement=displacement,
+        tol=tol,
+        max_iter=max_iter,
+        constraint=BoundedWall(p_y),
+        raise_on_failure=False,
+    )
+    # Only points at the bound yield (as in _plastic_iteration): a free point's gap is the
+    # solver's residual, not flow. BoundedWall clips to p_Y exactly, so == would do; >= is
+    # the appendix route's test.
+    flow = np.where((out.pressure >= p_y) & (out.gap < 0.0), out.gap, 0.0)
+    plastic = plastic_prev + local_increment(flow)
+    message = out.message
+    if out.converged:
+        message = (
+            f"bounded solve under the force constraint: {message}; "
+            f"{int(np.count_nonzero(flow))} pixel(s) flowed"
+        )
+    return PlasticState(
+        pressure=out.pressure,
+        gap=out.gap - flow,
+        elastic_displacement=out.displacement_field,
+        plastic_displacement=plastic,
+        displacement=out.rigid_displacement,
+        iterations=out.iterations,
+        residual=out.residual,
+        history=out.history,
+        convolutions=out.convolutions,
+        outer_iterations=1,
+        resets=out.info["steepest_descent_resets"],
+        status=out.status,
+        message=message,
+    )
 
 
 def _elastic_state(out, plastic_prev):

@@ -123,11 +123,13 @@ class SolveInfo:
 
     Attributes
     ----------
-    route : {"elastic", "winkler", "appendix"}
+    route : {"elastic", "winkler", "bounded", "appendix"}
         How the solve was done: ``"elastic"`` (no plasticity law; one Polonsky–Keer solve),
         ``"winkler"`` (contact hardening with local increments, solved exactly as an elastic
-        half-space plus a Winkler layer) or ``"appendix"`` (the appendix's iterative scheme:
-        bounded solve, plastic increment, repeat; penetration hardness always takes it).
+        half-space plus a Winkler layer), ``"bounded"`` (penetration hardness with local
+        increments: one bounded Polonsky–Keer solve under the load or approach, then the
+        plastic update) or ``"appendix"`` (the appendix's iterative scheme: bounded solve,
+        plastic increment, repeat, with a root find on the approach under load control).
     convolutions : int
         Convolutions on the finest grid. Plastic routes under load control: those of the
         final approach only (the root find's trial approaches are not counted).
@@ -135,9 +137,10 @@ class SolveInfo:
         Conjugate-gradient restarts from steepest descent (see :mod:`amontons.contact.cg`),
         counted like ``convolutions``.
     outer_iterations : int
-        Outer rounds of the returned state: active-set rounds (``"winkler"``) or rounds of
+        Outer rounds of the returned state: active-set rounds (``"winkler"``), rounds of
         bounded solve and plastic update at the final approach (``"appendix"``; 0 when the
-        elastic solution never reaches the hardness); 0 for an elastic solve.
+        elastic solution never reaches the hardness), 1 for ``"bounded"`` (its one solve
+        and update); 0 for an elastic solve.
     coarse_levels : tuple of CoarseLevel
         Coarse grids solved for a coarse-to-fine start, coarsest first; empty when none ran.
     plasticity : PenetrationHardness or ContactHardening or None
@@ -153,7 +156,7 @@ class SolveInfo:
     max_iter : int
         Conjugate-gradient iteration cap per solve on the finest grid.
     max_outer : int or None
-        Cap on ``outer_iterations``; None for an elastic solve.
+        Cap on ``outer_iterations``; None for an elastic solve and the ``"bounded"`` route.
     wall_time_s : float
         Wall time of the solve, s.
     """
