@@ -2,7 +2,8 @@
 
 For each grid a full load-controlled solve (tol 1e-8, cold start) is timed; per iteration:
 milliseconds, convolutions, and the ratio to one pyfftw r2c + c2r pair of the grid the
-convolution works on (n² periodic, (2n)² non-periodic: Hockney padding), planned with the
+convolution works on (n² periodic; non-periodic m², m >= 2n the fast length of the Hockney
+padding, ``op.padded_shape``; 2n before 2026-11-23's "Fast FFT lengths"), planned with the
 same effort and threads and timed in the same process, alternating with the solves. The
 remainder is ratio minus convolutions per iteration: everything an iteration does besides
 its FFT pairs (element-wise work, spectrum multiply, point responses). "in conv" is the
@@ -91,7 +92,7 @@ def run(n, periodic, path, threads, effort, repeats):
     op = get_operator(
         h.shape, 1.0, E_STAR, periodic=periodic, threads=threads, planner_effort=effort
     )
-    fft_shape = h.shape if periodic else (2 * n, 2 * n)
+    fft_shape = h.shape if periodic else op.padded_shape  # fast lengths >= 2n
     pair = RealFFT2Pair(fft_shape, threads=threads, planner_effort=effort)
     pair.real[...] = np.random.default_rng(0).random(pair.shape)
     kernels = path == "fused"

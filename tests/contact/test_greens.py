@@ -1,6 +1,7 @@
 """Green's functions: Love square-patch kernel and periodic multiplier against analytics."""
 
 import numpy as np
+import pytest
 
 from amontons.contact.convolution import PeriodicConvolution
 from amontons.contact.greens import hockney_kernel, love_square, periodic_multiplier
@@ -63,3 +64,25 @@ def test_periodic_rigid_mode_is_zero():
     assert mult[0, 0] == 0.0
     op = PeriodicConvolution((8, 8), 1.0, 1.0, backend="numpy")
     assert np.abs(op(np.full((8, 8), 5.0))).max() < 1e-14
+
+
+def test_hockney_kernel_on_a_larger_padded_grid():
+    """On an m0 × m1 grid (m >= 2n, odd and even) the entries that reach the n0 × n1 window,
+    offsets -(n-1)..(n-1), are the Love kernel at those offsets, and the kernel stays even;
+    (2n0, 2n1) gives the plain kernel bit for bit; m < 2n is refused. Tolerance 1e-12
+    relative (round-off): the kernel is evaluated at |offset|, the check at the signed
+    offset, and love_square's logs of near-equal ratios differ there by ~1e-14; a wrong
+    offset (one pixel) would be off by >= 1e-3."""
+    n0, n1, dx = 6, 5, 0.1
+    k = hockney_kernel((n0, n1), dx, 1.0, padded_shape=(15, 12))
+    assert k.shape == (15, 12)
+    for i in range(-(n0 - 1), n0):
+        for j in range(-(n1 - 1), n1):
+            expected = love_square(i * dx, j * dx, dx / 2, dx / 2, 1.0)
+            assert abs(k[i % 15, j % 12] / expected - 1) < 1e-12
+    np.testing.assert_array_equal(k[1:, :], k[1:, :][::-1, :])
+    np.testing.assert_array_equal(k[:, 1:], k[:, 1:][:, ::-1])
+    plain = hockney_kernel((n0, n1), dx, 1.0)
+    np.testing.assert_array_equal(hockney_kernel((n0, n1), dx, 1.0, (12, 10)), plain)
+    with pytest.raises(ValueError):
+        hockney_kernel((n0, n1), dx, 1.0, padded_shape=(11, 10))

@@ -7,19 +7,25 @@ displacement (m) on the same grid:
     ``u = irfft2(rfft2(p) · 2/(E*|q|))``: one forward and one inverse real 2-D FFT.
 
 ``NonPeriodicConvolution``
-    Free-space convolution with the Love kernel through Hockney padding to ``2n0 × 2n1``.
-    Three quarters of the padded pressure are zero and only one quarter of the padded
-    displacement is wanted, so the default *pruned* transform skips that work:
+    Free-space convolution with the Love kernel through Hockney padding to an ``m0 × m1``
+    grid, ``m = fast_length(2n)``: the smallest FFTW-friendly even length ``>= 2n`` on each
+    axis (:func:`amontons.contact.fft.fast_length`). Any ``m >= 2n`` gives the same
+    free-space result (:func:`.greens.hockney_kernel`), and a ``2n`` with a large prime
+    factor made FFTW 2.4-5× slower per call than the next fast length (3688 = 2³·461
+    against 3696 = 2⁴·3·7·11, 856 = 2³·107 against 864 = 2⁵·3³; benchmarks/README.md,
+    "Fast FFT lengths"). At least three quarters of the padded pressure are zero and only
+    one quarter of the padded displacement is wanted, so the default *pruned* transform
+    skips that work:
 
-    forward  r2c along axis 1 (length 2n1) on the n0 non-zero rows only,
-             then c2c along axis 0 (length 2n0) on the n1 + 1 spectral columns;
+    forward  r2c along axis 1 (length m1) on the n0 non-zero rows only,
+             then c2c along axis 0 (length m0) on the m1 // 2 + 1 spectral columns;
     multiply by the real kernel spectrum;
-    inverse  c2c along axis 0 on the n1 + 1 columns,
+    inverse  c2c along axis 0 on the m1 // 2 + 1 columns,
              then c2r along axis 1 on the first n0 rows only, keep the first n1 columns.
 
-    The row transforms touch half the rows of the plain ``2n0 × 2n1`` transform, so the
-    FFT work is 3/4 of the plain one (ideal speed-up 4/3). ``pruned=False`` gives the plain
-    transform, kept for tests and benchmarks.
+    The row transforms touch n0 of the m0 rows of the plain ``m0 × m1`` transform, so the
+    FFT work is about 3/4 of the plain one (ideal speed-up 4/3). ``pruned=False`` gives the
+    plain transform, kept for tests and benchmarks.
 
 Operators own aligned work arrays and FFTW plans; :func:`get_operator` caches them per
 (shape, spacing, E*, periodic, backend, threads, pruned, planner effort). Operators are not
@@ -42,6 +48,13 @@ def _scaled(mult, scale):
     pyfftw plans run through ``execute()``, which does not normalise)."""
     mult *= scale
     return mult
+
+
+def fast_padded_shape(shape) -> tuple[int, int]:
+    """The FFT grid ``(m0, m1)`` of a Hockney-padded solve on an ``n0 × n1`` window: on each
+    axis the smallest FFT-friendly length ``m >= 2n`` (:func:`amontons.contact.fft.fast_length`).
+    Any ``m >= 2n`` gives the same free-space convolution (:func:`.greens.hockney_kernel`)."""
+    return tuple(_fft.fast_length(2 * int(n)) for n in shape)
 
 
 class _MultiplierMixin:
@@ -186,10 +199,14 @@ class NonPeriodicConvolution(_MultiplierMixin):
     threads : int
         FFTW threads.
     pruned : bool
-        Use the pruned transform (default) or the plain ``2n0 × 2n1`` one.
+        Use the pruned transform (default) or the plain ``m0 × m1`` one.
     planner_effort : str
         FFTW planner effort, one of :data:`amontons.contact.fft.PLANNER_EFFORTS`
         (default ``"FFTW_ESTIMATE"``: deterministic).
+    padded_shape : (m0, m1), optional
+        The FFT grid, ``m >= 2n`` on each axis; default :func:`fast_padded_shape` (the
+        same result to round-off, faster). ``(2n0, 2n1)`` gives plain Hockney padding (tests
+        and benchmarks). The operator's ``padded_shape`` attribute holds the one used.
     """
 
     periodic = False
@@ -203,6 +220,7 @@ class NonPeriodicConvolution(_MultiplierMixin):
         threads=1,
         pruned=True,
         planner_effort=_fft.DEFAULT_PLANNER_EFFORT,
+        padded_shape=None,
     ):
         self.shape = tuple(int(s) for s in shape)
         self.spacing = float(spacing)
@@ -211,22 +229,26 @@ class NonPeriodicConvolution(_MultiplierMixin):
         self.threads = int(threads)
         self.pruned = bool(pruned)
         self.planner_effort = _fft.check_planner_effort(planner_effort)
-        self._multiplier = hockney_multiplier(self.shape, spacing, e_star)
+        if padded_shape is None:
+            padded_shape = fast_padded_shape(self.shape)
+        self.padded_shape = tuple(int(s) for s in padded_shape)
+        self._multiplier = hockney_multiplier(self.shape, spacing, e_star, self.padded_shape)
         self._green = None  # real-space kernel on the padded grid, built on first use
         self.ncalls = 0
         n0, n1 = self.shape
+        m0, m1 = self.padded_shape
         be = self.backend
         if be != "pyfftw":
             return
-        spec_shape = (2 * n0, n1 + 1)
+        spec_shape = self._multiplier.shape  # (m0, m1 // 2 + 1)
         if self.pruned:
             # _rows: real rows; the right half is the padding and stays zero forever.
             # _spec: one complex work array for every stage. All column transforms run in
             # place: FFTW's in-place strided column transforms measured ~30 % faster than
             # out-of-place ones here, which is worth re-zeroing the lower half per call.
-            self._rows = _fft.empty((n0, 2 * n1), np.float64, be)
+            self._rows = _fft.empty((n0, m1), np.float64, be)
             self._spec = _fft.empty(spec_shape, np.complex128, be)
-            self._out = _fft.empty((n0, 2 * n1), np.float64, be)
+            self._out = _fft.empty((n0, m1), np.float64, be)
             kw = {"threads": threads, "planner_effort": planner_effort}
             self._row_fwd = _fft.fftw_plan(self._rows, self._spec[:n0], (1,), **kw)
             self._col_fwd = _fft.fftw_plan(self._spec, self._spec, (0,), **kw)
@@ -236,34 +258,34 @@ class NonPeriodicConvolution(_MultiplierMixin):
             # afterwards
             self._rows[...] = 0.0
             # plans run through execute(), which does not normalise inverses: the
-            # 1/(2n0 · 2n1) of the inverse DFT is folded into the multiplier
-            self._scale = 1.0 / (4 * n0 * n1)
+            # 1/(m0 · m1) of the inverse DFT is folded into the multiplier
+            self._scale = 1.0 / (m0 * m1)
             self._mult_scaled = _scaled(self._multiplier, self._scale)
             self._multiplier = None  # keep one copy only (memory)
         else:
-            self._real = _fft.empty((2 * n0, 2 * n1), np.float64, be)
+            self._real = _fft.empty((m0, m1), np.float64, be)
             self._spec = _fft.empty(spec_shape, np.complex128, be)
             kw = {"threads": threads, "planner_effort": planner_effort}
             self._fwd = _fft.fftw_plan(self._real, self._spec, (0, 1), **kw)
             self._inv = _fft.fftw_plan(self._spec, self._real, (0, 1), inverse=True, **kw)
             self._real[...] = 0.0
-            self._scale = 1.0 / (4 * n0 * n1)
+            self._scale = 1.0 / (m0 * m1)
             self._mult_scaled = _scaled(self._multiplier, self._scale)
             self._multiplier = None  # keep one copy only (memory)
 
     def real_space_kernel(self) -> np.ndarray:
-        """The kernel of the padded circular convolution, ``(2n0, 2n1)``, m/Pa (built once):
-        the response at ``x`` of a unit pressure on the pixel at the origin is
-        ``G[x mod 2n]``, the same discrete operator as the FFT path. 4 n0·n1 floats."""
+        """The kernel of the padded circular convolution, ``padded_shape = (m0, m1)``, m/Pa
+        (built once): the response at ``x`` of a unit pressure on the pixel at the origin is
+        ``G[x mod m]``, the same discrete operator as the FFT path. m0·m1 floats."""
         if self._green is None:
-            n0, n1 = self.shape
-            self._green = np.fft.irfft2(self.multiplier, s=(2 * n0, 2 * n1))
+            self._green = np.fft.irfft2(self.multiplier, s=self.padded_shape)
         return self._green
 
     def __call__(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Return the displacement (m) of pressure ``p`` (Pa); writes into ``out`` if given."""
         self.ncalls += 1
         n0, n1 = self.shape
+        m0, m1 = self.padded_shape
         if self.backend == "pyfftw":
             if self.pruned:
                 self._rows[:, :n1] = p
@@ -283,14 +305,14 @@ class NonPeriodicConvolution(_MultiplierMixin):
                 self._inv.execute()
                 result = self._real[:n0, :n1]
         elif self.pruned:
-            rows = np.fft.rfft(p, n=2 * n1, axis=1)
-            cols = np.fft.fft(rows, n=2 * n0, axis=0)
+            rows = np.fft.rfft(p, n=m1, axis=1)
+            cols = np.fft.fft(rows, n=m0, axis=0)
             cols *= self._multiplier
             back = np.fft.ifft(cols, axis=0)[:n0]
-            result = np.fft.irfft(back, n=2 * n1, axis=1)[:, :n1]
+            result = np.fft.irfft(back, n=m1, axis=1)[:, :n1]
         else:
-            spec = np.fft.rfft2(p, s=(2 * n0, 2 * n1))
-            result = np.fft.irfft2(spec * self._multiplier, s=(2 * n0, 2 * n1))[:n0, :n1]
+            spec = np.fft.rfft2(p, s=(m0, m1))
+            result = np.fft.irfft2(spec * self._multiplier, s=(m0, m1))[:n0, :n1]
         if out is None:
             return result.copy()
         out[...] = result

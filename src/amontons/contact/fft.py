@@ -190,3 +190,48 @@ class RealFFT2Pair:
         else:
             self.spec[...] = np.fft.rfft2(self.real)
             self.real[...] = np.fft.irfft2(self.spec, s=self.shape)
+
+
+# FFT lengths of the Hockney-padded operator (contact.convolution). FFTW has hard-coded
+# codelets for small factors and uses slower general-purpose algorithms for a large prime
+# factor; its manual (fftw.org/fftw3_doc, "Complex One-Dimensional DFTs") says it is best
+# at sizes 2^a 3^b 5^c 7^d 11^e 13^f with e + f = 0 or 1. Even sizes, because convolutions
+# on odd sizes were 20-40 % slower here (below). Time of one pruned padded convolution,
+# NonPeriodicConvolution(padded_shape=(m, m)), one thread, FFTW_ESTIMATE, 2026-11-23
+# (benchmarks/README.md, "Fast FFT lengths", "Choice of the rule"):
+#   n = 428:  34 ms on 856 = 2³·107,  7.0 ms on 864 = 2⁵·3³,  9.7 ms on 875 = 5³·7 (odd);
+#   n = 461:  29 ms on 922 = 2·461,   8.3 ms on 924 = 2²·3·7·11,  7.6 ms on 936 = 2³·3²·13,
+#             10.7 ms on 945 = 3³·5·7 (odd);
+#   n = 308:  2.9 ms on 616 = 2³·7·11, 3.7 ms on 625 = 5⁴ (odd);
+#   n = 1844: 500 ms on 3688 = 2³·461, 209 ms on 3696 = 2⁴·3·7·11, 237 ms on 3750 = 2·3·5⁴.
+# A 5-smooth length (scipy.fft.next_fast_len) pads further; it was no faster under the
+# solver's default FFTW_ESTIMATE (n = 461: 8.0 ms on 960 = 2⁶·3·5 against 8.3 ms on 924) and
+# faster under FFTW_MEASURE (5.2 against 7.3 ms); both are far from the 2n cost (23-29 ms).
+FAST_PRIMES = (2, 3, 5, 7)
+FAST_EXTRA = (1, 11, 13)  # at most one factor 11 or 13
+
+
+def smooth_length(target: int, primes=FAST_PRIMES) -> int:
+    """The smallest integer ``>= target`` whose prime factors are all in ``primes``."""
+    target = int(target)
+    if target <= 1:
+        return 1
+    best = None
+    # depth-first over the products of the primes (non-decreasing prime order, so each
+    # product once), stopping at the first one >= target: a few hundred for target ~ 10⁴
+    stack = [(1, 0)]
+    while stack and best != target:
+        value, first = stack.pop()
+        if value >= target:
+            best = value if best is None else min(best, value)
+            continue
+        for k in range(first, len(primes)):
+            stack.append((value * primes[k], k))
+    return best
+
+
+def fast_length(n: int) -> int:
+    """The smallest even length ``>= n`` of the form ``2^a 3^b 5^c 7^d 11^e 13^f`` with
+    ``e + f <= 1`` (FFTW's fast sizes, see the comment above :data:`FAST_PRIMES`)."""
+    half = (int(n) + 1) // 2  # even m = 2k, k >= ceil(n / 2)
+    return 2 * min(f * smooth_length(-(-half // f)) for f in FAST_EXTRA)

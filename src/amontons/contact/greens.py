@@ -16,9 +16,10 @@ Non-periodic
     Love (1929) / Johnson (1985, eq. 3.25): displacement at offset ``(x, y)`` from the
     centre of a ``2a × 2b`` rectangle carrying unit uniform pressure. Its value at the
     centre of a square (``a = b``) is ``(4a / (π E*)) ln(1 + √2) · 2 = 2.2444 a / E*``.
-    It is sampled at wrapped offsets on the Hockney-padded ``2n0 × 2n1`` grid so that a
-    circular convolution on the padded grid is the exact free-space convolution on the
-    ``n0 × n1`` window.
+    It is sampled at wrapped offsets on a padded ``m0 × m1`` grid, ``m >= 2n`` on each axis
+    (Hockney padding; the operator picks FFT-friendly ``m``, see
+    :func:`amontons.contact.fft.fast_length`), so that a circular convolution on the padded
+    grid is the exact free-space convolution on the ``n0 × n1`` window.
 """
 
 from __future__ import annotations
@@ -91,42 +92,77 @@ def love_square(x, y, a: float, b: float, e_star: float):
     return total / (np.pi * e_star)
 
 
-def hockney_kernel(shape: tuple[int, int], spacing: float, e_star: float) -> np.ndarray:
-    """Love kernel sampled at wrapped offsets on the ``2n0 × 2n1`` padded grid.
+def _check_padded(shape, padded_shape):
+    """``(n0, n1)`` and the padded ``(m0, m1)`` (default ``(2n0, 2n1)``), with ``m >= 2n``."""
+    n0, n1 = (int(s) for s in shape)
+    m0, m1 = (2 * n0, 2 * n1) if padded_shape is None else (int(s) for s in padded_shape)
+    if m0 < 2 * n0 or m1 < 2 * n1:
+        raise ValueError(f"padded shape {(m0, m1)} is smaller than 2 x {(n0, n1)}")
+    return n0, n1, m0, m1
 
-    Offsets are ``iΔ`` for ``i < n`` and ``(i - 2n)Δ`` for ``i >= n`` (the ``i = n`` entry
-    never contributes to the ``n0 × n1`` window and is set by the same rule).
+
+def hockney_kernel(
+    shape: tuple[int, int],
+    spacing: float,
+    e_star: float,
+    padded_shape: tuple[int, int] | None = None,
+) -> np.ndarray:
+    """Love kernel sampled at wrapped offsets on the ``m0 × m1`` padded grid.
+
+    Parameters
+    ----------
+    shape : (n0, n1)
+        The window.
+    spacing : float
+        Grid spacing, m.
+    e_star : float
+        Contact modulus, Pa.
+    padded_shape : (m0, m1), optional
+        The FFT grid, ``m >= 2n`` on each axis; default ``(2n0, 2n1)`` (plain Hockney).
+
+    Index ``i`` holds the offset ``iΔ`` for ``i <= m/2`` and ``(i - m)Δ`` above. A source
+    and a target on the window are at most ``n - 1`` pixels apart, so only the indices
+    ``i <= n - 1`` and ``i >= m - n + 1`` reach the window; with ``m >= 2n`` these are the
+    true offsets, and the circular convolution on the padded grid is exactly the free-space
+    one on the window whatever ``m`` is. The entries in between never reach the window;
+    they take the same rule, which keeps the kernel even (its spectrum real).
 
     Returns
     -------
-    ndarray, shape (2n0, 2n1)
+    ndarray, shape (m0, m1)
         m/Pa.
     """
-    n0, n1 = shape
-    # |wrapped offset| in pixels: i for i <= n, 2n - i above
-    i0 = np.arange(2 * n0)
-    i1 = np.arange(2 * n1)
-    a0 = np.where(i0 <= n0, i0, 2 * n0 - i0)
-    a1 = np.where(i1 <= n1, i1, 2 * n1 - i1)
+    n0, n1, m0, m1 = _check_padded(shape, padded_shape)
+    # |wrapped offset| in pixels: i for i <= m/2, m - i above
+    i0 = np.arange(m0)
+    i1 = np.arange(m1)
+    a0 = np.minimum(i0, m0 - i0)
+    a1 = np.minimum(i1, m1 - i1)
     half = spacing / 2
-    # The kernel is even in x and y: evaluate it once on the (n0+1) x (n1+1) quadrant of
-    # distinct |offsets| (a quarter of the temporaries) and mirror by indexing, which also
-    # makes the padded kernel exactly symmetric so its spectrum is exactly real.
-    x = np.arange(n0 + 1)[:, None] * spacing
-    y = np.arange(n1 + 1)[None, :] * spacing
+    # The kernel is even in x and y: evaluate it once on the quadrant of distinct |offsets|
+    # (a quarter of the temporaries) and mirror by indexing, which also makes the padded
+    # kernel exactly symmetric so its spectrum is exactly real.
+    x = np.arange(m0 // 2 + 1)[:, None] * spacing
+    y = np.arange(m1 // 2 + 1)[None, :] * spacing
     quadrant = love_square(x, y, half, half, e_star)
     return quadrant[a0[:, None], a1[None, :]]
 
 
-def hockney_multiplier(shape: tuple[int, int], spacing: float, e_star: float) -> np.ndarray:
-    """Real spectrum ``rfft2`` of :func:`hockney_kernel`, shape ``(2n0, n1 + 1)``, m/Pa.
+def hockney_multiplier(
+    shape: tuple[int, int],
+    spacing: float,
+    e_star: float,
+    padded_shape: tuple[int, int] | None = None,
+) -> np.ndarray:
+    """Real spectrum ``rfft2`` of :func:`hockney_kernel` on the ``m0 × m1`` padded grid
+    (default ``(2n0, 2n1)``), shape ``(m0, m1 // 2 + 1)``, m/Pa.
 
     The kernel is even in both directions, so its spectrum is real; the imaginary part
     (round-off only) is dropped, which halves the cost of the multiplication.
     The convolution operators that use it are cached per (shape, spacing, E*), so it is
     computed once per problem; the returned array is writable (a fresh array per call).
     """
-    kernel = hockney_kernel(tuple(int(s) for s in shape), spacing, e_star)
+    kernel = hockney_kernel(shape, spacing, e_star, padded_shape)
     spec = np.fft.rfft2(kernel)
     del kernel
     mult = np.ascontiguousarray(spec.real)

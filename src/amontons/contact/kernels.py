@@ -430,7 +430,8 @@ def add_point_responses(u, green, idx, values):
     ``(a_k, b_k)`` the 2-D position of flat index ``idx[k]`` on ``u``'s grid.
 
     ``u`` (n0, n1), m; ``green`` (N0, N1) the real-space kernel of the convolution, m/Pa
-    (periodic: N = n; Hockney-padded: N = 2n, the same discrete operator as the FFT path);
+    (periodic: N = n; Hockney-padded: N = the operator's padded_shape, m >= 2n, the same
+    discrete operator as the FFT path);
     ``values`` Pa. One sweep over ``u`` whatever the number of points (each row adds every
     point's kernel row while it is in cache), rows in parallel; each element sums the points
     in the same order, so the result does not depend on the thread count.
