@@ -7,6 +7,7 @@ and the script prints predicted / measured per job and per model, and the share 
 a factor of 2:
 
     python benchmarks/check_timing_model.py --run full [--model workflow/timing_model.json]
+        [--root a/fresh/clone]
 
 The measured times are those of the run's own jobs, under whatever else the machine ran.
 """
@@ -60,9 +61,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--run", default="full")
     parser.add_argument("--model", default=str(REPO / "workflow" / "timing_model.json"))
+    parser.add_argument("--root", default=str(REPO), help="project folder holding results/")
     args = parser.parse_args()
     record = json.loads(Path(args.model).read_text())
-    jobs = solver_jobs(REPO / "results" / args.run)
+    jobs = solver_jobs(Path(args.root) / "results" / args.run)
     jobs["predicted_s"] = [
         predict(record, r.model, side_px=r.side_px, periodic=r.periodic, loads=r.loads, tol=r.tol)[
             0

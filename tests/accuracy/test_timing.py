@@ -7,7 +7,7 @@ import pytest
 from amontons.accuracy.timing import fit_timing_model, predict
 
 
-def _points(c_fix=2e-8, c_it=3e-10, m0=150.0, m1=5e-5):
+def _points(c_0=0.2, c_fix=2e-8, c_it=3e-10, m0=150.0, m1=5e-5):
     """Solves obeying the model exactly, with iterations per load ∝ tol^-0.1 · N^0.2."""
     out = []
     for model, b0 in (("elastic", 0.5), ("hardening", 0.1)):
@@ -23,7 +23,7 @@ def _points(c_fix=2e-8, c_it=3e-10, m0=150.0, m1=5e-5):
                         "loads": 5,
                         "tol": tol,
                         "iterations": its,
-                        "wall_time_s": c_fix * n + c_it * its * n * math.log2(n),
+                        "wall_time_s": c_0 + c_fix * n + c_it * its * n * math.log2(n),
                         "peak_rss_mb": m0 + m1 * n,
                     }
                 )
@@ -32,13 +32,14 @@ def _points(c_fix=2e-8, c_it=3e-10, m0=150.0, m1=5e-5):
 
 def test_fit_recovers_the_law_and_predict_reproduces_the_points():
     record = fit_timing_model(_points())
+    assert record["time"]["c_0"] == pytest.approx(0.2, rel=1e-6)
     assert record["time"]["c_fix"] == pytest.approx(2e-8, rel=1e-6)
     assert record["time"]["c_it"] == pytest.approx(3e-10, rel=1e-6)
     assert record["models"]["hardening"]["iterations"] == pytest.approx([0.1, 0.1, 0.2], abs=1e-9)
     seconds, mb = predict(record, "hardening", side_px=256, periodic=False, loads=5, tol=1e-6)
     n = 512**2
     its = 5 * math.exp(0.1 + 0.6 + 0.2 * math.log(n))
-    assert seconds == pytest.approx(2e-8 * n + 3e-10 * its * n * math.log2(n), rel=1e-6)
+    assert seconds == pytest.approx(0.2 + 2e-8 * n + 3e-10 * its * n * math.log2(n), rel=1e-6)
     assert mb == pytest.approx(150.0 + 5e-5 * n, rel=1e-6)
 
 

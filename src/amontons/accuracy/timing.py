@@ -6,11 +6,12 @@ DAG); :func:`fit_timing_model` needs numpy.
 Per load series on an FFT grid of N points (n² periodic, (2n)² non-periodic):
 
     iterations per load  I = exp(b0 + b1·log10(1/tol) + b2·ln N)      (per contact model)
-    wall time            t = c_fix·N + c_it·L·I·N·log2 N
+    wall time            t = c_0 + c_fix·N + c_it·L·I·N·log2 N
     peak memory          m = m0 + m1·N
 
 c_it is the cost of one CG iteration per N·log2 N (one FFT pair dominates it), c_fix the
-per-solve work linear in N (surface, Green's function, plans); L the number of loads.
+per-solve work linear in N (surface, Green's function, plans), c_0 what every solve costs
+whatever its grid (FFTW plans, dispatch of the compiled kernels); L the number of loads.
 """
 
 from __future__ import annotations
@@ -35,7 +36,11 @@ def predict(record: Mapping, model: str, *, side_px: int, periodic: bool, loads:
     per_model = record["models"].get(model, record["models"]["elastic"])
     iterations = loads * iterations_per_load(per_model, tol, points)
     time = record["time"]
-    seconds = time["c_fix"] * points + time["c_it"] * iterations * points * math.log2(points)
+    seconds = (
+        time["c_0"]
+        + time["c_fix"] * points
+        + time["c_it"] * iterations * points * math.log2(points)
+    )
     memory = record["memory"]
     return seconds, memory["m0"] + memory["m1"] * points
 
@@ -52,9 +57,9 @@ def fit_timing_model(points: Sequence[Mapping]) -> dict:
     n = np.array([p["fft_points"] for p in points], float)
     t = np.array([p["wall_time_s"] for p in points], float)
     its = np.array([p["iterations"] for p in points], float)
-    design = np.column_stack([n, its * n * np.log2(n)]) / t[:, None]
-    (c_fix, c_it), _ = nnls(design, np.ones_like(t))
-    predicted = c_fix * n + c_it * its * n * np.log2(n)
+    design = np.column_stack([np.ones_like(n), n, its * n * np.log2(n)]) / t[:, None]
+    (c_0, c_fix, c_it), _ = nnls(design, np.ones_like(t))
+    predicted = c_0 + c_fix * n + c_it * its * n * np.log2(n)
     memory = np.array([p["peak_rss_mb"] for p in points], float)
     m1, m0 = np.polyfit(n, memory, 1)
     m0 += float(np.max(memory - (m0 + m1 * n)))
@@ -73,7 +78,7 @@ def fit_timing_model(points: Sequence[Mapping]) -> dict:
         models[model] = {"iterations": [float(c) for c in coef], "points": len(rows)}
     ratio = predicted / t
     return {
-        "time": {"c_fix": float(c_fix), "c_it": float(c_it)},
+        "time": {"c_0": float(c_0), "c_fix": float(c_fix), "c_it": float(c_it)},
         "memory": {"m0": float(m0), "m1": float(m1)},
         "models": models,
         "fit": {

@@ -48,7 +48,7 @@ from scipy import optimize
 
 from .cg import BoundedWall, polonsky_keer
 from .plastic_increments import local_increment, volume_conserving_increment
-from .result import CONVERGED, ITERATION_CAP, STALLED, ContactInputError
+from .result import CONVERGED, ITERATION_CAP, STALLED, ContactInputError, FreeBoundaryError
 
 Increment = Literal["local", "volume"]
 METHODS = ("winkler", "bounded", "appendix")
@@ -546,9 +546,21 @@ def solve_plastic(
         p_y = np.broadcast_to(np.asarray(law.p_y, dtype=float), heights.shape)
         capacity = float(p_y.sum()) * pixel_area
         if load is not None and load >= capacity:
-            raise ContactInputError(
+            message = (
                 f"load {load:.3e} N needs more than the whole window at the hardness "
                 f"(Σ p_Y·Δx² = {capacity:.3e} N); lower the load or enlarge the window"
+            )
+            if periodic:
+                # the whole periodic surface at p_Y carries less: no state carries the load
+                raise ContactInputError(message)
+            # on a half-space the contact would grow past the window: the window is too small,
+            # as when a solution's pressure reaches the edge (every pixel would be at p_Y)
+            ring = np.ones(heights.shape, dtype=bool)
+            ring[1:-1, 1:-1] = False
+            raise FreeBoundaryError(
+                message,
+                edge_pixels=int(ring.sum()),
+                edge_force=float(p_y[ring].sum()) * pixel_area,  # the ring at p_Y
             )
         if route == "bounded":
             return _hardness_bounded(
