@@ -272,7 +272,7 @@ def _scene_config(repo, edit):
             r"PS's Hertz contact diameter",
         ),
         (
-            lambda s: s["elastic"].update(side_px=64),
+            lambda s: s["elastic"].update(side_px=64, pixel_nm=256.0),
             r"scene elastic: the solver window \(side_px\) is 16\.4 µm, smaller",
         ),
         (

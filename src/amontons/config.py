@@ -499,11 +499,17 @@ def read_config(base: str | Path, *overlays: str | Path) -> dict:
 
 
 def check_accuracy_study(config: Mapping, sheet: Mapping[str, dict], source: str) -> None:
-    """The accuracy study's sphere must be a sphere of a selected material, and its grid and
-    reference must make sense (amontons.accuracy.settings.check_accuracy)."""
+    """The accuracy study's sphere (null: the first sphere of the first selected material,
+    set in place) must be a sphere of a selected material, and its grid and reference must
+    make sense (amontons.accuracy.settings.check_accuracy)."""
     from amontons.accuracy.settings import AccuracyConfigError, check_accuracy
 
     study = config["accuracy"]
+    if study["sphere"] is None:
+        # the first sphere of the first selected material: the study runs on any data set
+        study["sphere"] = next(
+            s for m in config["materials"] for s, r in sheet.items() if r["material"] == m
+        )
     record = sheet.get(study["sphere"])
     if record is None or record["material"] not in config["materials"]:
         raise ConfigError(

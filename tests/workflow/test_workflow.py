@@ -166,7 +166,7 @@ def test_slurm_dry_run_gives_every_job_measured_resources_that_grow_with_the_gri
     """Every cluster job of the full config carries mem_mb and runtime from the measured
     runs (workflow/resources.json, no profile default stands in), every rule declares its
     threads, and a solve asks for more the larger its FFT grid (PMMA-4mm's scenes run on
-    512², PS's on ~250², both non-periodic)."""
+    512², PS's on ~380², both non-periodic)."""
     jobs, stdout = _slurm_jobs(project, "config/config.yaml")
     assert len(jobs) > 150
     # the few-second jobs go in bundles (the profile's groups), the solves on their own
@@ -189,7 +189,9 @@ def test_slurm_dry_run_gives_every_job_measured_resources_that_grow_with_the_gri
     }
     large = next(r for w, r in scenes.items() if "sphere=PMMA-4mm" in w)
     small = next(r for w, r in scenes.items() if "sphere=PS," in w)
-    assert int(large["mem_mb"]) > int(small["mem_mb"])
+    # memory: the process's baseline dominates (docs/accuracy.md §6), so after rounding to
+    # 100 MB the two may ask for the same; time grows with the grid
+    assert int(large["mem_mb"]) >= int(small["mem_mb"])
     assert int(large["runtime"]) > int(small["runtime"])
 
 

@@ -4,17 +4,6 @@
 # fronts propose, and the timing model. Target: `snakemake accuracy`.
 ACCURACY = f"{RESULTS}/accuracy"
 ACCURACY_LOGS = f"{LOGS}/accuracy"
-ACCURACY_SPHERE = config["accuracy"]["sphere"]
-
-
-def accuracy_sphere_inputs(wildcards):
-    """The AFM map a rough-sphere problem presses and the PSF every problem is rendered with."""
-    sphere = ACCURACY_SPHERE
-    material = sphere_row(sphere)["material"]
-    inputs = {"psf": measured(material, sphere, "psf.json")}
-    if accuracy_geometry(wildcards.problem) == "sphere":
-        inputs["levelled"] = measured(material, sphere, "afm_before_levelled.h5")
-    return inputs
 
 
 rule solve_accuracy_setting:

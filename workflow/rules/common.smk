@@ -625,6 +625,18 @@ def solve_mem_mb(rule, scene_of):
 # The accuracy study (docs/accuracy.md): its problems and settings by name.
 from amontons.accuracy.settings import problem_kind, settings_by_name
 
+ACCURACY_SPHERE = config["accuracy"]["sphere"]
+
+
+def accuracy_sphere_inputs(wildcards):
+    """The AFM map a rough-sphere problem presses and the PSF every problem is rendered with."""
+    sphere = ACCURACY_SPHERE
+    material = sphere_row(sphere)["material"]
+    inputs = {"psf": measured(material, sphere, "psf.json")}
+    if accuracy_geometry(wildcards.problem) == "sphere":
+        inputs["levelled"] = measured(material, sphere, "afm_before_levelled.h5")
+    return inputs
+
 
 def accuracy_geometry(problem):
     return problem_kind(problem)[1]
