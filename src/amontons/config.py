@@ -502,7 +502,7 @@ def check_accuracy_study(config: Mapping, sheet: Mapping[str, dict], source: str
     """The accuracy study's sphere (null: the first sphere of the first selected material,
     set in place) must be a sphere of a selected material, and its grid and reference must
     make sense (amontons.accuracy.settings.check_accuracy)."""
-    from amontons.accuracy.settings import AccuracyConfigError, check_accuracy
+    from amontons.accuracy.settings import check_accuracy  # it imports this module
 
     study = config["accuracy"]
     if study["sphere"] is None:
@@ -517,7 +517,4 @@ def check_accuracy_study(config: Mapping, sheet: Mapping[str, dict], source: str
             f"materials {list(config['materials'])}; expected one of "
             f"{', '.join(s for s, r in sheet.items() if r['material'] in config['materials'])}"
         )
-    try:
-        check_accuracy(study, source)
-    except AccuracyConfigError as error:
-        raise ConfigError(str(error)) from error
+    check_accuracy(study, source)

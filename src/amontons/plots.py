@@ -212,15 +212,21 @@ def plot_amontons_deviation(
     for ax, (column, label, name) in zip(axes, panels, strict=True):
         for sphere, rows in table.groupby("sphere", sort=False):
             ax.plot(rows["normal_force_mn"] / reference_load_mn, rows[column], "o-", label=sphere)
-        ax.plot(span, span, "k--", lw=0.8, label="Amontons (∝ F)")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel(f"F / {reference_load_mn:g} mN")
-        ax.set_ylabel(label)
-        ax.set_title(name, fontsize=9)
-        ax.legend(fontsize=7)
+        amontons_axes(ax, span, reference_load_mn, label, name, legend_size=7)
     fig.suptitle(title, fontsize=9)
     _save(fig, paths)
+
+
+def amontons_axes(ax, span, reference_load_mn: float, ylabel: str, title: str, legend_size):
+    """One panel of Fig. B.13: log-log against F / F_ref (mN) with Amontons' law (slope 1)
+    over ``span``, the quantity ``ylabel`` normalised at the reference load."""
+    ax.plot(span, span, "k--", lw=0.8, label="Amontons (∝ F)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(f"F / {reference_load_mn:g} mN")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=legend_size)
 
 
 def plot_contact_separation(

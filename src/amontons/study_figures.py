@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 
-from amontons.plots import _save  # noqa: E402
+from amontons.plots import _save, amontons_axes  # noqa: E402
 
 
 @dataclass(frozen=True)
@@ -211,13 +211,7 @@ def plot_normalised_study(
         (axes[0], "a) contact area", "A / A_ref"),
         (axes[1], "b) static friction", "F_s / F_s,ref"),
     ):
-        ax.plot(span, span, "k--", lw=0.8, label="Amontons (∝ F)")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel(f"F / {reference_load_mn:g} mN")
-        ax.set_ylabel(label)
-        ax.set_title(name, fontsize=9)
-        ax.legend(fontsize=6)
+        amontons_axes(ax, span, reference_load_mn, label, name, legend_size=6)
     for ax in axes:
         _plain_log_ticks(ax)
     fig.suptitle(_wrapped(title, 110), fontsize=9)

@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from amontons.measure.area import OtsuSettings, otsu_contact_area
-from amontons.simulate.grid import PixelAverager
-from amontons.simulate.render import image_side_px, render_contact
+from amontons.measure.area import OtsuSettings
+from amontons.simulate.render import render_load_series
 from amontons.simulate.surface import area_average
 
 
@@ -41,20 +40,17 @@ def relative_l2(field: np.ndarray, reference: np.ndarray) -> float:
 def rendered_areas_um2(
     results, spacing_m: float, window_m: float, *, pixel_m: float, psf_fwhm_m: float, otsu
 ) -> list[float]:
-    """Otsu area (µm²) of each load rendered like the microscope sees it (emission law, bare
-    √p) on the common image of the fluorescence pixel ``pixel_m`` over ``window_m``."""
-    side = image_side_px(window_m, pixel_m)
-    averager = PixelAverager(results[0].pressure.shape, spacing_m, (side, side), pixel_m)
-    settings = otsu if isinstance(otsu, OtsuSettings) else OtsuSettings.from_config(otsu)
-    areas = []
-    for result in results:
-        image = render_contact(
-            result.pressure,
-            result.contact,
-            spacing_m,
-            pixel_m=pixel_m,
-            psf_fwhm_m=psf_fwhm_m,
-            averager=averager,
-        )
-        areas.append(otsu_contact_area(image, pixel_m, settings).area_m2 * 1e12)
-    return areas
+    """Otsu area (µm²) of each load rendered like the microscope sees it (the scenes'
+    rendering, :func:`amontons.simulate.render.render_load_series`: emission law, bare √p)
+    on the common image of the fluorescence pixel ``pixel_m`` over ``window_m``."""
+    rendered = render_load_series(
+        [{"pressure": r.pressure, "contact": r.contact} for r in results],
+        spacing_m,
+        pixel_m=pixel_m,
+        psf_fwhm_m=psf_fwhm_m,
+        rendering="emission",
+        confinement_floor_pa=0.0,
+        otsu=OtsuSettings.from_config(otsu),
+        window_m=window_m,
+    )
+    return [r.otsu.area_m2 * 1e12 for r in rendered]

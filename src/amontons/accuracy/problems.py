@@ -15,7 +15,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from amontons.accuracy.settings import Setting, problem_kind
 from amontons.contact import ContactResult, solve_load_series
@@ -122,17 +121,17 @@ def periodic_problem(setting: Setting, spec: Mapping) -> Problem:
 
 
 def solve_problem(problem: Problem, setting: Setting) -> tuple[list[ContactResult], float]:
-    """The load series at ``setting`` and its wall time (s): one thread, as a scene job."""
+    """The load series at ``setting`` and its wall time (s): one thread, as a scene job
+    (solve_load_series bounds the thread pools itself)."""
     start = time.perf_counter()
-    with threadpool_limits(limits=1):
-        results = solve_load_series(
-            problem.heights,
-            problem.pixel_m,
-            problem.e_star_pa,
-            list(problem.loads_n),
-            periodic=problem.periodic,
-            tol=setting.tol,
-            plasticity=problem.plasticity,
-            coarse_to_fine=setting.coarse_to_fine,
-        )
+    results = solve_load_series(
+        problem.heights,
+        problem.pixel_m,
+        problem.e_star_pa,
+        list(problem.loads_n),
+        periodic=problem.periodic,
+        tol=setting.tol,
+        plasticity=problem.plasticity,
+        coarse_to_fine=setting.coarse_to_fine,
+    )
     return results, time.perf_counter() - start

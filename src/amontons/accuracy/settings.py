@@ -15,6 +15,8 @@ import itertools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from amontons.config import ConfigError
+
 # problem -> (contact model, geometry)
 PROBLEMS = {
     "elastic_sphere": ("elastic", "sphere"),
@@ -24,7 +26,7 @@ PROBLEMS = {
 REFERENCE = "reference"
 
 
-class AccuracyConfigError(ValueError):
+class AccuracyConfigError(ConfigError):
     """An accuracy study the config cannot run (names the key)."""
 
 

@@ -210,6 +210,15 @@ def _increment(gap, increment: Increment, periodic: bool):
     return volume_conserving_increment(gap, periodic)
 
 
+def _penetration_at_bound(pressure, gap, p_max):
+    """The negative gap (m) where the pressure is at its bound ``p_max`` (Pa), 0 elsewhere.
+
+    Only points at the bound yield (appendix: "where p = p_Y the material deforms
+    plastically"); a free point's gap is the elastic solver's residual, not flow. BoundedWall
+    clips to the bound exactly, so ``>=`` is ``==`` there."""
+    return np.where((pressure >= p_max) & (gap < 0.0), gap, 0.0)
+
+
 def _plastic_iteration(
     operator,
     heights,
@@ -252,9 +261,7 @@ def _plastic_iteration(
         state = _appendix_state(out, h_pl, displacement, tally, outer)
         if not out.converged:
             return state
-        # Only points at the bound yield (appendix: "where p = p_Y the material deforms
-        # plastically"); a free point's gap is the elastic solver's residual, not flow.
-        yielding = np.where((p >= p_max) & (out.gap < 0.0), out.gap, 0.0)
+        yielding = _penetration_at_bound(p, out.gap, p_max)
         worst = float(-yielding.min())
         if worst <= tol * h_scale:
             residual = max(out.residual, worst / h_scale)
@@ -690,10 +697,7 @@ def _hardness_bounded(
         constraint=BoundedWall(p_y),
         raise_on_failure=False,
     )
-    # Only points at the bound yield (as in _plastic_iteration): a free point's gap is the
-    # solver's residual, not flow. BoundedWall clips to p_Y exactly, so == would do; >= is
-    # the appendix route's test.
-    flow = np.where((out.pressure >= p_y) & (out.gap < 0.0), out.gap, 0.0)
+    flow = _penetration_at_bound(out.pressure, out.gap, p_y)
     plastic = plastic_prev + local_increment(flow)
     message = out.message
     if out.converged:
