@@ -1,9 +1,9 @@
 """Rule fit_timing_model: wall time and peak memory of a solve as a function of its FFT grid,
-iterations and tolerance, fitted to the accuracy study's measured points (docs/accuracy.md)."""
+contact extent, tolerance and plastic law, fitted to the accuracy study's measured solves
+and its timing points (docs/accuracy.md, "Timing model")."""
 
 import logging
 
-from amontons.accuracy.settings import problem_kind
 from amontons.accuracy.timing import fit_timing_model
 from amontons.io.files import read_json, write_json
 from amontons.runlog import run_logged
@@ -11,19 +11,22 @@ from amontons.runlog import run_logged
 log = logging.getLogger(__name__)
 
 
+# what the fit reads of each solve's summary (amontons.accuracy.problems.cost_record)
+KEYS = ("model", "fft_points", "periodic", "contact_px", "ratio", "tol", "convolutions")
+COST = ("wall_time_s", "peak_rss_mb")
+
+
 def main(summary_paths: list, model_path: str) -> None:
     points = []
     for path in summary_paths:
         summary = read_json(path)
+        if summary.get("outside_window"):
+            log.info("%s: outside its window, left out", path)
+            continue
         points.append(
             {
-                "model": problem_kind(summary["problem"])[0],
-                "fft_points": summary["fft_points"],
+                **{key: summary[key] for key in KEYS + COST},
                 "loads": len(summary["loads"]),
-                "tol": summary["tol"],
-                "iterations": summary["iterations"],
-                "wall_time_s": summary["wall_time_s"],
-                "peak_rss_mb": summary["peak_rss_mb"],
             }
         )
     model = fit_timing_model(points)
@@ -37,4 +40,9 @@ def main(summary_paths: list, model_path: str) -> None:
 
 if __name__ == "__main__":
     sm = snakemake  # noqa: F821 (injected by Snakemake)
-    run_logged(main, sm.log[0], summary_paths=list(sm.input.summaries), model_path=sm.output.model)
+    run_logged(
+        main,
+        sm.log[0],
+        summary_paths=list(sm.input.summaries) + list(sm.input.timing_points),
+        model_path=sm.output.model,
+    )

@@ -123,7 +123,10 @@ def main(
             "area_ratio_largest": rows[-1].area_ratio,
             "wall_time_s": solution.wall_time_s,
             "loads": [
-                {**row.to_record(), **{k: info[k] for k in ("iterations", "outer_iterations")}}
+                {
+                    **row.to_record(),
+                    **{k: info[k] for k in ("iterations", "outer_iterations", "convolutions")},
+                }
                 for row, info in zip(rows, solution.per_load, strict=True)
             ],
         },

@@ -10,7 +10,12 @@ if "snakemake" in globals():
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
 from amontons.accuracy.compare import common_side_px, on_common_grid, rendered_areas_um2
-from amontons.accuracy.problems import periodic_problem, solve_problem, sphere_problem
+from amontons.accuracy.problems import (
+    cost_record,
+    periodic_problem,
+    solve_problem,
+    sphere_problem,
+)
 from amontons.accuracy.settings import (
     common_pixel_factor,
     common_window_factor,
@@ -96,17 +101,12 @@ def main(
         "problem": problem_name,
         "setting": setting_name,
         **setting.to_record(),
+        "model": problem_kind(problem_name)[0],
         "pixel_nm": problem.pixel_m * 1e9,
-        "side_px": problem.heights.shape[0],
-        "periodic": problem.periodic,
-        "fft_points": problem.heights.size * (1 if problem.periodic else 4),
         "window_um": problem.window_m * 1e6,
         "common_pixel_nm": common_pixel * 1e9,
         "common_side_px": side,
-        "wall_time_s": wall_time_s,
-        "peak_rss_mb": peak_mb,
-        "iterations": sum(p["iterations"] for p in per_load),
-        "convolutions": sum(p["convolutions"] for p in per_load),
+        **cost_record(problem, results, wall_time_s, peak_mb),
         "loads": per_load,
     }
     write_load_series(

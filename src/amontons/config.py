@@ -271,9 +271,17 @@ def solver_side_px(scene: Mapping, diameter_mm: float | None, e_star_gpa: float,
         n = int(scene["side_px"])
     else:
         window_um = _scene_window_um(scene, diameter_mm, e_star_gpa, loads)
-        pixel_um = max(scene["pixel_nm"] * 1e-3, window_um / scene["max_side_px"])
-        n = int(round(window_um / pixel_um))
+        n = int(round(window_um / solver_pixel_um(scene, diameter_mm, e_star_gpa, loads)))
     return n + n % 2
+
+
+def solver_pixel_um(scene: Mapping, diameter_mm: float | None, e_star_gpa: float, loads):
+    """The solver pixel (µm) of a scene, as :func:`solver_side_px`: its pixel_nm, coarsened
+    where the window would exceed max_side_px."""
+    if scene["side_px"] is not None:
+        return scene["pixel_nm"] * 1e-3
+    window_um = _scene_window_um(scene, diameter_mm, e_star_gpa, loads)
+    return max(scene["pixel_nm"] * 1e-3, window_um / scene["max_side_px"])
 
 
 def _check_scene_window(name: str, scene: Mapping, spheres: Mapping[str, dict], source: str):

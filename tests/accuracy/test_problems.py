@@ -51,3 +51,40 @@ def test_common_grid_keeps_the_force_of_a_centred_field():
     common = on_common_grid(p, a, side, c)
     assert common.sum() * c**2 == pytest.approx(p.sum() * a**2, rel=1e-12)
     assert relative_l2(common, common) == 0.0
+
+
+def _levelled_sphere():
+    """A rough sphere's levelled map: R = 0.3 mm cap plus a self-affine surface, 100 nm pixels."""
+    from amontons.contact.surfaces import self_affine
+    from amontons.measure.topography import sphere_cap
+    from amontons.simulate.surface import LevelledMap
+
+    n, pixel, radius = 256, 100e-9, 0.3e-3
+    rough = self_affine((n, n), pixel, 0.8, rms_height=20e-9, short_cutoff=0.4e-6, rng=2)
+    heights = sphere_cap((n, n), pixel, radius, (0.0, 0.0)) + rough
+    return LevelledMap(heights, pixel, radius, (0.0, 0.0), float(heights.max()))
+
+
+RECORD = {
+    "sphere": "test",
+    "diameter_mm": 0.6,
+    "e_star_gpa": 3.7,
+    "loads": [1.0, 2.0],
+    "hardness_mpa": 200.0,
+    "hardening_k_mpa_per_nm": 5.0,
+}
+
+
+@pytest.mark.parametrize(("model", "ratio"), [("hardening", 0.3), ("penetration_hardness", 1.2)])
+def test_a_timing_point_sets_its_law_from_its_ratio(model, ratio):
+    """k = s·πE*/(2Δx) and p_Y = y·E*·h'/2 give back the ratio asked for (to rounding), and
+    the contact extent is the Hertz diameter at the largest load in solver pixels."""
+    from amontons.accuracy.problems import timing_problem
+    from amontons.physics.hertz import contact_radius
+
+    setting = Setting(2, 1e-4, 1.5, False)
+    problem = timing_problem(model, ratio, setting, _levelled_sphere(), RECORD, "test map")
+    assert problem.ratio == pytest.approx(ratio, rel=1e-12)
+    assert problem.pixel_m == pytest.approx(200e-9)
+    diameter = 2 * contact_radius(2e-3, 0.3e-3, 3.7e9)
+    assert problem.contact_px == pytest.approx(diameter / 200e-9, rel=1e-12)

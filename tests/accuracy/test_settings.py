@@ -73,3 +73,21 @@ def test_a_reference_less_converged_than_a_setting_is_refused(key, value, text):
 def test_an_unknown_problem_is_refused():
     with pytest.raises(AccuracyConfigError, match="'rough_plate'.*expected one of"):
         check_accuracy({**STUDY, "problems": ["rough_plate"]}, "config.yaml")
+
+
+def test_timing_points_are_named_by_model_and_ratio():
+    from amontons.accuracy.settings import Setting, timing_points, timing_setting
+
+    study = {
+        "timing_points": {
+            "setting": {"pixel_factor": 4, "tol": 1e-4, "window_factor": 1.5},
+            "stiffness_ratio": [0.03, 3.0],
+            "yield_ratio": [0.6],
+        }
+    }
+    assert timing_points(study) == {
+        "hardening_s0.03": ("hardening", 0.03),
+        "hardening_s3": ("hardening", 3.0),
+        "penetration_hardness_y0.6": ("penetration_hardness", 0.6),
+    }
+    assert timing_setting(study) == Setting(4, 1e-4, 1.5, False)

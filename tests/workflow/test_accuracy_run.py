@@ -76,3 +76,22 @@ def test_errors_fall_as_the_pixel_is_refined(accuracy_run):
         for measure in ("area_error", "pressure_error"):
             values = group[measure].to_numpy()
             assert (values[1:] < values[:-1]).all(), (problem, measure, values)
+
+
+def test_timing_points_vary_the_plastic_ratio_and_enter_the_model(accuracy_run, study_config):
+    """Each timing point is solved at the ratio it names (to rounding), and the fitted model
+    has a count for both plastic models: a softer hardening layer (smaller s) costs fewer
+    convolutions per load, as its better-conditioned operator K + 1/k should (γ > 0)."""
+    import json
+
+    from amontons.accuracy.settings import timing_points
+
+    for point, (model, ratio) in timing_points(study_config).items():
+        summary = json.loads((accuracy_run / "timing" / point / "summary.json").read_text())
+        assert summary["model"] == model
+        if summary["outside_window"] is None:
+            assert summary["ratio"] == pytest.approx(ratio, rel=1e-9)
+            assert summary["convolutions"] > 0 and summary["wall_time_s"] > 0
+    record = json.loads((accuracy_run / "timing_model.json").read_text())
+    assert set(record["convolutions"]) == {"elastic", "hardening", "penetration_hardness"}
+    assert record["convolutions"]["hardening"]["gamma"] > 0

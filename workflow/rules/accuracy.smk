@@ -40,6 +40,35 @@ rule solve_accuracy_setting:
         "../../scripts/solve_accuracy_setting.py"
 
 
+rule solve_timing_point:
+    input:
+        levelled=accuracy_levelled_map(),
+    output:
+        summary=f"{ACCURACY}/timing/{{point}}/summary.json",
+    log:
+        f"{ACCURACY_LOGS}/timing/{{point}}/solve_timing_point.log",
+    benchmark:
+        f"{ACCURACY_LOGS}/timing/{{point}}/solve_timing_point.benchmark.tsv"
+    wildcard_constraints:
+        point=r"(hardening|penetration_hardness)_[sy][0-9.e+-]+",
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=measured_mem_mb("solve_accuracy_setting"),
+        runtime=measured_runtime("solve_accuracy_setting"),
+    params:
+        study=lambda wc: sorted_keys(
+            {"timing_points": config["accuracy"]["timing_points"]}
+        ),
+        record=lambda wc: {
+            **scene_sphere_record(ACCURACY_SPHERE),
+            "sphere": ACCURACY_SPHERE,
+        },
+    script:
+        "../../scripts/solve_timing_point.py"
+
+
 rule tabulate_accuracy:
     input:
         summaries=accuracy_files("summary.json"),
@@ -96,6 +125,7 @@ rule plot_accuracy:
 rule fit_timing_model:
     input:
         summaries=accuracy_files("summary.json"),
+        timing_points=timing_point_files(),
     output:
         model=f"{ACCURACY}/timing_model.json",
     log:

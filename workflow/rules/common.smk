@@ -555,8 +555,8 @@ def study_overview_outputs():
 # Cluster resources (README, "On a cluster"): each rule's measured wall time and peak memory,
 # and for the solves a model in their FFT grid and loads (amontons.resources), from
 # workflow/resources.json (benchmarks/fit_job_resources.py).
-from amontons.config import solver_side_px
-from amontons.accuracy.timing import predict
+from amontons.config import hertz_diameter_um, solver_pixel_um, solver_side_px
+from amontons.accuracy.timing import predict, stiffness_ratio, yield_ratio
 from amontons.resources import JobResources, mem_mb_of, runtime_min
 
 # The accuracy study's timing model (workflow/timing_model.json, a copy of
@@ -577,33 +577,65 @@ def measured_mem_mb(rule):
     return RESOURCES.mem_mb(rule)
 
 
-def solve_size(scene, sphere=None):
-    """(model, solver grid side px, periodic, loads, tol) of a scene's solve on ``sphere``
-    (None: synthetic)."""
+def solve_size(scene, sphere=None, scan=None, value=None):
+    """What the timing model needs of a scene's solve on ``sphere`` (None: synthetic), with
+    the scan parameter ``scan`` (p_y_mpa or k_mpa_per_nm) at ``value`` if given: model and
+    the keyword arguments of amontons.accuracy.timing.predict."""
     spec = config["scenes"][scene]
     if sphere is None:
         synthetic = spec["synthetic"]
         diameter = 2 * synthetic.get("radius_mm", 0.0) or None
         e_star, loads = synthetic["e_star_gpa"], spec["loads"]
+        slope = synthetic.get("rms_slope")
+        law = spec
     else:
         row = sphere_row(sphere)
         diameter, e_star = row["diameter_mm"], row["e_star_gpa"]
         loads = row["loads"] if spec["loads"] == "measured" else spec["loads"]
-    side = solver_side_px(spec, diameter, e_star, loads)
+        slope = None  # the map's slope is known only once it is levelled
+        law = {
+            "p_y_mpa": spec["p_y_mpa"] or row.get("hardness_mpa"),
+            "k_mpa_per_nm": spec["k_mpa_per_nm"] or row.get("hardening_k_mpa_per_nm"),
+        }
+    if scan is not None:
+        law = {**law, scan: float(value)}
     periodic = spec["geometry"] == "flat_periodic"
-    return spec["model"], side, periodic, len(loads), spec["tol"]
+    pixel_um = solver_pixel_um(spec, diameter, e_star, loads)
+    contact_px = None
+    if diameter is not None:
+        contact_px = hertz_diameter_um(max(loads), diameter, e_star) / pixel_um
+    ratio = None
+    if spec["model"] == "hardening" and law.get("k_mpa_per_nm"):
+        ratio = stiffness_ratio(
+            law["k_mpa_per_nm"] * 1e15, pixel_um * 1e-6, e_star * 1e9
+        )
+    elif spec["model"] == "penetration_hardness" and slope and law.get("p_y_mpa"):
+        ratio = yield_ratio(law["p_y_mpa"] * 1e6, e_star * 1e9, slope)
+    return spec["model"], {
+        "side_px": solver_side_px(spec, diameter, e_star, loads),
+        "periodic": periodic,
+        "loads": len(loads),
+        "tol": spec["tol"],
+        "contact_px": contact_px,
+        "ratio": ratio,
+    }
+
+
+def scan_solve(wildcards):
+    """A scan job's solve for the timing model: its scene on its sphere at its value."""
+    scan = SCANS[wildcards.scan]
+    return scan["scene"], wildcards.sphere, scan["parameter"], wildcards.value
 
 
 def predicted_solve(scene_of, wildcards):
     """(wall time s, peak memory MB) the timing model predicts for a scene's solve."""
-    model, side, periodic, loads, tol = solve_size(*scene_of(wildcards))
-    return predict(
-        TIMING_MODEL, model, side_px=side, periodic=periodic, loads=loads, tol=tol
-    )
+    model, size = solve_size(*scene_of(wildcards))
+    return predict(TIMING_MODEL, model, **size)
 
 
 def solve_runtime(rule, scene_of):
-    """Runtime (min) of a solve job: ``scene_of(wildcards)`` gives (scene, sphere or None);
+    """Runtime (min) of a solve job: ``scene_of(wildcards)`` gives (scene, sphere or None[,
+    scan parameter, value]);
     the timing model's prediction (docs/accuracy.md) with the resources' safety factor.
     """
 
@@ -623,7 +655,7 @@ def solve_mem_mb(rule, scene_of):
 
 
 # The accuracy study (docs/accuracy.md): its problems and settings by name.
-from amontons.accuracy.settings import problem_kind, settings_by_name
+from amontons.accuracy.settings import problem_kind, settings_by_name, timing_points
 
 ACCURACY_SPHERE = config["accuracy"]["sphere"]
 
@@ -631,15 +663,28 @@ ACCURACY_SPHERE = config["accuracy"]["sphere"]
 def accuracy_sphere_inputs(wildcards):
     """The AFM map a rough-sphere problem presses and the PSF every problem is rendered with."""
     sphere = ACCURACY_SPHERE
-    material = sphere_row(sphere)["material"]
-    inputs = {"psf": measured(material, sphere, "psf.json")}
+    inputs = {"psf": measured(sphere_row(sphere)["material"], sphere, "psf.json")}
     if accuracy_geometry(wildcards.problem) == "sphere":
-        inputs["levelled"] = measured(material, sphere, "afm_before_levelled.h5")
+        inputs["levelled"] = accuracy_levelled_map()
     return inputs
+
+
+def accuracy_levelled_map():
+    """The levelled AFM map of the accuracy study's sphere."""
+    sphere = ACCURACY_SPHERE
+    return measured(sphere_row(sphere)["material"], sphere, "afm_before_levelled.h5")
 
 
 def accuracy_geometry(problem):
     return problem_kind(problem)[1]
+
+
+def timing_point_files():
+    """The summary of every timing point of the accuracy study."""
+    return [
+        f"{RESULTS}/accuracy/timing/{point}/summary.json"
+        for point in timing_points(config["accuracy"])
+    ]
 
 
 def accuracy_files(name):

@@ -23,12 +23,8 @@ rule scan_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=solve_mem_mb(
-            "scan_scene", lambda wc: (SCANS[wc.scan]["scene"], wc.sphere)
-        ),
-        runtime=solve_runtime(
-            "scan_scene", lambda wc: (SCANS[wc.scan]["scene"], wc.sphere)
-        ),
+        mem_mb=solve_mem_mb("scan_scene", scan_solve),
+        runtime=solve_runtime("scan_scene", scan_solve),
     params:
         scan=lambda wc: sorted_keys(SCANS[wc.scan]),
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),

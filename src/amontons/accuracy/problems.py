@@ -10,6 +10,7 @@ its pixel, window, tolerance and start do to the solve.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -17,8 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from amontons.accuracy.settings import Setting, problem_kind
+from amontons.accuracy.timing import stiffness_ratio, yield_ratio
 from amontons.contact import ContactResult, solve_load_series
 from amontons.contact.surfaces import self_affine
+from amontons.physics.hertz import contact_radius
 from amontons.simulate.scene import Scene, scene_for_sphere
 from amontons.simulate.surface import LevelledMap, afm_indenter
 
@@ -29,8 +32,10 @@ UNCAPPED_SIDE_PX = 1 << 20
 @dataclass(frozen=True)
 class Problem:
     """One problem at one setting: heights (m, rigid indenter, larger = closer), pixel (m),
-    E* (Pa), loads (N), periodic, the plasticity law (None: elastic), the window side (m) and
-    the finest pixel of the study (m)."""
+    E* (Pa), loads (N), periodic, the plasticity law (None: elastic), the window side (m),
+    the finest pixel of the study (m), and what the timing model reads of it: the contact's
+    extent in pixels (a sphere's Hertz diameter at the largest load; a periodic surface's
+    side) and a plastic law's dimensionless ratio (amontons.accuracy.timing; None: elastic)."""
 
     heights: np.ndarray
     pixel_m: float
@@ -40,18 +45,24 @@ class Problem:
     plasticity: object
     window_m: float
     finest_pixel_m: float
+    contact_px: float
+    ratio: float | None
 
 
 def sphere_scene(problem: str, setting: Setting, levelled: LevelledMap, record: Mapping) -> Scene:
     """The scene of a rough-sphere problem at ``setting``: the sphere's measured loads, its
     sheet E* and k, the pixel ``pixel_factor`` × the AFM map's."""
-    model, _ = problem_kind(problem)
+    model = problem_kind(problem)[0]
+    return _sphere_scene(f"accuracy:{problem}", model, setting, levelled.pixel_m, record)
+
+
+def _sphere_scene(name: str, model: str, setting: Setting, map_pixel_m: float, record) -> Scene:
     config = {
         "surface": "afm_before",
         "geometry": "sphere",
         "model": model,
         "loads": "measured",
-        "pixel_nm": setting.pixel_factor * levelled.pixel_m * 1e9,
+        "pixel_nm": setting.pixel_factor * map_pixel_m * 1e9,
         "window_factor": setting.window_factor,
         "side_px": None,
         "max_side_px": UNCAPPED_SIDE_PX,
@@ -61,13 +72,33 @@ def sphere_scene(problem: str, setting: Setting, levelled: LevelledMap, record: 
         "p_y_mpa": None,
         "k_mpa_per_nm": None,
     }
-    return scene_for_sphere(f"accuracy:{problem}", config, record["sphere"], record)
+    return scene_for_sphere(name, config, record["sphere"], record)
 
 
 def sphere_problem(problem: str, setting: Setting, levelled: LevelledMap, record, source: str):
     """The rough sphere at ``setting`` (its AFM map on the setting's grid)."""
     scene = sphere_scene(problem, setting, levelled, record)
+    return _sphere_problem(scene, afm_indenter(levelled, scene, source), levelled)
+
+
+def timing_problem(
+    model: str, ratio: float, setting: Setting, levelled: LevelledMap, record, source: str
+) -> Problem:
+    """A timing point: the rough sphere at ``setting`` under ``model`` with its law set by
+    the dimensionless ``ratio`` (amontons.accuracy.timing): hardening k = s·πE*/(2Δx),
+    penetration hardness p_Y = y·E*·h'_rms/2 with h'_rms the map's rms slope on the solver
+    grid."""
+    scene = _sphere_scene(f"timing:{model}", model, setting, levelled.pixel_m, record)
     indenter = afm_indenter(levelled, scene, source)
+    if model == "hardening":
+        law = {"k_pa_per_m": ratio * np.pi * scene.e_star_pa / (2.0 * scene.pixel_m)}
+    else:
+        slope = indenter.solver_statistics["slope_rms"]
+        law = {"p_y_pa": ratio * 0.5 * scene.e_star_pa * slope}
+    return _sphere_problem(dataclasses.replace(scene, **law), indenter, levelled)
+
+
+def _sphere_problem(scene: Scene, indenter, levelled: LevelledMap) -> Problem:
     return Problem(
         heights=indenter.heights,
         pixel_m=scene.pixel_m,
@@ -77,7 +108,21 @@ def sphere_problem(problem: str, setting: Setting, levelled: LevelledMap, record
         plasticity=scene.plasticity,
         window_m=scene.side_px * scene.pixel_m,
         finest_pixel_m=levelled.pixel_m,
+        contact_px=2.0
+        * contact_radius(max(scene.loads_n), scene.radius_m, scene.e_star_pa)
+        / scene.pixel_m,
+        ratio=_plastic_ratio(scene, indenter),
     )
+
+
+def _plastic_ratio(scene: Scene, indenter) -> float | None:
+    """The scene's law as the timing model's dimensionless ratio (None: elastic)."""
+    if scene.model == "hardening":
+        return stiffness_ratio(scene.k_pa_per_m, scene.pixel_m, scene.e_star_pa)
+    if scene.model == "penetration_hardness":
+        slope = indenter.solver_statistics["slope_rms"]
+        return yield_ratio(scene.p_y_pa, scene.e_star_pa, slope)
+    return None
 
 
 def periodic_surface(spec: Mapping) -> tuple[np.ndarray, float]:
@@ -117,7 +162,28 @@ def periodic_problem(setting: Setting, spec: Mapping) -> Problem:
         plasticity=None,
         window_m=fine.shape[0] * fine_pixel,
         finest_pixel_m=fine_pixel,
+        contact_px=float(heights.shape[0]),
+        ratio=None,
     )
+
+
+def cost_record(
+    problem: Problem, results: list[ContactResult], wall_time_s: float, peak_rss_mb: float
+) -> dict:
+    """What a solve cost and what the timing model reads of it (amontons.accuracy.timing):
+    grid, FFT points, contact extent, plastic ratio, wall time (s), peak memory (MB),
+    iterations and convolutions over all loads."""
+    return {
+        "side_px": problem.heights.shape[0],
+        "periodic": problem.periodic,
+        "fft_points": problem.heights.size * (1 if problem.periodic else 4),
+        "contact_px": problem.contact_px,
+        "ratio": problem.ratio,
+        "wall_time_s": wall_time_s,
+        "peak_rss_mb": peak_rss_mb,
+        "iterations": sum(int(r.iterations) for r in results),
+        "convolutions": sum(int(r.info.convolutions) for r in results),
+    }
 
 
 def solve_problem(problem: Problem, setting: Setting) -> tuple[list[ContactResult], float]:

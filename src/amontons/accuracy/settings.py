@@ -24,6 +24,9 @@ PROBLEMS = {
     "periodic": ("elastic", "flat_periodic"),
 }
 REFERENCE = "reference"
+# timing points (docs/accuracy.md, "Timing model"): plastic model -> the dimensionless number
+# they sweep, the one that sets the model's cost (amontons.accuracy.timing)
+TIMING_RATIOS = {"hardening": "stiffness_ratio", "penetration_hardness": "yield_ratio"}
 
 
 class AccuracyConfigError(ConfigError):
@@ -104,6 +107,25 @@ def settings_by_name(problem: str, config: Mapping) -> dict[str, Setting]:
     named = {s.name: s for s in problem_settings(problem, config["grid"])}
     named[REFERENCE] = reference_setting(problem, config["reference"])
     return named
+
+
+def timing_points(config: Mapping) -> dict[str, tuple[str, float]]:
+    """The timing points by name (e.g. ``penetration_hardness_y0.6``): (contact model, its
+    dimensionless ratio)."""
+    spec = config["timing_points"]
+    points = {}
+    for model, key in TIMING_RATIOS.items():
+        for value in spec[key]:
+            points[f"{model}_{key[0]}{value:g}"] = (model, float(value))
+    return points
+
+
+def timing_setting(config: Mapping) -> Setting:
+    """The one setting every timing point is solved at."""
+    spec = config["timing_points"]["setting"]
+    return Setting(
+        int(spec["pixel_factor"]), float(spec["tol"]), float(spec["window_factor"]), False
+    )
 
 
 def common_pixel_factor(config: Mapping) -> int:

@@ -1,17 +1,36 @@
 """The timing model (docs/accuracy.md, "Timing model"): a solve's wall time and peak memory
-from its FFT grid, its iterations and its preset, fitted to the accuracy study's measured
-points. :func:`predict` is pure Python (the workflow sizes jobs with it while it builds the
-DAG); :func:`fit_timing_model` needs numpy.
+from its FFT grid, its contact model and its tolerance, fitted to the accuracy study's
+measured points. :func:`predict` is pure Python (the workflow sizes jobs with it while it
+builds the DAG); :func:`fit_timing_model` needs numpy.
 
-Per load series on an FFT grid of N points (n² periodic, (2n)² non-periodic):
+Per load series of L loads on an FFT grid of N points (n² periodic, the padded (2n)²-ish
+grid of a window otherwise):
 
-    iterations per load  I = exp(b0 + b1·log10(1/tol) + b2·ln N)      (per contact model)
-    wall time            t = c_0 + c_fix·N + c_it·L·I·N·log2 N
-    peak memory          m = m0 + m1·N
+    convolutions per load  C_el = exp(b0 + b_p·[periodic] + b1·log10(1/tol) + b2·ln P)
+                                                                          (elastic)
+                           C    = C_el · exp(a) · (z / (1 + z))^γ            (plastic models)
+    wall time              t = c_0 + c_conv·L·C·N·log2 N
+    peak memory            m = m0 + m1·N
 
-c_it is the cost of one CG iteration per N·log2 N (one FFT pair dominates it), c_fix the
-per-solve work linear in N (surface, Green's function, plans), c_0 what every solve costs
-whatever its grid (FFTW plans, dispatch of the compiled kernels); L the number of loads.
+P is the number of pixels the contact can cover: the whole grid n² of a periodic surface,
+(D/Δx)² on a sphere, D its Hertz contact diameter at the largest load and Δx the pixel (CG
+iterations grow with the contact's extent in pixels, not with the empty window around it).
+A convolution (one FFT pair) is the unit of work: a CG iteration costs one or two of them
+depending on the route, and each load adds a few of its own (the approach search), so
+counting convolutions rather than iterations keeps one cost per unit across models.
+
+z is the dimensionless number that decides how far a plastic solve departs from the elastic
+one (docs/accuracy.md §6):
+
+- contact hardening, the stiffness ratio s = 2kΔx/(πE*): the Winkler layer of stiffness k
+  against the half-space's stiffness at the pixel scale. The operator K + 1/k is better
+  conditioned the softer the layer (small s: few iterations); s ≫ 1 is the elastic limit.
+- penetration hardness, the yield ratio y = p_Y/(E*·h'_rms/2): the yield pressure against a
+  rough surface's elastic mean contact pressure. At small y most contact points sit at the
+  bound and the CG works on the few free ones; y ≫ 1 is the elastic limit.
+
+Where z is not known (None: a dry run before the AFM map's slope is measured) the model
+takes z/(1+z) = 1, the elastic limit, which over-predicts soft layers and low yield ratios.
 """
 
 from __future__ import annotations
@@ -21,69 +40,139 @@ from collections.abc import Mapping, Sequence
 
 from amontons.resources import fft_points
 
-
-def iterations_per_load(model_record: Mapping, tol: float, points: int) -> float:
-    b0, b1, b2 = model_record["iterations"]
-    return math.exp(b0 + b1 * math.log10(1.0 / tol) + b2 * math.log(points))
+# the dimensionless number each plastic model's convolutions follow (module docstring)
+PLASTIC_RATIO = {"hardening": "stiffness_ratio", "penetration_hardness": "yield_ratio"}
 
 
-def predict(record: Mapping, model: str, *, side_px: int, periodic: bool, loads: int, tol: float):
-    """(wall time s, peak memory MB) of a load series of ``loads`` loads: the fitted
-    iterations of ``model`` at ``tol`` (a model the study did not measure takes the elastic
-    one's), then the time and memory model. ``record``: the JSON :func:`fit_timing_model`
-    writes."""
+def stiffness_ratio(k_pa_per_m: float, pixel_m: float, e_star_pa: float) -> float:
+    """s = 2kΔx/(πE*): a hardening layer's stiffness k (Pa/m) over the half-space's at the
+    pixel Δx (m), E* (Pa)."""
+    return 2.0 * k_pa_per_m * pixel_m / (math.pi * e_star_pa)
+
+
+def yield_ratio(p_y_pa: float, e_star_pa: float, slope_rms: float) -> float:
+    """y = p_Y/(E*·h'_rms/2): the yield pressure (Pa) over a rough surface's elastic mean
+    contact pressure, from E* (Pa) and the rms slope at the solver pixel."""
+    return p_y_pa / (0.5 * e_star_pa * slope_rms)
+
+
+def convolutions_per_load(
+    record: Mapping,
+    model: str,
+    *,
+    tol: float,
+    periodic: bool,
+    contact_px: float,
+    ratio: float | None = None,
+) -> float:
+    """Predicted convolutions per load of ``model`` at ``tol``, the contact ``contact_px``
+    pixels across (a periodic surface: its side), its dimensionless ``ratio`` z (None: the
+    elastic limit). A model the study did not measure takes the elastic count."""
+    coef = record["convolutions"]["elastic"]["coef"]
+    features = _elastic_features(tol, periodic, contact_px)
+    count = math.exp(sum(c * f for c, f in zip(coef, features, strict=True)))
+    plastic = record["convolutions"].get(model)
+    if model == "elastic" or plastic is None:
+        return count
+    share = 1.0 if ratio is None else ratio / (1.0 + ratio)
+    return count * math.exp(plastic["offset"]) * share ** plastic["gamma"]
+
+
+def predict(
+    record: Mapping,
+    model: str,
+    *,
+    side_px: int,
+    periodic: bool,
+    loads: int,
+    tol: float,
+    contact_px: float | None = None,
+    ratio: float | None = None,
+) -> tuple[float, float]:
+    """(wall time s, peak memory MB) of a load series of ``loads`` loads of ``model`` on a
+    ``side_px`` grid at ``tol``: ``contact_px`` the Hertz contact diameter at the largest load
+    in pixels (None or periodic: the grid's side), ``ratio`` its z (:data:`PLASTIC_RATIO`;
+    None: the elastic limit). ``record``: the JSON :func:`fit_timing_model` writes."""
     points = fft_points(side_px, periodic)
-    per_model = record["models"].get(model, record["models"]["elastic"])
-    iterations = loads * iterations_per_load(per_model, tol, points)
-    time = record["time"]
-    seconds = (
-        time["c_0"]
-        + time["c_fix"] * points
-        + time["c_it"] * iterations * points * math.log2(points)
+    extent = side_px if periodic or contact_px is None else contact_px
+    count = loads * convolutions_per_load(
+        record, model, tol=tol, periodic=periodic, contact_px=extent, ratio=ratio
     )
+    time = record["time"]
+    seconds = time["c_0"] + time["c_conv"] * count * points * math.log2(points)
     memory = record["memory"]
     return seconds, memory["m0"] + memory["m1"] * points
 
 
+def _elastic_features(tol: float, periodic: bool, contact_px: float) -> list[float]:
+    return [1.0, float(periodic), math.log10(1.0 / tol), 2.0 * math.log(contact_px)]
+
+
+def _features(point: Mapping) -> list[float]:
+    return _elastic_features(point["tol"], point["periodic"], point["contact_px"])
+
+
+def _fit_elastic(rows: Sequence[Mapping]) -> dict:
+    import numpy as np
+
+    x = np.array([_features(p) for p in rows])
+    y = np.log([p["convolutions"] / p["loads"] for p in rows])
+    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+    return {"coef": [float(c) for c in coef], "points": len(rows)}
+
+
+def _fit_plastic(rows: Sequence[Mapping], elastic: Mapping) -> dict:
+    """offset a and exponent γ of a plastic model over the elastic count: least squares in
+    logs; γ = 0 where the points hold fewer than two distinct ratios."""
+    import numpy as np
+
+    b = np.array(elastic["coef"])
+    base = np.array([np.dot(b, _features(p)) for p in rows])
+    excess = np.log([p["convolutions"] / p["loads"] for p in rows]) - base
+    ratios = np.array([p["ratio"] for p in rows], float)
+    share = np.log(ratios / (1.0 + ratios))
+    if len(np.unique(np.round(share, 6))) < 2:
+        return {"offset": float(excess.mean()), "gamma": 0.0, "points": len(rows)}
+    x = np.column_stack([np.ones_like(share), share])
+    (offset, gamma), *_ = np.linalg.lstsq(x, excess, rcond=None)
+    return {"offset": float(offset), "gamma": float(gamma), "points": len(rows)}
+
+
 def fit_timing_model(points: Sequence[Mapping]) -> dict:
-    """Fit the model to measured solves: each point a mapping with model, fft_points, loads,
-    tol, iterations (all loads), wall_time_s and peak_rss_mb. Time by non-negative least
-    squares in relative terms (each point weighted by 1/t, so small solves count as much as
-    large ones); memory by the line under which no point lies above by more than its own
-    measurement (its largest excess over the fitted baseline); iterations by OLS in logs."""
+    """Fit the model to measured solves: each point a mapping with model, fft_points,
+    periodic, contact_px (periodic: the side), loads, tol, convolutions (all loads), ratio
+    (z of a plastic model), wall_time_s and peak_rss_mb.
+    Convolutions by least squares in logs (elastic first, each plastic model as its excess
+    over the elastic count); time by non-negative least squares in relative terms (each
+    point weighted by 1/t, so small solves count as much as large ones); memory by the line
+    under which no point lies above by more than its own measurement (its largest excess
+    over the fitted baseline)."""
     import numpy as np
     from scipy.optimize import nnls
 
+    elastic_rows = [p for p in points if p["model"] == "elastic"]
+    if not elastic_rows:
+        raise ValueError("the timing model needs elastic solves: none among the points")
+    counts = {"elastic": _fit_elastic(elastic_rows)}
+    for model in sorted({p["model"] for p in points} - {"elastic"}):
+        rows = [p for p in points if p["model"] == model and p.get("ratio") is not None]
+        if rows:
+            counts[model] = _fit_plastic(rows, counts["elastic"])
     n = np.array([p["fft_points"] for p in points], float)
     t = np.array([p["wall_time_s"] for p in points], float)
-    its = np.array([p["iterations"] for p in points], float)
-    design = np.column_stack([np.ones_like(n), n, its * n * np.log2(n)]) / t[:, None]
-    (c_0, c_fix, c_it), _ = nnls(design, np.ones_like(t))
-    predicted = c_0 + c_fix * n + c_it * its * n * np.log2(n)
+    work = np.array([p["convolutions"] for p in points], float) * n * np.log2(n)
+    (c_0, c_conv), _ = nnls(np.column_stack([np.ones_like(n), work]) / t[:, None], np.ones_like(t))
     memory = np.array([p["peak_rss_mb"] for p in points], float)
     m1, m0 = np.polyfit(n, memory, 1)
     m0 += float(np.max(memory - (m0 + m1 * n)))
-    models = {}
-    for model in sorted({p["model"] for p in points}):
-        rows = [p for p in points if p["model"] == model]
-        x = np.column_stack(
-            [
-                np.ones(len(rows)),
-                [math.log10(1.0 / p["tol"]) for p in rows],
-                [math.log(p["fft_points"]) for p in rows],
-            ]
-        )
-        y = np.log([p["iterations"] / p["loads"] for p in rows])
-        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-        models[model] = {"iterations": [float(c) for c in coef], "points": len(rows)}
-    ratio = predicted / t
+    ratio = (c_0 + c_conv * work) / t
     return {
-        "time": {"c_0": float(c_0), "c_fix": float(c_fix), "c_it": float(c_it)},
+        "time": {"c_0": float(c_0), "c_conv": float(c_conv)},
         "memory": {"m0": float(m0), "m1": float(m1)},
-        "models": models,
+        "convolutions": counts,
         "fit": {
             "points": len(points),
             "time_ratio_range": [float(ratio.min()), float(ratio.max())],
-            "note": "predicted / measured wall time at the measured iterations",
+            "note": "predicted / measured wall time at the measured convolutions",
         },
     }
