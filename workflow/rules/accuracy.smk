@@ -55,8 +55,8 @@ rule solve_timing_point:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=measured_mem_mb("solve_accuracy_setting"),
-        runtime=measured_runtime("solve_accuracy_setting"),
+        mem_mb=measured_mem_mb("solve_timing_point"),
+        runtime=measured_runtime("solve_timing_point"),
     params:
         study=lambda wc: sorted_keys(
             {"timing_points": config["accuracy"]["timing_points"]}
