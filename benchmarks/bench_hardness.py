@@ -14,13 +14,21 @@ rms height 30 nm, 51.2 µm non-periodic window, 512²), 5 loads 1–10 mN (geome
 8 hardness values from 15 MPa to 240 MPa (geometric), each a
 warm-started load series on the default ("bounded") route, against one elastic load
 series of the same sphere. Ratio = mean time of one hardness series / time of the elastic
-series (target ≤ 3); the medians over the repeats.
+series; the medians over the repeats.
+
+Part C (the scan warm-started from its neighbours): the scan of part B through
+``solve_scan``, each value's series started load by load from the previous value's
+pressures, in descending p_Y (from the nearly elastic end) and ascending order, against the
+independent series of part B and one elastic series, timed in alternation. Target: the
+whole scan ≤ 3× one elastic series. The fields agree with the independent series to the
+solver's tolerance (max |Δp| / p_Y printed).
 
 Both parts plan FFTs with FFTW_MEASURE (_common.TIMING_EFFORT), one thread, plain process.
 
     python benchmarks/bench_hardness.py                 # A at 256², 512²; B at 512²
     python benchmarks/bench_hardness.py --sizes 1024 --repeats 1 --skip-scan
-    python benchmarks/bench_hardness.py --quick         # A at 64²; B at 128²
+    python benchmarks/bench_hardness.py --quick         # A at 64²; B and C at 128²
+    python benchmarks/bench_hardness.py --skip-routes --skip-scan   # part C only
 """
 
 from __future__ import annotations
@@ -32,7 +40,14 @@ import numpy as np
 from _common import E_STAR, PBAR, TIMING_EFFORT, header, parser, rough_surface, table
 
 import amontons.contact.plasticity as plasticity
-from amontons.contact import PenetrationHardness, self_affine, solve, solve_load_series, sphere
+from amontons.contact import (
+    PenetrationHardness,
+    self_affine,
+    solve,
+    solve_load_series,
+    solve_scan,
+    sphere,
+)
 
 P_Y = 0.1  # E*
 RADIUS, E_STAR_PMMA = 0.75e-3, 3.5e9  # m, Pa
@@ -181,10 +196,64 @@ def part_b(n, repeats, threads):
     table(detail, list(detail[0]))
 
 
+def run_scan(h, dx, threads, p_ys):
+    t0 = time.perf_counter()
+    scan = solve_scan(
+        h, dx, E_STAR_PMMA, SCAN_LOADS, [PenetrationHardness(p) for p in p_ys],
+        threads=threads, planner_effort=TIMING_EFFORT,
+    )  # fmt: skip
+    return time.perf_counter() - t0, scan
+
+
+def part_c(n, repeats, threads):
+    h, dx = scan_sphere(n)
+    run_series(h, dx, threads)  # warm-up: plans, operator cache
+    run_series(h, dx, threads, PenetrationHardness(SCAN_P_Y[0]))
+    orders = {"descending p_Y": SCAN_P_Y[::-1], "ascending p_Y": SCAN_P_Y}
+    times = {key: [] for key in ("elastic", "independent", *orders)}
+    scans = {}
+    for _ in range(repeats):
+        times["elastic"].append(run_series(h, dx, threads)[0])
+        runs = [run_series(h, dx, threads, PenetrationHardness(p)) for p in SCAN_P_Y]
+        times["independent"].append(sum(t for t, _ in runs))
+        scans["independent"] = [series for _, series in runs]
+        for key, p_ys in orders.items():
+            t, scan = run_scan(h, dx, threads, p_ys)
+            times[key].append(t)
+            scans[key] = scan if key == "ascending p_Y" else scan[::-1]
+    elastic_s = statistics.median(times["elastic"])
+    rows = []
+    for key in ("independent", *orders):
+        scan = scans[key]
+        worst = max(
+            float(np.max(np.abs(a.pressure - b.pressure))) / p
+            for p, ours, ref in zip(SCAN_P_Y, scan, scans["independent"], strict=True)
+            for a, b in zip(ours, ref, strict=True)
+        )
+        rows.append(
+            {
+                "grid": f"{n}²",
+                "scan": key,
+                "scan s": statistics.median(times[key]),
+                "elastic series s": elastic_s,
+                "scan / elastic series": statistics.median(
+                    t / e for t, e in zip(times[key], times["elastic"], strict=True)
+                ),
+                "CG iterations per value": " ".join(
+                    str(sum(r.iterations for r in series)) for series in scan
+                ),
+                "max |Δp| / p_Y vs independent": worst,
+                "repeats": repeats,
+            }
+        )
+    table(rows, list(rows[0]))
+
+
 def main():
     ap = parser(__doc__.splitlines()[0])
-    ap.add_argument("--skip-scan", action="store_true", help="part A only")
-    ap.add_argument("--skip-routes", action="store_true", help="part B only")
+    ap.add_argument("--skip-scan", action="store_true", help="no part B")
+    ap.add_argument("--skip-routes", action="store_true", help="no part A")
+    ap.add_argument("--skip-neighbours", action="store_true", help="no part C")
     args = ap.parse_args()
     sizes = args.sizes or ([64] if args.quick else [256, 512])
     repeats = args.repeats or 3
@@ -193,6 +262,8 @@ def main():
         part_a(sizes, repeats, args.threads)
     if not args.skip_scan:
         part_b(128 if args.quick else 512, repeats, args.threads)
+    if not args.skip_neighbours:
+        part_c(128 if args.quick else 512, repeats, args.threads)
 
 
 if __name__ == "__main__":

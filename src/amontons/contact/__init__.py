@@ -22,8 +22,10 @@ Public API
 ----------
 ``solve(heights, spacing, e_star, *, load | displacement, periodic, tol, max_iter, threads,
 warm_start, coarse_to_fine, backend, plasticity, plastic_displacement, method, max_outer,
-planner_effort, raise_on_failure) -> ContactResult`` and ``solve_load_series(heights,
-spacing, e_star, loads, *, ...) -> list[ContactResult]``; the plasticity laws
+planner_effort, raise_on_failure) -> ContactResult``, ``solve_load_series(heights,
+spacing, e_star, loads, *, ..., warm_starts) -> list[ContactResult]`` and ``solve_scan(heights,
+spacing, e_star, loads, laws, **options) -> list[list[ContactResult]]`` (one load series per
+law, each warm-started from the previous law's); the plasticity laws
 ``PenetrationHardness(p_y)`` and ``ContactHardening(k)`` (:mod:`amontons.contact.plasticity`);
 surface synthesis ``sphere`` and ``self_affine`` (:mod:`amontons.contact.surfaces`).
 
@@ -79,7 +81,7 @@ Exceptions
     scipy modules).
 """
 
-from .api import solve, solve_load_series
+from .api import solve, solve_load_series, solve_scan
 from .plasticity import ContactHardening, PenetrationHardness
 from .result import (
     CoarseLevel,
@@ -107,5 +109,6 @@ __all__ = [
     "self_affine",
     "solve",
     "solve_load_series",
+    "solve_scan",
     "sphere",
 ]

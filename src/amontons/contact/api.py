@@ -230,6 +230,7 @@ def solve_load_series(
     max_outer=None,
     planner_effort=None,
     raise_on_failure=True,
+    warm_starts=None,
 ) -> list[ContactResult]:
     """Solve for increasing loads, each step warm-started from the previous pressure.
 
@@ -251,6 +252,11 @@ def solve_load_series(
     raise_on_failure : bool
         As in :func:`solve`. With False a step that does not converge is returned with
         ``success=False`` and the series goes on from its state: check every result.
+    warm_starts : sequence of array_like, optional
+        One starting pressure (Pa) per load, e.g. the pressures of the same loads under a
+        neighbouring law (:func:`solve_scan`). Without it each step starts from the previous
+        step's pressure scaled to its load. The plastic history always comes from the
+        series' own previous step.
 
     Returns
     -------
@@ -279,7 +285,15 @@ def solve_load_series(
         max_outer=max_outer,
         raise_on_failure=raise_on_failure,
     )
-    _warn_ignored(opts, h.shape, method=method, max_outer=max_outer, coarse_to_fine=coarse_to_fine)
+    starts = _checked_starts(warm_starts, arr.size, h.shape)
+    _warn_ignored(
+        opts,
+        h.shape,
+        method=method,
+        max_outer=max_outer,
+        coarse_to_fine=coarse_to_fine,
+        warm_start=starts is not None,
+    )
     plastic = None if opts.law is None else np.zeros(h.shape)
     results = []
     prev = None
@@ -293,9 +307,9 @@ def solve_load_series(
                     opts,
                     load=float(w),
                     displacement=None,
-                    warm_start=_scaled_start(prev, w),
+                    warm_start=_scaled_start(prev, w) if starts is None else starts[i],
                     plastic_prev=plastic,
-                    coarse_to_fine=bool(coarse_to_fine) and i == 0,
+                    coarse_to_fine=bool(coarse_to_fine) and i == 0 and starts is None,
                 )
             except ContactError as err:
                 # the error describes the solve; the caller also needs to know which step
@@ -306,6 +320,53 @@ def solve_load_series(
             results.append(res)
             prev = res
     return results
+
+
+def solve_scan(heights, spacing, e_star, loads: Sequence[float], laws: Sequence, **options):
+    """Load series of one surface under each plasticity law of ``laws`` in turn (a scan of
+    p_Y or k), each series warm-started load by load from the previous law's pressures.
+
+    Neighbouring laws give neighbouring contacts, so the previous law's pressure at the same
+    load is a closer start than the series' own previous load (benchmarks/README.md,
+    benchmark 7): order ``laws`` so that neighbours follow each other. ``options`` are those
+    of :func:`solve_load_series` (not ``plasticity`` nor ``warm_starts``).
+
+    Returns
+    -------
+    list of lists of ContactResult: one series per law, in the order given.
+
+    Raises
+    ------
+    As :func:`solve_load_series`; the error carries a note naming the law.
+    """
+    for key in ("plasticity", "warm_starts"):
+        if key in options:
+            raise ContactInputError(f"solve_scan sets {key} itself; got {key}={options[key]!r}")
+    scan = []
+    previous = None
+    for i, law in enumerate(laws):
+        starts = None if previous is None else [r.pressure for r in previous]
+        try:
+            series = solve_load_series(
+                heights, spacing, e_star, loads, plasticity=law, warm_starts=starts, **options
+            )
+        except ContactError as err:
+            err.add_note(f"scan value {i + 1} of {len(laws)} ({law!r})")
+            raise
+        scan.append(series)
+        previous = series
+    return scan
+
+
+def _checked_starts(warm_starts, count: int, shape) -> list[np.ndarray] | None:
+    """One validated starting pressure per load, or None."""
+    if warm_starts is None:
+        return None
+    if len(warm_starts) != count:
+        raise ContactInputError(
+            f"warm_starts must hold one pressure per load ({count}), got {len(warm_starts)}"
+        )
+    return [check_warm_start(w, shape) for w in warm_starts]
 
 
 def _scaled_start(prev, load):
