@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from amontons.accuracy.timing import predict, stiffness_ratio, yield_ratio
+from amontons.accuracy.timing import plastic_ratio, predict
 from amontons.physics.hertz import contact_radius
 
 REPO = Path(__file__).resolve().parents[1]
@@ -65,12 +65,13 @@ def _row(kind, solve, p_y_mpa, k_mpa_per_nm, seconds, point) -> dict:
     if not periodic and solve.get("radius_mm"):
         radius = contact_radius(max(solve["loads_mn"]) * 1e-3, solve["radius_mm"] * 1e-3, e_star)
         contact_px = 2 * radius / pixel_m
-    ratio = dry_ratio = None
-    if solve["model"] == "hardening":
-        ratio = dry_ratio = stiffness_ratio(k_mpa_per_nm * 1e15, pixel_m, e_star)
-    elif solve["model"] == "penetration_hardness":
-        slope = solve["surface_at_solver_pixel"]["slope_rms"]
-        ratio = yield_ratio(p_y_mpa * 1e6, e_star, slope)
+    law = {
+        "pixel_m": pixel_m,
+        "e_star_pa": e_star,
+        "k_pa_per_m": (k_mpa_per_nm or 0.0) * 1e15,
+        "p_y_pa": (p_y_mpa or 0.0) * 1e6,
+    }
+    slope = solve["surface_at_solver_pixel"]["slope_rms"]
     return {
         "kind": kind,
         "sphere": solve.get("sphere"),
@@ -82,8 +83,8 @@ def _row(kind, solve, p_y_mpa, k_mpa_per_nm, seconds, point) -> dict:
         "loads": len(solve["loads_mn"]),
         "tol": solve["tol"],
         "contact_px": contact_px,
-        "plastic_ratio": ratio,
-        "dry_ratio": dry_ratio,
+        "plastic_ratio": plastic_ratio(solve["model"], slope_rms=slope, **law),
+        "dry_ratio": plastic_ratio(solve["model"], **law),  # the slope unknown
         "measured_s": seconds,
     }
 

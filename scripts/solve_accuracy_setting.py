@@ -4,7 +4,6 @@ on (areas, rendered Otsu areas, pressure on the common grid), docs/accuracy.md."
 
 import logging
 import os
-import resource
 
 if "snakemake" in globals():
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
@@ -29,11 +28,6 @@ from amontons.runlog import run_logged
 from amontons.simulate.surface import load_levelled_map
 
 log = logging.getLogger(__name__)
-
-
-def _peak_rss_mb() -> float:
-    """The process's peak resident memory so far, MB (Linux reports kB)."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def _common_window_m(problem, study: dict, record: dict | None) -> float:
@@ -74,7 +68,7 @@ def main(
         problem.window_m * 1e6,
     )
     results, wall_time_s = solve_problem(problem, setting)
-    peak_mb = _peak_rss_mb()
+    cost = cost_record(problem, results, wall_time_s)  # the peak before the rendering
     common_pixel = problem.finest_pixel_m * common_pixel_factor(study)
     common_window = _common_window_m(problem, study, record)
     side = common_side_px(common_window, common_pixel)
@@ -106,7 +100,7 @@ def main(
         "window_um": problem.window_m * 1e6,
         "common_pixel_nm": common_pixel * 1e9,
         "common_side_px": side,
-        **cost_record(problem, results, wall_time_s, peak_mb),
+        **cost,
         "loads": per_load,
     }
     write_load_series(
@@ -125,7 +119,7 @@ def main(
         setting_name,
         wall_time_s,
         summary["iterations"],
-        peak_mb,
+        cost["peak_rss_mb"],
     )
 
 

@@ -4,7 +4,6 @@ for the timing model (docs/accuracy.md, "Timing model")."""
 
 import logging
 import os
-import resource
 
 if "snakemake" in globals():
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
@@ -40,7 +39,6 @@ def main(point: str, study: dict, levelled_path: str, record: dict, summary_path
         log.warning("%s: outside the window, left out of the timing model: %s", point, error)
         write_json(summary_path, {"point": point, "model": model, "outside_window": str(error)})
         return
-    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # Linux: kB
     summary = {
         "point": point,
         "model": model,
@@ -48,7 +46,7 @@ def main(point: str, study: dict, levelled_path: str, record: dict, summary_path
         **setting.to_record(),
         "pixel_nm": problem.pixel_m * 1e9,
         **_law_record(problem.plasticity),
-        **cost_record(problem, results, wall_time_s, peak_mb),
+        **cost_record(problem, results, wall_time_s),
         "loads": [
             {
                 "load_mn": r.load * 1e3,

@@ -556,7 +556,7 @@ def study_overview_outputs():
 # and for the solves a model in their FFT grid and loads (amontons.resources), from
 # workflow/resources.json (benchmarks/fit_job_resources.py).
 from amontons.config import hertz_diameter_um, solver_pixel_um, solver_side_px
-from amontons.accuracy.timing import predict, stiffness_ratio, yield_ratio
+from amontons.accuracy.timing import plastic_ratio, predict
 from amontons.resources import JobResources, mem_mb_of, runtime_min
 
 # The accuracy study's timing model (workflow/timing_model.json, a copy of
@@ -604,13 +604,14 @@ def solve_size(scene, sphere=None, scan=None, value=None):
     contact_px = None
     if diameter is not None:
         contact_px = hertz_diameter_um(max(loads), diameter, e_star) / pixel_um
-    ratio = None
-    if spec["model"] == "hardening" and law.get("k_mpa_per_nm"):
-        ratio = stiffness_ratio(
-            law["k_mpa_per_nm"] * 1e15, pixel_um * 1e-6, e_star * 1e9
-        )
-    elif spec["model"] == "penetration_hardness" and slope and law.get("p_y_mpa"):
-        ratio = yield_ratio(law["p_y_mpa"] * 1e6, e_star * 1e9, slope)
+    ratio = plastic_ratio(
+        spec["model"],
+        pixel_m=pixel_um * 1e-6,
+        e_star_pa=e_star * 1e9,
+        k_pa_per_m=(law.get("k_mpa_per_nm") or 0.0) * 1e15,
+        p_y_pa=(law.get("p_y_mpa") or 0.0) * 1e6,
+        slope_rms=slope,
+    )
     return spec["model"], {
         "side_px": solver_side_px(spec, diameter, e_star, loads),
         "periodic": periodic,

@@ -11,6 +11,7 @@ its pixel, window, tolerance and start do to the solve.
 from __future__ import annotations
 
 import dataclasses
+import resource
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -18,10 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from amontons.accuracy.settings import Setting, problem_kind
-from amontons.accuracy.timing import stiffness_ratio, yield_ratio
+from amontons.accuracy.timing import law_at_ratio, plastic_ratio
 from amontons.contact import ContactResult, solve_load_series
 from amontons.contact.surfaces import self_affine
 from amontons.physics.hertz import contact_radius
+from amontons.resources import fft_points
 from amontons.simulate.scene import Scene, scene_for_sphere
 from amontons.simulate.surface import LevelledMap, afm_indenter
 
@@ -90,11 +92,13 @@ def timing_problem(
     grid."""
     scene = _sphere_scene(f"timing:{model}", model, setting, levelled.pixel_m, record)
     indenter = afm_indenter(levelled, scene, source)
-    if model == "hardening":
-        law = {"k_pa_per_m": ratio * np.pi * scene.e_star_pa / (2.0 * scene.pixel_m)}
-    else:
-        slope = indenter.solver_statistics["slope_rms"]
-        law = {"p_y_pa": ratio * 0.5 * scene.e_star_pa * slope}
+    law = law_at_ratio(
+        model,
+        ratio,
+        pixel_m=scene.pixel_m,
+        e_star_pa=scene.e_star_pa,
+        slope_rms=indenter.solver_statistics["slope_rms"],
+    )
     return _sphere_problem(dataclasses.replace(scene, **law), indenter, levelled)
 
 
@@ -111,18 +115,15 @@ def _sphere_problem(scene: Scene, indenter, levelled: LevelledMap) -> Problem:
         contact_px=2.0
         * contact_radius(max(scene.loads_n), scene.radius_m, scene.e_star_pa)
         / scene.pixel_m,
-        ratio=_plastic_ratio(scene, indenter),
+        ratio=plastic_ratio(
+            scene.model,
+            pixel_m=scene.pixel_m,
+            e_star_pa=scene.e_star_pa,
+            k_pa_per_m=scene.k_pa_per_m,
+            p_y_pa=scene.p_y_pa,
+            slope_rms=indenter.solver_statistics["slope_rms"],
+        ),
     )
-
-
-def _plastic_ratio(scene: Scene, indenter) -> float | None:
-    """The scene's law as the timing model's dimensionless ratio (None: elastic)."""
-    if scene.model == "hardening":
-        return stiffness_ratio(scene.k_pa_per_m, scene.pixel_m, scene.e_star_pa)
-    if scene.model == "penetration_hardness":
-        slope = indenter.solver_statistics["slope_rms"]
-        return yield_ratio(scene.p_y_pa, scene.e_star_pa, slope)
-    return None
 
 
 def periodic_surface(spec: Mapping) -> tuple[np.ndarray, float]:
@@ -167,20 +168,19 @@ def periodic_problem(setting: Setting, spec: Mapping) -> Problem:
     )
 
 
-def cost_record(
-    problem: Problem, results: list[ContactResult], wall_time_s: float, peak_rss_mb: float
-) -> dict:
+def cost_record(problem: Problem, results: list[ContactResult], wall_time_s: float) -> dict:
     """What a solve cost and what the timing model reads of it (amontons.accuracy.timing):
-    grid, FFT points, contact extent, plastic ratio, wall time (s), peak memory (MB),
-    iterations and convolutions over all loads."""
+    grid, FFT points, contact extent, plastic ratio, wall time (s), the process's peak
+    memory so far (MB), iterations and convolutions over all loads."""
+    side = problem.heights.shape[0]
     return {
-        "side_px": problem.heights.shape[0],
+        "side_px": side,
         "periodic": problem.periodic,
-        "fft_points": problem.heights.size * (1 if problem.periodic else 4),
+        "fft_points": fft_points(side, problem.periodic),
         "contact_px": problem.contact_px,
         "ratio": problem.ratio,
         "wall_time_s": wall_time_s,
-        "peak_rss_mb": peak_rss_mb,
+        "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,  # Linux: kB
         "iterations": sum(int(r.iterations) for r in results),
         "convolutions": sum(int(r.info.convolutions) for r in results),
     }

@@ -15,6 +15,7 @@ import itertools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from amontons.accuracy.timing import PLASTIC_RATIO
 from amontons.config import ConfigError
 
 # problem -> (contact model, geometry)
@@ -24,9 +25,6 @@ PROBLEMS = {
     "periodic": ("elastic", "flat_periodic"),
 }
 REFERENCE = "reference"
-# timing points (docs/accuracy.md, "Timing model"): plastic model -> the dimensionless number
-# they sweep, the one that sets the model's cost (amontons.accuracy.timing)
-TIMING_RATIOS = {"hardening": "stiffness_ratio", "penetration_hardness": "yield_ratio"}
 
 
 class AccuracyConfigError(ConfigError):
@@ -114,7 +112,7 @@ def timing_points(config: Mapping) -> dict[str, tuple[str, float]]:
     dimensionless ratio)."""
     spec = config["timing_points"]
     points = {}
-    for model, key in TIMING_RATIOS.items():
+    for model, key in PLASTIC_RATIO.items():
         for value in spec[key]:
             points[f"{model}_{key[0]}{value:g}"] = (model, float(value))
     return points

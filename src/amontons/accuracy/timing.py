@@ -56,6 +56,36 @@ def yield_ratio(p_y_pa: float, e_star_pa: float, slope_rms: float) -> float:
     return p_y_pa / (0.5 * e_star_pa * slope_rms)
 
 
+def plastic_ratio(
+    model: str,
+    *,
+    pixel_m: float,
+    e_star_pa: float,
+    k_pa_per_m: float | None = None,
+    p_y_pa: float | None = None,
+    slope_rms: float | None = None,
+) -> float | None:
+    """The dimensionless ratio z of a solve under ``model`` (:data:`PLASTIC_RATIO`); None for
+    an elastic solve or where the law or the slope is not known (the elastic limit)."""
+    if model == "hardening" and k_pa_per_m:
+        return stiffness_ratio(k_pa_per_m, pixel_m, e_star_pa)
+    if model == "penetration_hardness" and p_y_pa and slope_rms:
+        return yield_ratio(p_y_pa, e_star_pa, slope_rms)
+    return None
+
+
+def law_at_ratio(
+    model: str, ratio: float, *, pixel_m: float, e_star_pa: float, slope_rms: float
+) -> dict:
+    """The plastic law whose ratio is ``ratio``, as Scene fields: hardening
+    ``k_pa_per_m`` = s·πE*/(2Δx) (Pa/m), penetration hardness ``p_y_pa`` = y·E*·h'_rms/2 (Pa)."""
+    if model == "hardening":
+        return {"k_pa_per_m": ratio / stiffness_ratio(1.0, pixel_m, e_star_pa)}
+    if model == "penetration_hardness":
+        return {"p_y_pa": ratio / yield_ratio(1.0, e_star_pa, slope_rms)}
+    raise ValueError(f"no plastic ratio for model {model!r}; expected one of {list(PLASTIC_RATIO)}")
+
+
 def convolutions_per_load(
     record: Mapping,
     model: str,
