@@ -21,6 +21,7 @@ import pytest
 from amontons.contact import (
     ConvergenceError,
     PenetrationHardness,
+    fused,
     solve,
     solve_load_series,
 )
@@ -149,7 +150,7 @@ def test_flat_punch_tends_to_full_plasticity(deficit):
     the punch, the load is met to round-off, and all but the pixels the deficit leaves
     below the bound sit at p_Y. At deficit 0 every contact pixel is at p_Y, so load =
     p_Y × area exactly, the approach is not fixed by the force and the route takes the
-    smallest admissible one (fused.fully_bound_approach): the least plastic flow, zero at
+    smallest admissible one (bounded_load.fully_bound_approach): the least plastic flow, zero at
     one pixel of the punch. Otherwise the oracle agrees."""
     h, punch = flat_punch()
     p_y = 0.01
@@ -200,3 +201,47 @@ def test_a_bounded_solve_that_cannot_converge_raises(sphere_case):
     assert res.success is False and res.status == 1 and res.info.route == "bounded"
     assert np.isfinite(res.pressure).all() and res.pressure.min() >= 0
     assert res.pressure.max() <= p_y
+
+
+@pytest.mark.parametrize("case", ["sphere", "periodic per-pixel"])
+def test_the_fused_load_step_matches_its_numpy_reference(sphere_case, case, monkeypatch):
+    """The default bounded load step keeps u = K*p by point responses and the rescale
+    u <- s·u - (s - 1)·K*p_bound (bounded_load.BoundedLoadSweep); its numpy reference takes
+    u afresh after every step. Same algorithm, so the same state to the solver's tolerance
+    (pressure 1e-6 p_Y as above; measured 3e-8), iterations within 5 % (round-off can move
+    a contact-set change by an iteration), and fewer convolutions: that is its point."""
+    if case == "sphere":
+        h, dx, load, p_y = sphere_case
+        kw = dict(spacing=dx, e_star=E_STAR)
+    else:
+        h = rough_plane()
+        dx, load = 1.0, 0.005 * h.size
+        checker = (np.indices(h.shape).sum(axis=0) % 2).astype(float)
+        p_y = 0.05 * (0.75 + 0.5 * checker)
+        kw = dict(spacing=1.0, e_star=1.0, periodic=True)
+    law = PenetrationHardness(p_y)
+    new = solve(h, load=load, plasticity=law, **kw)
+    monkeypatch.setattr(fused, "BOUNDED_LOAD_SWEEP", False)
+    ref = solve(h, load=load, plasticity=law, **kw)
+    assert new.success and ref.success
+    np.testing.assert_array_equal(new.contact, ref.contact)
+    np.testing.assert_allclose(new.pressure, ref.pressure, rtol=0, atol=1e-6 * np.max(p_y))
+    assert abs(new.iterations - ref.iterations) <= max(1, 0.05 * ref.iterations)
+    assert new.info.convolutions < ref.info.convolutions
+    assert new.load == pytest.approx(load, rel=1e-12)
+
+
+def test_a_start_above_the_bound_is_clipped_after_the_load_rescale(sphere_case):
+    """A warm start whose load rescale lifts points past p_Y must not keep them there. Here
+    twice the plastic state at half the load: clipped to p_Y first, it carries less than the
+    load, and the rescale then lifted its bound points to 1.3 p_Y, where a step that moves
+    only free points left them (a bug, fixed by clipping after the rescale). No pressure
+    above p_Y, and the state of a cold start (tolerances above)."""
+    h, dx, load, p_y = sphere_case
+    law = PenetrationHardness(p_y)
+    half = solve(h, dx, E_STAR, load=0.5 * load, plasticity=law)
+    warm = solve(h, dx, E_STAR, load=load, plasticity=law, warm_start=2 * half.pressure)
+    cold = solve(h, dx, E_STAR, load=load, plasticity=law)
+    assert warm.pressure.max() <= p_y
+    np.testing.assert_array_equal(warm.contact, cold.contact)
+    np.testing.assert_allclose(warm.pressure, cold.pressure, rtol=0, atol=1e-6 * p_y)

@@ -26,6 +26,12 @@ import numpy as np
 
 from . import fft as _fft
 from . import kernels as _k
+from .bounded_load import (
+    BoundedLoadSweep,
+    bounded_load_step,
+    fully_bound_approach,
+    impose_bounded_load,
+)
 from .result import CONVERGED, STALLED, ConvergenceError
 from .stall import StallMonitor
 
@@ -38,6 +44,10 @@ SPARSE_MAX_PERIODIC = 12
 # Largest Σa²/G of the one-pass moments about the previous approach (see _centred_moments).
 RECENTRE = 1e3
 SPARSE_MAX_PADDED = 32
+# Bounded load control on the fused sweep that keeps u = K*p without a convolution
+# (.bounded_load.BoundedLoadSweep); False takes the numpy step and a convolution per step,
+# the reference the tests compare with.
+BOUNDED_LOAD_SWEEP = True
 
 
 def fused_polonsky_keer(
@@ -136,8 +146,6 @@ def _loop(
     p[:] = np.ravel(p_init)
     if p.min() < 0:
         raise ValueError("p_init must be >= 0")
-    if bounded:
-        np.minimum(p, p_max, out=p)
     calls = 0
 
     def conv(x, out):
@@ -152,6 +160,9 @@ def _loop(
             p[:] = 1.0
             total = p.size
         p *= load / (pixel_area * total)
+    if bounded:
+        # after the load's rescale, which may push a start's points through the bound
+        np.minimum(p, p_max, out=p)
     # bounded load control: the force is imposed on the free points only (module docstring)
     bounded_load = bounded and load_control
     target = load / pixel_area if load_control else 0.0  # Σp, Pa
@@ -194,6 +205,9 @@ def _loop(
             SPARSE_MAX_PERIODIC if getattr(base_op, "periodic", False) else SPARSE_MAX_PADDED
         )
     green = None
+    sweep = None
+    if bounded_load and BOUNDED_LOAD_SWEEP and not winkler:
+        sweep = BoundedLoadSweep(base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf)
     monitor = StallMonitor()  # as in cg.polonsky_keer
     while it < max_iter:
         if history and monitor.update(history[-1]):
@@ -278,29 +292,23 @@ def _loop(
             # the convergence test below needs the pressure change: keep the old field
             # (this pass is paid only in the last iterations; otherwise p is updated in place)
             p_old = np.copy(p) if p_old is None else _copy(p, p_old)
-        if bounded_load:
+        how = None  # how u followed the step, when the bounded load step says
+        if sweep is not None:
+            p, m, n_clip, n_add, pen, how, backtracked = sweep.step(
+                p, u, r, t, h, m, d, tau, violators, idx_buf, val_buf, counts
+            )
+        elif bounded_load:
             n_clip, n_add, pen, backtracked = bounded_load_step(
                 p, u, h, m, t, p_max, d, tau, target
             )
+            # the step rescaled the free points only: u is taken afresh
+            conv(p, u)
+            how = "full: bounded load"
         else:
-            psum, pen = _k.update(
-                p,
-                p,
-                u,
-                r,
-                t,
-                h,
-                m,
-                p_max,
-                bounded,
-                sigma,
-                d,
-                tau,
-                violators,
-                idx_buf,
-                val_buf,
-                counts,
-            )
+            psum, pen, _ = _k.update(
+                p, p, u, r, t, h, m, p_max, bounded, sigma, d, tau,
+                violators, idx_buf, val_buf, counts, False,
+            )  # fmt: skip
             n_clip = int(counts[:, 0].sum())
             n_add = int(counts[:, 1].sum())
             backtracked = False
@@ -321,13 +329,18 @@ def _loop(
         if load_control and not bounded_load:
             sigma = load / (pixel_area * psum)
         changes = n_clip + n_add
-        if bounded_load:
-            # sigma stays 1 and the step rescaled the free points only (bounded_load_step):
-            # that changes u by a field of its own, so u is recomputed (a second
-            # convolution per iteration)
-            conv(p, u)
-            since_fresh = 0
-            updates["full: bounded load"] += 1
+        if how is not None:
+            # the bounded load step brought u to K*p itself (sigma stays 1)
+            if how.startswith("full"):
+                since_fresh = 0
+            elif since_fresh >= refresh:
+                conv(p, u)
+                since_fresh = 0
+                sweep.forget_bound_displacement()
+                how = "full: refresh"
+            else:
+                since_fresh += 1
+            updates[how] += 1
         elif since_fresh >= refresh or (changes and not (sparse_ok and changes <= sparse_max)):
             conv(p, u)
             since_fresh = 0
@@ -337,7 +350,7 @@ def _loop(
             if changes:
                 # u (stored, scale sigma_old) += K*c / sigma_old; u = K*p holds for the stored
                 # pair whatever their common scale, so the new scale needs no pass
-                idx, vals = _changed_points(counts, idx_buf, val_buf)
+                idx, vals = _k.changed_points(counts, idx_buf, val_buf)
                 if green is None:
                     green = base_op.real_space_kernel()
                 _k.add_point_responses(u.reshape(shape), green, idx, vals / sigma_old)
@@ -395,156 +408,6 @@ def _loop(
     )
 
 
-# Rounds of rescale-and-clip allowed to impose the load on the free points; each round clips
-# at least one point at p_max or ends, and one or two suffice in practice.
-MAX_LOAD_ROUNDS = 50
-
-
-def impose_bounded_load(p, m, t, p_max, target, u, h):
-    """Bounded load control: make ``Σp = target`` (Pa) keeping ``0 <= p <= p_max``.
-
-    The points at ``p_max`` keep their pressure; the free ones (``0 < p < p_max``) are
-    scaled by the common factor that makes the sum right: the load control of the hard wall
-    restricted to the points whose pressure no bound fixes. A free point the scale pushes
-    past ``p_max`` is clipped there and leaves the free set (``m = 0``, ``t = 0``), and the
-    scale is taken again; a negative pressure (a point falling from the bound by more than
-    its pressure) is clipped to 0 first. Two cases leave nothing to scale and restart the
-    field (the caller rebuilds ``m`` and resets the conjugation):
-
-    * every loaded point at the bound and load missing: the deficit goes to the unloaded
-      points next to touch, largest ``u - h`` first (``u``, ``h`` in m; ``u`` may be the
-      step's linear update, it only orders the candidates), each up to its ``p_max`` —
-      what raising the approach until they touch would do;
-    * the points at the bound alone carry more than the load: the excess is taken off the
-      points at the bound that are most open, largest ``u - h`` first, each down to 0 —
-      what lowering the approach until they leave contact would do.
-
-    Flat arrays, in place; ``m`` is uint8. Returns ``(points clipped, restarted)``.
-    """
-    clipped = 0
-    restarted = False
-    negative = np.flatnonzero(p < 0.0) if p.min() < 0.0 else None
-    if negative is not None:
-        p[negative] = 0.0
-        m[negative] = 0
-        t[negative] = 0.0
-        clipped += int(negative.size)
-    for _ in range(MAX_LOAD_ROUNDS):
-        below = p < p_max
-        free_sum = float(p.sum(where=below))
-        rest = target - float(p.sum(where=~below))
-        if rest < 0.0:
-            _release_bound_points(p, p_max, float(p.sum()) - target, u, h)
-            restarted = True
-            continue
-        if not free_sum > 0.0:
-            if rest > 0.0:
-                _fill_next_points(p, p_max, rest, u, h)
-                restarted = True
-            return clipped, restarted
-        scale = rest / free_sum
-        if scale == 1.0:
-            return clipped, restarted
-        p[below] *= scale
-        over = np.flatnonzero(below & (p > p_max))
-        if not over.size:
-            return clipped, restarted
-        p[over] = p_max[over]
-        m[over] = 0
-        t[over] = 0.0
-        clipped += int(over.size)
-    return clipped, restarted
-
-
-# Halvings of the step allowed in bounded_load_step before the load is imposed by moving
-# points on or off the bound instead.
-MAX_BACKTRACK = 30
-
-
-def bounded_load_step(p, u, h, m, t, p_max, d, tau, target):
-    """One CG step under ``0 <= p <= p_max`` and ``Σp = target`` (bounded load control).
-
-    As ``kernels.update`` (free points step to ``p - τ t``, constrained points that should be
-    free move by ``-τ g`` and join, everything is projected onto ``[0, p_max]``), then the
-    load is imposed on the free points (:func:`impose_bounded_load`). A step that clips so
-    many free points to ``p_max`` that the bound alone carries more than the load (or none
-    is left free to carry a deficit) is halved until it does not: the step that leaves the
-    previous, admissible field (τ → 0) always qualifies. ``u`` (m) must be ``K*p`` of the
-    current ``p`` (Pa); the free set ``m`` is rebuilt from the new field and ``t`` is zeroed
-    off it. Flat arrays, in place.
-
-    Returns ``(points that left the free set, points that joined it, max |g| over the
-    joining points (m), whether the step was shortened or the load imposed by a
-    restart)``: either way the conjugation is reset.
-    """
-    g = u - h - d
-    free = m != 0
-    rise = ~free & (p <= 0.0) & (g < 0.0) & (p_max > 0.0)
-    fall = ~free & (p >= p_max) & (g > 0.0) & (p > 0.0)
-    add = np.flatnonzero(rise | fall)
-    pen = float(np.abs(g[add]).max()) if add.size else 0.0
-    step = tau
-    shortened = False
-    for _ in range(MAX_BACKTRACK):
-        q = p - step * t
-        q[add] = p[add] - step * g[add]
-        np.clip(q, 0.0, p_max, out=q)
-        below = q < p_max
-        rest = target - float(q.sum(where=~below))
-        if rest >= 0.0 and (rest == 0.0 or float(q.sum(where=below)) > 0.0):
-            break
-        step *= 0.5
-        shortened = True
-    p[:] = q
-    _, restarted = impose_bounded_load(p, m, t, p_max, target, u, h)
-    new = (p > 0.0) & (p < p_max)
-    left = int(np.count_nonzero(free & ~new))
-    joined = int(np.count_nonzero(~free & new))
-    m[:] = new
-    t *= m
-    return left, joined, pen, shortened or restarted
-
-
-def _fill_next_points(p, p_max, deficit, u, h):
-    """Put ``deficit`` (Pa, summed) on the unloaded points next to touch, smallest gap
-    ``u - h - d`` (so smallest ``u - h``) first, each up to its ``p_max``
-    (impose_bounded_load)."""
-    cand = np.flatnonzero((p <= 0.0) & (p_max > 0.0))
-    order = cand[np.argsort(u[cand] - h[cand], kind="stable")]
-    room = np.cumsum(p_max[order])
-    k = int(np.searchsorted(room, deficit)) + 1  # points needed
-    take = order[:k]
-    p[take] = p_max[take]
-    # the last one takes what is left (its room minus the overshoot)
-    p[take[-1]] -= room[k - 1] - deficit if k <= room.size else 0.0
-
-
-def _release_bound_points(p, p_max, excess, u, h):
-    """Take ``excess`` (Pa, summed) off the points at the bound that open first as the
-    approach falls, largest gap ``u - h - d`` (so largest ``u - h``) first, each down to 0
-    (impose_bounded_load)."""
-    cand = np.flatnonzero(p >= p_max)
-    order = cand[np.argsort(h[cand] - u[cand], kind="stable")]
-    held = np.cumsum(p[order])
-    k = min(int(np.searchsorted(held, excess)) + 1, held.size)  # points to release
-    take = order[:k]
-    p[take[-1]] = held[k - 1] - excess if held[k - 1] > excess else 0.0
-    p[take[:-1]] = 0.0
-
-
-def fully_bound_approach(u, h, p, d):
-    """Approach (m) of a load-controlled bounded solve without free points: every loaded
-    point sits at ``p_max``, so the force does not fix the approach; any ``d`` with
-    ``g = u - h - d <= 0`` on the loaded points and ``>= 0`` on the others is a solution.
-    The smallest, ``max(u - h)`` over the loaded points, is taken: the least penetration
-    (for penetration hardness, the least plastic flow that carries the load). ``d`` is
-    returned unchanged when no point is loaded."""
-    loaded = p > 0.0
-    if not loaded.any():
-        return d
-    return float(np.max(u[loaded] - h[loaded]))
-
-
 def _copy(src, dst):
     np.copyto(dst, src)
     return dst
@@ -574,15 +437,6 @@ def _centred_moments(u, sigma, h, m, t, d_old, nc):
     s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d)
     mean = s1 / nc
     return d + mean, max(s2 - s1 * mean, 0.0), st - mean * tsum, 1
-
-
-def _changed_points(counts, idx_buf, val_buf):
-    """Flat indices and added pressures (Pa) of the points ``update`` recorded."""
-    per = counts.sum(axis=1)
-    rows = np.flatnonzero(per)
-    idx = np.concatenate([idx_buf[c, : per[c]] for c in rows])
-    vals = np.concatenate([val_buf[c, : per[c]] for c in rows])
-    return idx, vals
 
 
 def _final_complementarity(u, h, p, d, load_control, m, t, p_max, bounded):

@@ -226,7 +226,9 @@ def step_dots(r, t, m, compliance, winkler):
 
 
 @numba.njit(**_JIT)
-def update(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, idx, val, counts):
+def update(
+    p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, idx, val, counts, keep_mask
+):
     """One CG step in one sweep (stored fields, true value = ``sigma`` × stored).
 
     For each point, with the gap ``g = sigma·u - h - d`` (m) of this iteration:
@@ -245,11 +247,17 @@ def update(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, id
     counted by ``direction`` into ``violators``); the few chunks with an event run the
     scalar loop that records them, the rest a vectorised step.
 
-    Returns ``(Σ p_new, max |g| over the added points)`` (stored units, m).
+    With ``keep_mask`` (the bounded load step, :mod:`.bounded_load`) the free set ``m`` and
+    the direction ``t`` are left as they were (the events are still recorded), so that the
+    step can still be taken again from the old state, and joining points are projected onto
+    ``[0, p_max]`` too; the caller rebuilds ``m`` and ``t`` after its rescale.
+
+    Returns ``(Σ p_new, max |g| over the added points, Σ p_new over the points at
+    p_max)`` (stored units; the last is 0 without a bound).
     """
     n = p.size
     nch = (n + CHUNK - 1) // CHUNK
-    part = np.zeros((nch, 2))
+    part = np.zeros((nch, 3))
     step = tau / sigma
     for c in prange(nch):
         lo = c * CHUNK
@@ -263,22 +271,43 @@ def update(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, id
             ubc = p_max
             events = violators[c] or _clips_hard(pc, tc, mc, step)
         if events:
-            acc, pen, nclip, nadd = _chunk_with_events(
-                pc, pnc, uc, rc, tc, hc, mc, ubc, bounded, sigma, d, tau, idx[c], val[c], lo
+            acc, accb, pen, nclip, nadd = _chunk_with_events(
+                pc,
+                pnc,
+                uc,
+                rc,
+                tc,
+                hc,
+                mc,
+                ubc,
+                bounded,
+                sigma,
+                d,
+                tau,
+                idx[c],
+                val[c],
+                lo,
+                keep_mask,
             )
+        elif bounded:
+            acc, accb = _chunk_step_bounded(pc, pnc, uc, rc, tc, ubc, sigma, step)
+            pen, nclip, nadd = 0.0, 0, 0
         else:
             acc = _chunk_step(pc, pnc, uc, rc, tc, step)
-            pen, nclip, nadd = 0.0, 0, 0
+            accb, pen, nclip, nadd = 0.0, 0.0, 0, 0
         part[c, 0] = acc
         part[c, 1] = pen
+        part[c, 2] = accb
         counts[c, 0] = nclip
         counts[c, 1] = nadd
     total = 0.0
     pen = 0.0
+    at_bound = 0.0
     for c in range(nch):
         total += part[c, 0]
         pen = max(pen, part[c, 1])
-    return total, pen
+        at_bound += part[c, 2]
+    return total, pen, at_bound
 
 
 @numba.njit(**_INNER)
@@ -312,12 +341,30 @@ def _chunk_step(p, p_new, u, r, t, step):
     return acc
 
 
+@numba.njit(**_INNER)
+def _chunk_step_bounded(p, p_new, u, r, t, p_max, sigma, step):
+    """Event-free step of a bounded chunk: as ``_chunk_step``, plus ``Σ p_new`` over the
+    points at ``p_max`` (constrained points there keep ``t = 0``, so they stay)."""
+    acc = 0.0
+    accb = 0.0
+    for i in range(p.size):
+        q = p[i] - step * t[i]
+        p_new[i] = q
+        acc += q
+        accb += q * (sigma * q >= p_max[i])
+        u[i] -= step * r[i]
+    return acc, accb
+
+
 @numba.njit(cache=True)
-def _chunk_with_events(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, idx, val, lo):
+def _chunk_with_events(
+    p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, idx, val, lo, keep_mask
+):
     """The step of a chunk starting at flat index ``lo``, with its projection and violators
     recorded (``update``)."""
     step = tau / sigma
     acc = 0.0
+    accb = 0.0
     pen = 0.0
     nclip = 0
     nadd = 0
@@ -338,8 +385,9 @@ def _chunk_with_events(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, i
                 free = False
             if not free:
                 q = pn / sigma
-                m[i] = 0
-                t[i] = 0.0
+                if not keep_mask:
+                    m[i] = 0
+                    t[i] = 0.0
                 k = nclip + nadd
                 if k < SLOTS:
                     idx[k] = lo + i
@@ -350,18 +398,119 @@ def _chunk_with_events(p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, i
             rise = pn <= 0.0 and g < 0.0 and pn < ub
             fall = pn >= ub and g > 0.0 and pn > 0.0
             if rise or fall:
-                q = (pn - tau * g) / sigma
-                m[i] = 1
+                added = -tau * g
+                joined = pn + added
+                if keep_mask:
+                    # the bounded load step projects the joining points too (as its numpy
+                    # version, .bounded_load.bounded_load_step, does)
+                    if joined < 0.0 or joined > ub:
+                        joined = min(max(joined, 0.0), ub)
+                        added = joined - pn
+                else:
+                    m[i] = 1
+                q = joined / sigma
                 k = nclip + nadd
                 if k < SLOTS:
                     idx[k] = lo + i
-                    val[k] = -tau * g
+                    val[k] = added
                 nadd += 1
                 pen = max(pen, abs(g))
         p_new[i] = q
         acc += q
+        if bounded and sigma * q >= ub:
+            accb += q
         u[i] -= step * r[i]
-    return acc, pen, nclip, nadd
+    return acc, accb, pen, nclip, nadd
+
+
+@numba.njit(cache=True)
+def _rescale_chunk(p, u, v, m_old, m_new, t, p_max, s, with_u, idx, val, lo):
+    """``rescale_free`` on a chunk starting at flat index ``lo``."""
+    acc = 0.0
+    accb = 0.0
+    left = 0
+    joined = 0
+    nover = 0
+    for i in range(p.size):
+        q = p[i]
+        ub = p_max[i]
+        free = q > 0.0 and q < ub
+        if free:
+            q *= s
+            if q >= ub:
+                if nover < SLOTS:
+                    idx[nover] = lo + i
+                    val[nover] = ub - q
+                nover += 1
+                q = ub
+                free = False
+            p[i] = q
+        if not free:
+            t[i] = 0.0
+        if q >= ub:
+            accb += q
+        acc += q
+        m_new[i] = 1 if free else 0
+        was = m_old[i] != 0
+        left += was and not free
+        joined += free and not was
+        if with_u:
+            u[i] = s * u[i] - (s - 1.0) * v[i]
+    return acc, accb, left, joined, nover
+
+
+@numba.njit(**_JIT)
+def rescale_free(p, u, v, m_old, m_new, t, p_max, s, with_u, idx, val, counts):
+    """Scale the free points (``0 < p < p_max``) of ``p`` by ``s`` in place, clipping those
+    it pushes to ``p_max`` or past it, and rebuild the free set into ``m_new`` (uint8) with
+    ``t`` zeroed off it.
+
+    With ``with_u``, ``u ← s·u - (s - 1)·v``: if ``u = K*p`` and ``v = K*p_b`` (m, ``p_b``
+    the pressure of the points at the bound, Pa) before the call, ``u = K*p`` after it, up to
+    the clipped points. Those are recorded per chunk in ``idx[c, :]``, ``val[c, :]`` (the
+    pressure the clip added, Pa, ``<= 0``), ``counts[c, 0]`` (their number); they need
+    ``val`` added to ``u`` and ``p_max`` to ``v`` as point responses.
+
+    Returns ``(Σ p, Σ p over the points at p_max, points that left the free set m_old,
+    points that joined it)`` (Pa).
+    """
+    n = p.size
+    nch = (n + CHUNK - 1) // CHUNK
+    part = np.zeros((nch, 2))
+    moved = np.zeros((nch, 2), dtype=np.int64)
+    for c in prange(nch):
+        lo = c * CHUNK
+        hi = min(n, lo + CHUNK)
+        acc, accb, left, joined, nover = _rescale_chunk(
+            p[lo:hi],
+            u[lo:hi],
+            v[lo:hi],
+            m_old[lo:hi],
+            m_new[lo:hi],
+            t[lo:hi],
+            p_max[lo:hi],
+            s,
+            with_u,
+            idx[c],
+            val[c],
+            lo,
+        )
+        part[c, 0] = acc
+        part[c, 1] = accb
+        moved[c, 0] = left
+        moved[c, 1] = joined
+        counts[c, 0] = nover
+        counts[c, 1] = 0
+    total = 0.0
+    at_bound = 0.0
+    left = 0
+    joined = 0
+    for c in range(nch):
+        total += part[c, 0]
+        at_bound += part[c, 1]
+        left += moved[c, 0]
+        joined += moved[c, 1]
+    return total, at_bound, left, joined
 
 
 @numba.njit(**_INNER)
@@ -463,3 +612,15 @@ def multiply_spectrum(spec, multiplier):
         mrow = multiplier[i]
         for j in range(row.size):
             row[j] = row[j] * mrow[j]
+
+
+def changed_points(counts, idx_buf, val_buf):
+    """Flat indices and added pressures (Pa) of the points ``update`` (or
+    ``rescale_free``) recorded per chunk."""
+    per = counts.sum(axis=1)
+    rows = np.flatnonzero(per)
+    if not rows.size:
+        return np.empty(0, dtype=np.int64), np.empty(0)
+    idx = np.concatenate([idx_buf[c, : per[c]] for c in rows])
+    vals = np.concatenate([val_buf[c, : per[c]] for c in rows])
+    return idx, vals
