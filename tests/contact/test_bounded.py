@@ -66,7 +66,7 @@ def test_numpy_loop_refuses_bounded_load_control(problem):
 def test_bounded_load_control_is_the_displacement_controlled_solution(problem, per_pixel):
     """Load control with 0 <= p <= p_max (p_max 30 % of the elastic peak, so ~40 % of the
     contact sits at the bound): the load is met to round-off (the free points carry what
-    the bound points leave, fused.impose_bounded_load), and the displacement-controlled
+    the bound points leave, bounded_load.impose_bounded_load), and the displacement-controlled
     bounded solve at the returned approach gives the same field. Both solves run to 1e-10;
     the fields agree to 1e-8 of p_max (the residual is a gap, ~E*·g/Δx in pressure, and the
     approach is itself a solver output), and the bound holds exactly."""

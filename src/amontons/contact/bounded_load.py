@@ -12,8 +12,15 @@ keep their pressure and the free ones share what is left by one common factor
   the rescale in ``kernels.rescale_free``, keeping ``u = K*p`` without a convolution. The
   rescale multiplies the free part of the pressure by ``s`` and leaves the bound part
   ``p_b``, so ``K*p`` becomes ``s·K*p - (s - 1)·K*p_b``; ``v = K*p_b`` is carried from step
-  to step by point responses of the few points that join or leave the bound, and taken
-  afresh (one convolution) only when it was lost to a step that changed too many points.
+  to step by point responses of the few points that join or leave the bound. It is dropped,
+  and taken afresh (one convolution) at the next step that can use it, after a step that
+  changed too many points, a scale far from 1, the numpy fallback, a restart of the free
+  set, and whenever the solver changes the free set or ``u`` itself (a refresh; violators
+  added without a step).
+
+The two differ in one detail: the fused step, like ``kernels.update`` on every other route,
+lets a free point clipped to 0 rejoin in the same step when it penetrates; the numpy step
+adds only points that were constrained before it. Both converge to the same state.
 
 Flat float64 arrays, pressures in Pa, lengths in m; the free set ``m`` is uint8.
 """
@@ -27,6 +34,9 @@ from . import kernels as _k
 # Rounds of rescale-and-clip allowed to impose the load on the free points; each round clips
 # at least one point at p_max or ends, and one or two suffice in practice.
 MAX_LOAD_ROUNDS = 50
+# Largest rescale of the free points that BoundedLoadSweep follows by s·u - (s - 1)·v; a
+# larger one (a start far from the load) takes u afresh instead.
+MAX_SPARSE_SCALE = 2.0
 
 
 def impose_bounded_load(p, m, t, p_max, target, u, h):
@@ -41,9 +51,9 @@ def impose_bounded_load(p, m, t, p_max, target, u, h):
     field (the caller rebuilds ``m`` and resets the conjugation):
 
     * every loaded point at the bound and load missing: the deficit goes to the unloaded
-      points next to touch, largest ``u - h`` first (``u``, ``h`` in m; ``u`` may be the
-      step's linear update, it only orders the candidates), each up to its ``p_max`` —
-      what raising the approach until they touch would do;
+      points next to touch, smallest gap (smallest ``u - h``) first (``u``, ``h`` in m; ``u``
+      may be the step's linear update, it only orders the candidates), each up to its
+      ``p_max`` — what raising the approach until they touch would do;
     * the points at the bound alone carry more than the load: the excess is taken off the
       points at the bound that are most open, largest ``u - h`` first, each down to 0 —
       what lowering the approach until they leave contact would do.
@@ -180,7 +190,8 @@ class BoundedLoadSweep:
     ``base_op`` is the convolution (with ``real_space_kernel()`` when ``sparse_ok``),
     ``conv(x, out)`` the caller's counted ``out = K*x``, ``buf()`` an aligned work array;
     ``p_max`` (Pa) has one entry per point, ``target`` is the force over the pixel area
-    (Σp, Pa). At most ``sparse_max`` changed points are applied as point responses.
+    (Σp, Pa). At most ``sparse_max`` changed points of the step, and as many of each rescale
+    round, are applied as point responses; more, and ``u`` is convolved afresh.
     """
 
     def __init__(self, base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf):
@@ -203,8 +214,9 @@ class BoundedLoadSweep:
         self.green = None
 
     def forget_bound_displacement(self):
-        """Drop ``v``: the caller recomputed ``u`` from scratch (a refresh), and ``v`` is
-        then taken afresh too."""
+        """Drop ``v``: the caller recomputed ``u`` from scratch (a refresh) or changed the
+        free set itself (violators added without a step: a point at the bound made free
+        leaves the bound by a plain step, which ``update`` does not record)."""
         self.v = None
 
     def step(self, p, u, r, t, h, m, d, tau, violators, idx_buf, val_buf, counts):
@@ -214,8 +226,9 @@ class BoundedLoadSweep:
         Returns ``(p, m, left, joined, pen, how, reset)``: the new pressure and free set
         (arrays of this object's or the caller's, to use from now on), the points that left
         and joined the free set, the largest ``|g|`` over the joining points (m), how ``u``
-        was brought to ``K*p`` (a key of the solver's ``u_updates``), and whether the step
-        was shortened or restarted (the conjugation is then reset).
+        was brought to ``K*p`` (a key of the solver's ``u_updates``; a convolution that takes
+        ``v`` afresh is counted by ``conv`` but not there), and whether the step was
+        shortened or restarted (the conjugation is then reset).
         """
         q = self.spare
         total, pen, at_bound = _k.update(
@@ -237,6 +250,10 @@ class BoundedLoadSweep:
         reset = False
         for _ in range(MAX_LOAD_ROUNDS):
             s = rest / free_sum if free_sum > 0.0 else 1.0
+            if sparse and not 0.0 <= s <= MAX_SPARSE_SCALE:
+                # s·u - (s - 1)·v carries the round-off of u and v times |s|
+                sparse = False
+                self.v = None
             v = self.v if sparse else u  # v is not read without u
             total, at_bound, left, joined = _k.rescale_free(
                 q, u, v, m, m_new, t, self.p_max, s, sparse, self.idx, self.val, self.counts
@@ -253,8 +270,9 @@ class BoundedLoadSweep:
                 self.v = None
             rest = self.target - at_bound
             free_sum = total - at_bound
-            if not free_sum > 0.0:
-                # every free point clipped: the deficit goes to the next points to touch
+            if rest < 0.0 or not free_sum > 0.0:
+                # every free point clipped (the deficit goes to the next points to touch), or
+                # the bound's round-off above the load (the excess comes off the bound)
                 left, joined = self._restart_free_set(q, u, h, m, m_new, t)
                 sparse = False
                 self.v = None
@@ -271,7 +289,7 @@ class BoundedLoadSweep:
     def _numpy_step(self, p, u, r, t, h, m, d, tau):
         """The step that must be shortened: :func:`bounded_load_step` from the old state
         (``update`` left ``p``, ``m`` and ``t`` as they were), then ``u = K*p``."""
-        u += tau * r  # back to K*p to round-off: it only orders candidates there
+        u += tau * r  # back to K*p to round-off (it gives the gap of the joining points)
         left, joined, pen, _ = bounded_load_step(p, u, h, m, t, self.p_max, d, tau, self.target)
         self.conv(p, u)
         self.v = None
@@ -296,6 +314,7 @@ class BoundedLoadSweep:
             np.multiply(q, q >= self.p_max, out=self._bound_buf)
             self.v = self.conv(self._bound_buf, self._v_buf)
             return
+        idx = np.unique(idx)  # a point clipped and rejoined is recorded twice
         ub = self.p_max[idx]
         before = np.where(p[idx] >= ub, p[idx], 0.0)
         after = np.where(q[idx] >= ub, q[idx], 0.0)

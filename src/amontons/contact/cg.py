@@ -123,11 +123,12 @@ class HardWall:
 class BoundedWall(HardWall):
     """The constraint ``0 <= p <= p_max`` (``p_max`` scalar or per pixel, Pa).
 
-    Free set ``0 < p < p_max`` (a free point that reaches ``p_max`` exactly stays free
-    until it crosses it); points at ``p_max`` are constrained and become violators
+    Free set ``0 < p < p_max`` (under displacement control a free point that reaches
+    ``p_max`` exactly stays free until it crosses it; the load-controlled step counts it as
+    at the bound); points at ``p_max`` are constrained and become violators
     when their gap opens (``g > 0``). Load control runs on the fused loop only, which
     imposes the load on the free points and leaves those at the bound
-    (:func:`amontons.contact.fused.impose_bounded_load`); a rescale of the whole field, as
+    (:func:`amontons.contact.bounded_load.impose_bounded_load`); a rescale of the whole field, as
     the numpy loop does, would push points through the bound.
     """
 
@@ -262,7 +263,7 @@ def polonsky_keer(
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
     if constraint.bounded and load is not None and not kernels:
-        # the fused loop imposes the load on the free points (fused.impose_bounded_load);
+        # the fused loop imposes the load on the free points (bounded_load.impose_bounded_load);
         # the numpy reference loop only rescales the whole field, which would push points
         # at the bound through it
         raise ValueError(
@@ -568,7 +569,7 @@ def _finish(
             d = float(np.dot(u - h, m) / nc)
         else:
             # bounded, every loaded point at the bound: the force does not fix d
-            from .fused import fully_bound_approach
+            from .bounded_load import fully_bound_approach
 
             d = fully_bound_approach(u, h, p, d)
     gap = u - h - d

@@ -17,7 +17,8 @@ scale ``sigma`` (true ``p = sigma·P``, ``u = sigma·U``); ``u = K*p`` is linear
 ``U = K*P`` stays true when only ``sigma`` changes.
 
 Convergence, status codes, the full-convolution refresh and the sparse point-response
-update are those of :mod:`.cg`.
+update are those of :mod:`.cg`. Bounded load control (penetration hardness) keeps ``sigma``
+at 1 and takes its step and its rescale of the free points from :mod:`.bounded_load`.
 """
 
 from __future__ import annotations
@@ -250,6 +251,8 @@ def _loop(
             m[:] = 0
             m[start] = 1
             t[:] = 0.0
+            if sweep is not None:
+                sweep.forget_bound_displacement()
         if load_control:
             d, big_g, gt_old, recentred = _centred_moments(u, sigma, h, m, t, d, nc)
             recentres += recentred
@@ -283,6 +286,8 @@ def _loop(
                 break
             m[ol] = 1
             nc += int(ol.size)
+            if sweep is not None:
+                sweep.forget_bound_displacement()
             delta = 0.0
             g_old = 0.0
             continue

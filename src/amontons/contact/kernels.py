@@ -10,7 +10,9 @@ kernels do the same arithmetic in four sweeps (docs/models.md §2.2 gives the al
                   ``r += t/k``, so a hardening solve needs no extra pass);
 ``update``        pressure step, projection onto ``0 <= p <= p_max``, violator search,
                   free-set update, ``Σ p`` and the displacement axpy ``u -= τ r``, in one
-                  sweep, recording the few changed points for the sparse update.
+                  sweep, recording the few changed points for the sparse update;
+``rescale_free``  bounded load control: the free points scaled to the load, the free set
+                  rebuilt and ``u`` carried along (:mod:`.bounded_load`).
 
 Arrays are flat float64 (the free set ``m`` is uint8). Sums are taken over fixed chunks of
 ``CHUNK`` points and the partial sums added in chunk order, so every result is the same bit
@@ -401,8 +403,8 @@ def _chunk_with_events(
                 added = -tau * g
                 joined = pn + added
                 if keep_mask:
-                    # the bounded load step projects the joining points too (as its numpy
-                    # version, .bounded_load.bounded_load_step, does)
+                    # the bounded load step projects the joining points too, as its numpy
+                    # version (.bounded_load.bounded_load_step) does
                     if joined < 0.0 or joined > ub:
                         joined = min(max(joined, 0.0), ub)
                         added = joined - pn

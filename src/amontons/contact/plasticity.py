@@ -679,7 +679,7 @@ def _hardness_bounded(
     ``h + h_pl,prev`` and one update, since lowering a point at the bound to zero gap leaves
     the bounded solution unchanged (p = p_Y with g = 0 is admissible). So the bounded solve
     (0 <= p <= p_Y, Pa) is run under the load itself, with the approach as the Lagrange
-    multiplier of the force (fused.impose_bounded_load), instead of a root find on the
+    multiplier of the force (bounded_load.impose_bounded_load), instead of a root find on the
     approach; then ``h_pl = h_pl,prev + g·θ(−g)`` where ``p = p_Y`` (m) and the gap there
     closes to ``max(g, 0)``. The plastic history enters only through the heights. Units:
     heights, gaps, ``h_pl`` in m; ``p_y`` (per pixel) in Pa.
