@@ -3,7 +3,7 @@ the same process with every pool pinned to one thread by the environment (issue 
 
 Each figure is the median over --repeats fresh processes of the second solve in the process
 (the first builds FFT plans). Run: `.venv/bin/python benchmarks/bench_thread_pools.py`.
-This script does not import benchmarks/_common.py, which pins OpenBLAS for the other benchmarks.
+It sets each child's environment itself, so it does not import benchmarks/_common.py.
 """
 
 from __future__ import annotations

@@ -207,10 +207,6 @@ class BoundedLoadSweep:
         self.spare_mask = np.empty(n, dtype=np.uint8)
         self.v = None  # K*p_b (m), None while it is not known
         self._v_buf = self._bound_buf = None  # allocated on first use
-        nch = _k.n_chunks(n)
-        self.idx = np.zeros((nch, _k.SLOTS), dtype=np.int64)
-        self.val = np.zeros((nch, _k.SLOTS))
-        self.counts = np.zeros((nch, 2), dtype=np.int64)
         self.green = None
 
     def forget_bound_displacement(self):
@@ -221,7 +217,9 @@ class BoundedLoadSweep:
 
     def step(self, p, u, r, t, h, m, d, tau, violators, idx_buf, val_buf, counts):
         """One CG step from ``p`` along ``t`` with length ``tau`` (``r = K*t``, ``u = K*p``,
-        ``d`` the approach in m), the load imposed on the free points.
+        ``d`` the approach in m), the load imposed on the free points. ``idx_buf``,
+        ``val_buf`` and ``counts`` are the caller's event records (``kernels.update``),
+        reused by the rescale rounds once the step's events are applied.
 
         Returns ``(p, m, left, joined, pen, how, reset)``: the new pressure and free set
         (arrays of this object's or the caller's, to use from now on), the points that left
@@ -239,7 +237,8 @@ class BoundedLoadSweep:
         free_sum = total - at_bound
         if rest < 0.0 or (rest > 0.0 and not free_sum > 0.0):
             return self._numpy_step(p, u, r, t, h, m, d, tau)
-        sparse = int(counts.sum()) <= self.sparse_max
+        changed = int(counts.sum())
+        sparse = changed <= self.sparse_max
         if sparse:
             idx, vals = _k.changed_points(counts, idx_buf, val_buf)
             self._add_responses(u, idx, vals)
@@ -256,13 +255,13 @@ class BoundedLoadSweep:
                 self.v = None
             v = self.v if sparse else u  # v is not read without u
             total, at_bound, left, joined = _k.rescale_free(
-                q, u, v, m, m_new, t, self.p_max, s, sparse, self.idx, self.val, self.counts
+                q, u, v, m, m_new, t, self.p_max, s, sparse, idx_buf, val_buf, counts
             )
-            over = int(self.counts[:, 0].sum())
+            over = int(counts[:, 0].sum())
             if not over:
                 break
             if sparse and over <= self.sparse_max:
-                idx, vals = _k.changed_points(self.counts, self.idx, self.val)
+                idx, vals = _k.changed_points(counts, idx_buf, val_buf)
                 self._add_responses(u, idx, vals)
                 self._add_responses(self.v, idx, self.p_max[idx])
             else:
@@ -279,7 +278,7 @@ class BoundedLoadSweep:
                 reset = True
                 break
         if sparse:
-            how = "point responses" if int(counts.sum()) else "linear"
+            how = "point responses" if changed else "linear"
         else:
             self.conv(q, u)
             how = "full: changes"
