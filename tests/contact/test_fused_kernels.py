@@ -145,3 +145,161 @@ def test_bad_thread_count_is_refused(rough):
         polonsky_keer(
             op, h, pixel_area=1.0, h_scale=1.0, p_init=np.ones_like(h), load=load, threads=0
         )
+
+
+@pytest.mark.parametrize(
+    ("shape", "periodic", "pruned"),
+    [
+        ((40, 56), True, None),
+        ((41, 57), True, None),
+        ((40, 56), False, True),
+        ((33, 20), False, False),
+    ],
+)
+def test_convolution_in_halves_is_the_convolution(shape, periodic, pruned):
+    """forward + multiply_energy + inverse give the operator's K*t to round-off (1e-14 of the
+    peak), and multiply_energy returns Σ t·(K*t) by Parseval to 1e-12 relative: for an even
+    and an odd last axis (the Nyquist column is held once or not at all in the
+    half-spectrum) and on the Hockney-padded grid, pruned and plain."""
+    kw = {} if pruned is None else {"pruned": pruned}
+    op = get_operator(shape, 0.5, 2.0, periodic=periodic, **kw)
+    t = np.random.default_rng(1).normal(size=shape)
+    whole = op(t)
+    op.forward(t)
+    energy = op.multiply_energy()
+    halves = op.inverse(np.empty(shape))
+    assert np.abs(halves - whole).max() <= 1e-14 * np.abs(whole).max()
+    assert energy == pytest.approx(float(np.sum(t * whole)), rel=1e-12)
+
+
+class _Whole:
+    """An operator that offers only whole convolutions (as a custom one would)."""
+
+    def __init__(self, op):
+        self.op = op
+        self.periodic = op.periodic
+
+    def __call__(self, x, out=None):
+        return self.op(x, out=out)
+
+    def real_space_kernel(self):
+        return self.op.real_space_kernel()
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_skipping_the_inverse_keeps_the_iterates(rough, periodic):
+    """Taking r = K*t in halves changes which transforms run, not the iterates: the same
+    iterations and fields to 1e-10 of the peak as whole convolutions (the step's Σ r t comes
+    from the spectrum instead of a real-space sum, so the two paths differ by round-off,
+    measured 1.8e-12 on the sphere), and fewer FFT pairs (each iteration that takes u afresh
+    skips the inverse of K*t)."""
+    if periodic:
+        h, load = rough
+    else:
+        n = 128
+        h = sphere((n, n), 1.0, 4.0 * n)
+        load = 4 * (n / 5) ** 3 / (3 * 4.0 * n)
+    op = get_operator(h.shape, 1.0, 1.0, periodic=periodic)
+    kw = {"pixel_area": 1.0, "h_scale": float(h.std()), "tol": 1e-9, "max_iter": 2000}
+    kw.update(p_init=np.ones_like(h), load=load)
+    halves = polonsky_keer(op, h, **kw)
+    whole = polonsky_keer(_Whole(op), h, **kw)
+    assert halves.iterations == whole.iterations
+    scale = whole.pressure.max()
+    assert np.abs(halves.pressure - whole.pressure).max() <= 1e-10 * scale
+    skipped = halves.info["forward_only_transforms"]
+    assert skipped > 0 and whole.info["forward_only_transforms"] == 0
+    assert halves.convolutions == pytest.approx(whole.convolutions - 0.5 * skipped)
+
+
+def test_load_control_direction_has_zero_sum_on_the_free_set():
+    """direction with shift = β Σ t_old / nc leaves Σ_Ic t = 0 (to round-off of Σ|t|) when
+    the gap has zero mean on Ic and t_old does not sum to zero there (points clipped)."""
+    rng = np.random.default_rng(2)
+    n = 3 * K.CHUNK + 17
+    m = (rng.random(n) < 0.3).astype(np.uint8)
+    u, h, p = rng.normal(size=n), rng.normal(size=n), np.ones(n)
+    t = rng.normal(size=n) * m + 0.3 * m  # non-zero sum on the free set
+    nc = int(m.sum())
+    d = float(np.sum((u - h) * m)) / nc  # the approach: zero-mean gap on Ic
+    beta = 0.7
+    shift = beta * float(t.sum()) / nc
+    viol = np.zeros(K.n_chunks(n), dtype=np.int64)
+    vidx = np.zeros((K.n_chunks(n), K.SLOTS), dtype=np.int64)
+    vg = np.zeros((K.n_chunks(n), K.SLOTS))
+    K.direction(u, 1.0, h, m, t, d, beta, shift, p, np.full(1, np.inf), False, viol, vidx, vg)
+    assert abs(t.sum()) <= 1e-12 * np.abs(t).sum()
+    assert not np.any(t[m == 0])
+
+
+def _step_reference(p, u, t, h, m, sigma, d, tau):
+    """The hard-wall step in numpy (docs/models.md §2.2): free points step and clip at 0 and
+    leave the free set; constrained ones that penetrate (and the clipped ones) join at
+    -tau·g. Stored units: true p = sigma·p."""
+    g = sigma * u - h - d
+    q = p - tau / sigma * t
+    free = m.astype(bool)
+    clip = free & (q < 0)
+    q[clip] = 0.0
+    join = (~free | clip) & (g < 0)
+    q[join] = -tau * g[join] / sigma
+    m_new = ((free & ~clip) | join).astype(np.uint8)
+    return q, m_new, clip, join, g
+
+
+@pytest.mark.parametrize("record_max", [K.SLOTS, -1])
+def test_update_records_few_events_and_counts_many(record_max):
+    """update's two event paths, the recording one (a chunk's clipped points and the
+    violators direction recorded) and the branch-free one (no records), give the numpy
+    step's pressure, free set and counts; the recording one lists exactly the changed
+    points and the pressure each event added."""
+    rng = np.random.default_rng(4)
+    n = 2 * K.CHUNK + 100
+    m = (rng.random(n) < 0.4).astype(np.uint8)
+    p = np.where(m == 1, 0.1 + rng.random(n), 0.0)
+    t = np.where(m == 1, rng.normal(size=n), 0.0)
+    u, h = rng.normal(size=n), rng.normal(size=n)
+    sigma, d = 1.3, 0.0
+    # constrained points open (g = 1), but two per chunk penetrating (g = -0.5); three free
+    # points per chunk that the step drives below 0
+    tau = 1e-3
+    h[m == 0] = sigma * u[m == 0] - d - 1.0
+    for c in range(K.n_chunks(n)):
+        lo = c * K.CHUNK
+        free = lo + np.flatnonzero(m[lo : lo + 200])[:3]
+        t[free] = p[free] * sigma / tau * 1.5 + 1.0
+        fixed = lo + np.flatnonzero(m[lo : lo + 200] == 0)[:2]
+        h[fixed] = sigma * u[fixed] - d + 0.5
+    ref_p, ref_m, clip, join, g = _step_reference(p.copy(), u, t, h, m, sigma, d, tau)
+    nch = K.n_chunks(n)
+    viol = np.zeros(nch, dtype=np.int64)
+    vidx = np.zeros((nch, K.SLOTS), dtype=np.int64)
+    vg = np.zeros((nch, K.SLOTS))
+    tt = t.copy()
+    K.direction(u, sigma, h, m, tt, d, 0.0, 0.0, p, np.full(1, np.inf), False, viol, vidx, vg)
+    idx = np.zeros((nch, K.SLOTS), dtype=np.int64)
+    val = np.zeros((nch, K.SLOTS))
+    counts = np.zeros((nch, 2), dtype=np.int64)
+    mm, pp, t2 = m.copy(), p.copy(), t.copy()
+    psum, pen, _ = K.update(
+        pp, pp, u.copy(), np.zeros(n), t2, h, mm, np.full(1, np.inf), False, sigma, d, tau,
+        viol, idx, val, counts, False, False, vidx, vg, record_max,
+    )  # fmt: skip
+    assert clip.sum() == 3 * nch and join.sum() >= 2 * nch
+    assert np.allclose(pp, ref_p, rtol=1e-14, atol=0)
+    assert np.array_equal(mm, ref_m)
+    assert not np.any(t2[clip])
+    assert (counts[:, 0].sum(), counts[:, 1].sum()) == (clip.sum(), join.sum())
+    assert psum == pytest.approx(ref_p.sum(), rel=1e-13)
+    assert pen == pytest.approx(np.abs(g[join]).max(), rel=1e-15)
+    if record_max == K.SLOTS:
+        got_idx, got_val = K.changed_points(counts, idx, val)
+        step = p - tau / sigma * t
+        expect = {int(i): -sigma * step[i] for i in np.flatnonzero(clip)}
+        for i in np.flatnonzero(join):
+            expect[int(i)] = expect.get(int(i), 0.0) - tau * g[i]
+        got = {}
+        for i, v in zip(got_idx.tolist(), got_val.tolist(), strict=True):
+            got[i] = got.get(i, 0.0) + v
+        assert got.keys() == expect.keys()
+        assert all(got[i] == pytest.approx(expect[i], rel=1e-12) for i in got)

@@ -182,7 +182,7 @@ def cost_record(problem: Problem, results: list[ContactResult], wall_time_s: flo
         "wall_time_s": wall_time_s,
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,  # Linux: kB
         "iterations": sum(int(r.iterations) for r in results),
-        "convolutions": sum(int(r.info.convolutions) for r in results),
+        "convolutions": sum(float(r.info.convolutions) for r in results),
     }
 
 

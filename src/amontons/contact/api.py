@@ -586,7 +586,7 @@ def _solve_info(opts, *, convolutions, resets, outer_iterations, coarse_levels, 
     """The SolveInfo of a solve that started at ``t0`` (perf_counter, s)."""
     return SolveInfo(
         route=opts.route,
-        convolutions=int(convolutions),
+        convolutions=float(convolutions),
         steepest_descent_resets=int(resets),
         outer_iterations=int(outer_iterations),
         coarse_levels=tuple(coarse_levels),

@@ -215,9 +215,10 @@ class BoundedLoadSweep:
         leaves the bound by a plain step, which ``update`` does not record)."""
         self.v = None
 
-    def step(self, p, u, r, t, h, m, d, tau, violators, idx_buf, val_buf, counts):
+    def step(self, p, u, r, t, h, m, d, tau, found, idx_buf, val_buf, counts):
         """One CG step from ``p`` along ``t`` with length ``tau`` (``r = K*t``, ``u = K*p``,
-        ``d`` the approach in m), the load imposed on the free points. ``idx_buf``,
+        ``d`` the approach in m), the load imposed on the free points. ``found`` holds the
+        violators ``kernels.direction`` counted and recorded (three arrays). ``idx_buf``,
         ``val_buf`` and ``counts`` are the caller's event records (``kernels.update``),
         reused by the rescale rounds once the step's events are applied.
 
@@ -229,9 +230,10 @@ class BoundedLoadSweep:
         shortened or restarted (the conjugation is then reset).
         """
         q = self.spare
+        violators, vidx, vg = found
         total, pen, at_bound = _k.update(
             p, q, u, r, t, h, m, self.p_max, True, 1.0, d, tau, violators,
-            idx_buf, val_buf, counts, True,
+            idx_buf, val_buf, counts, True, True, vidx, vg, self.sparse_max,
         )  # fmt: skip
         rest = self.target - at_bound
         free_sum = total - at_bound

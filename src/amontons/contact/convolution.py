@@ -148,6 +148,45 @@ class PeriodicConvolution(_MultiplierMixin):
         out[...] = result
         return out
 
+    @property
+    def splits(self) -> bool:
+        """Whether the convolution can be taken in halves (:meth:`forward`,
+        :meth:`multiply_energy`, :meth:`inverse`): with the pyfftw backend."""
+        return self.backend == "pyfftw"
+
+    def forward(self, p: np.ndarray) -> None:
+        """First half of ``K*p``: the spectrum of ``p`` (Pa) into the operator's work array.
+
+        With :meth:`multiply_energy` and :meth:`inverse` this is ``__call__`` taken apart, so
+        that the CG step can have ``Σ p·(K*p)`` from the spectrum and skip the inverse when
+        the displacement is taken afresh anyway (:mod:`.fused`). pyfftw backend only.
+        """
+        if _fft.aligned(p, self.shape):
+            self._fwd.update_arrays(p, self._spec)
+        else:
+            self._real[...] = p
+            self._fwd.update_arrays(self._real, self._spec)
+        self._fwd.execute()
+
+    def multiply_energy(self) -> float:
+        """Second half: the work spectrum times the kernel's; returns ``Σ p·(K*p)``
+        (m·Pa) of the field last given to :meth:`forward`, by Parseval."""
+        with _kernels.kernel_threads(self.threads):
+            return _kernels.multiply_spectrum_energy(
+                self._spec, self._mult_scaled, self.shape[1] % 2 == 0
+            )
+
+    def inverse(self, out: np.ndarray) -> np.ndarray:
+        """Last part: ``out = K*p`` (m) from the multiplied work spectrum."""
+        if _fft.aligned(out, self.shape):
+            self._inv.update_arrays(self._spec, out)
+            self._inv.execute()
+            return out
+        self._inv.update_arrays(self._spec, self._real)
+        self._inv.execute()
+        out[...] = self._real
+        return out
+
     def _multiply(self) -> None:
         """``spec *= multiplier`` on the operator's threads (numba kernel when threads > 1:
         numpy's multiply is serial and would be the one serial step of the convolution)."""
@@ -281,30 +320,59 @@ class NonPeriodicConvolution(_MultiplierMixin):
             self._green = np.fft.irfft2(self.multiplier, s=self.padded_shape)
         return self._green
 
+    @property
+    def splits(self) -> bool:
+        """Whether the convolution can be taken in halves (as
+        :meth:`PeriodicConvolution.forward`): with the pyfftw backend."""
+        return self.backend == "pyfftw"
+
+    def forward(self, p: np.ndarray) -> None:
+        """First half of ``K*p``: the padded spectrum of ``p`` (Pa) into the work array
+        (as :meth:`PeriodicConvolution.forward`; pyfftw backend only)."""
+        n0, n1 = self.shape
+        if self.pruned:
+            self._rows[:, :n1] = p
+            self._row_fwd.execute()
+            self._spec[n0:] = 0.0  # zero padding rows, overwritten by the last call
+            self._col_fwd.execute()
+        else:
+            self._real[:n0, :n1] = p
+            self._real[n0:, :] = 0.0  # the c2r inverse overwrote the padding
+            self._real[:n0, n1:] = 0.0
+            self._fwd.execute()
+
+    def multiply_energy(self) -> float:
+        """The work spectrum times the kernel's; returns ``Σ p·(K*p)`` (m·Pa) over the
+        window by Parseval on the padded grid (``p`` is zero on the padding)."""
+        with _kernels.kernel_threads(self.threads):
+            return _kernels.multiply_spectrum_energy(
+                self._spec, self._mult_scaled, self.padded_shape[1] % 2 == 0
+            )
+
+    def inverse(self, out: np.ndarray) -> np.ndarray:
+        """Last part: ``out = K*p`` (m) on the window from the multiplied work spectrum."""
+        n1 = self.shape[1]
+        if self.pruned:
+            self._col_inv.execute()
+            self._row_inv.execute()
+            out[...] = self._out[:, :n1]
+        else:
+            self._inv.execute()
+            out[...] = self._real[: self.shape[0], :n1]
+        return out
+
     def __call__(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Return the displacement (m) of pressure ``p`` (Pa); writes into ``out`` if given."""
         self.ncalls += 1
         n0, n1 = self.shape
         m0, m1 = self.padded_shape
         if self.backend == "pyfftw":
-            if self.pruned:
-                self._rows[:, :n1] = p
-                self._row_fwd.execute()
-                self._spec[n0:] = 0.0  # zero padding rows, overwritten by the last call
-                self._col_fwd.execute()
-                self._spec *= self._mult_scaled
-                self._col_inv.execute()
-                self._row_inv.execute()
-                result = self._out[:, :n1]
-            else:
-                self._real[:n0, :n1] = p
-                self._real[n0:, :] = 0.0  # the c2r inverse overwrote the padding
-                self._real[:n0, n1:] = 0.0
-                self._fwd.execute()
-                self._spec *= self._mult_scaled
-                self._inv.execute()
-                result = self._real[:n0, :n1]
-        elif self.pruned:
+            self.forward(p)
+            self._spec *= self._mult_scaled
+            if out is None:
+                out = np.empty(self.shape)
+            return self.inverse(out)
+        if self.pruned:
             rows = np.fft.rfft(p, n=m1, axis=1)
             cols = np.fft.fft(rows, n=m0, axis=0)
             cols *= self._multiplier

@@ -3,13 +3,25 @@
 
 Same algorithm, same iterates up to round-off, as the numpy loop in :mod:`.cg` (its module
 docstring and docs/models.md §2.2 describe it); what differs is how the element-wise work is
-done. One iteration is four sweeps over the grid plus the convolution ``r = K*t``
+done. One iteration is three sweeps over the grid plus the convolution ``r = K*t``
 (:mod:`.kernels`):
 
-1. ``gap_moments``: approach ``d`` (load control), ``G = Σ_Ic g²`` and ``Σ g t_old``;
-2. ``direction``: ``t = g·m + β t``;
-3. ``step_dots``: ``Σ r t`` and ``Σ_Ic r`` (plus the Winkler term of a hardening solve);
-4. ``update``: step, projection, violators, free-set update, ``Σ p`` and ``u -= τ r``.
+1. ``gap_moments``: approach ``d`` (load control), ``G = Σ_Ic g²``, ``Σ g t_old`` and
+   ``Σ t_old``;
+2. ``direction``: ``t = m·(g + β t - shift)``, ``shift`` giving ``t`` zero sum on the free
+   set under load control; counts, and records where few, the violators;
+3. the forward transform of ``t`` and, in the spectrum multiply, ``Σ t·(K*t)`` (Parseval:
+   :meth:`~.convolution.PeriodicConvolution.multiply_energy`);
+4. ``update``: step, projection, violators, free-set update and ``Σ p``;
+5. ``u`` follows the step: when at most ``sparse_max`` points changed, the inverse
+   transform gives ``r = K*t``, ``u -= τ r`` (``subtract_scaled``) and the changed points'
+   responses are added; otherwise ``u = K*p`` is taken afresh and the inverse of ``K*t`` is
+   never computed: the iteration then costs 1.5 FFT pairs, not 2.
+
+An operator that cannot be taken in halves (numpy backend, a custom one) and a hardening
+solve (its Winkler term needs ``r`` in real space) take the whole convolution first and
+``Σ r t`` from ``step_dots``; the bounded load step (penetration hardness) too, and
+``update`` then also does ``u -= τ r``.
 
 Load control rescales ``p`` (and so ``u``) to the target force every iteration. Here that
 rescale costs no pass: the stored pressure ``P`` and displacement ``U`` carry one common
@@ -180,6 +192,10 @@ def _loop(
     val_buf = np.zeros((nch, _k.SLOTS))
     counts = np.zeros((nch, 2), dtype=np.int64)
     violators = np.zeros(nch, dtype=np.int64)
+    # the violators of chunks with few, recorded by direction for update (kernels.direction)
+    vidx = np.zeros((nch, _k.SLOTS), dtype=np.int64)
+    vg = np.zeros((nch, _k.SLOTS))
+    found = (violators, vidx, vg)
     conv(p, u)
     sigma = 1.0  # true p = sigma·p, u = sigma·u (module docstring)
     nc = int(_k.free_mask(p, m, p_max, bounded))
@@ -207,6 +223,11 @@ def _loop(
         )
     green = None
     sweep = None
+    # the convolution r = K*t taken in halves (operator.forward, .multiply_energy, .inverse):
+    # an iteration that takes u = K*p afresh then skips the inverse, half an FFT pair. A
+    # Winkler term needs r in real space (step_dots); the bounded load step updates u itself
+    split = getattr(base_op, "splits", False) and not winkler and not bounded_load
+    forward_only = 0  # forward transforms whose inverse was skipped
     if bounded_load and BOUNDED_LOAD_SWEEP and not winkler:
         sweep = BoundedLoadSweep(base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf)
     monitor = StallMonitor()  # as in cg.polonsky_keer
@@ -254,19 +275,32 @@ def _loop(
             if sweep is not None:
                 sweep.forget_bound_displacement()
         if load_control:
-            d, big_g, gt_old, recentred = _centred_moments(u, sigma, h, m, t, d, nc)
+            d, big_g, gt_old, t_old_sum, recentred = _centred_moments(u, sigma, h, m, t, d, nc)
             recentres += recentred
         else:
             _, big_g, gt_old, _ = _k.gap_moments(u, sigma, h, m, t, d)
+            t_old_sum = 0.0
         beta = delta * big_g / g_old if g_old > 0 else 0.0
         g_dot_t = big_g + beta * gt_old if beta else big_g
-        tsum = _k.direction(u, sigma, h, m, t, d, beta, p, p_max, bounded, violators)
+        # load control: Σ_Ic t = 0, as in .cg (t_old loses its sum where points were
+        # clipped); the mean of r over Ic then drops out of Σ r t
+        shift = beta * t_old_sum / nc
+        _k.direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, *found)
         g_old = big_g
-        conv_t(base_op, t, r, shape)
-        calls += 1
-        rt, rm = _k.step_dots(r, t, m, comp_arg, winkler)
-        if load_control:
-            rt -= rm / nc * tsum
+        if split:
+            # r = K*t in halves: Σ r t from the spectrum now, the inverse only if u follows
+            # the step incrementally (below)
+            base_op.forward(t.reshape(shape))
+            rt = base_op.multiply_energy()
+            forward_only += 1
+        else:
+            conv_t(base_op, t, r, shape)
+            calls += 1
+            rt, _ = _k.step_dots(r, t, m, comp_arg, winkler)
+        if load_control and nc == 1:
+            # a one-point free set has no direction that keeps its force (its t is
+            # round-off): no descent direction, as in .cg
+            rt = 0.0
         if not (rt > 0 and np.isfinite(rt)):
             # no descent direction (cg.polonsky_keer says when): the solution if the gap on
             # the free set is below tol and nothing penetrates off it, judged on a freshly
@@ -300,7 +334,7 @@ def _loop(
         how = None  # how u followed the step, when the bounded load step says
         if sweep is not None:
             p, m, n_clip, n_add, pen, how, backtracked = sweep.step(
-                p, u, r, t, h, m, d, tau, violators, idx_buf, val_buf, counts
+                p, u, r, t, h, m, d, tau, found, idx_buf, val_buf, counts
             )
         elif bounded_load:
             n_clip, n_add, pen, backtracked = bounded_load_step(
@@ -312,7 +346,8 @@ def _loop(
         else:
             psum, pen, _ = _k.update(
                 p, p, u, r, t, h, m, p_max, bounded, sigma, d, tau,
-                violators, idx_buf, val_buf, counts, False,
+                violators, idx_buf, val_buf, counts, False, not split, vidx, vg,
+                sparse_max if sparse_ok else -1,
             )  # fmt: skip
             n_clip = int(counts[:, 0].sum())
             n_add = int(counts[:, 1].sum())
@@ -352,6 +387,12 @@ def _loop(
             updates["full: changes" if changes > sparse_max else "full: refresh"] += 1
         else:
             updates["point responses" if changes else "linear"] += 1
+            if split:
+                # the inverse the step skipped: u -= τ/σ K*t
+                base_op.inverse(r.reshape(shape))
+                forward_only -= 1
+                calls += 1
+                _k.subtract_scaled(u, r, tau / sigma_old)
             if changes:
                 # u (stored, scale sigma_old) += K*c / sigma_old; u = K*p holds for the stored
                 # pair whatever their common scale, so the new scale needs no pass
@@ -406,9 +447,14 @@ def _loop(
         it=it,
         residual=residual,
         history=history,
-        calls=calls,
+        # a forward transform whose inverse was skipped is half a convolution's FFT work
+        calls=calls + 0.5 * forward_only,
         resets=resets,
-        extra={"moment_recentres": recentres, "u_updates": updates},
+        extra={
+            "moment_recentres": recentres,
+            "u_updates": updates,
+            "forward_only_transforms": forward_only,
+        },
         shape=shape,
     )
 
@@ -425,8 +471,8 @@ def conv_t(base_op, t, r, shape):
 
 def _centred_moments(u, sigma, h, m, t, d_old, nc):
     """Load control: the approach ``d`` (m, the mean of ``sigma·u - h`` on the free set),
-    ``G = Σ_Ic g²`` (m²) and ``Σ g·t`` with ``g`` centred on it, and whether a second pass
-    was needed.
+    ``G = Σ_Ic g²`` (m²) and ``Σ g·t`` with ``g`` centred on it, ``Σ t`` (m), and whether a
+    second pass was needed.
 
     One pass takes the moments about the previous approach; when that is far from the new
     one (the first iteration, a warm start), ``G = Σa² - (Σa)²/nc`` would cancel
@@ -438,10 +484,10 @@ def _centred_moments(u, sigma, h, m, t, d_old, nc):
     d = d_old + mean
     big_g = max(s2 - s1 * mean, 0.0)
     if s2 <= RECENTRE * big_g:
-        return d, big_g, st - mean * tsum, 0
+        return d, big_g, st - mean * tsum, tsum, 0
     s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d)
     mean = s1 / nc
-    return d + mean, max(s2 - s1 * mean, 0.0), st - mean * tsum, 1
+    return d + mean, max(s2 - s1 * mean, 0.0), st - mean * tsum, tsum, 1
 
 
 def _final_complementarity(u, h, p, d, load_control, m, t, p_max, bounded):

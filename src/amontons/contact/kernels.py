@@ -2,15 +2,21 @@
 
 The numpy path of :func:`amontons.contact.cg.polonsky_keer` spends ~40 passes over the grid
 per iteration on masks, axpys, reductions, the projection and the violator search. These
-kernels do the same arithmetic in four sweeps (docs/models.md §2.2 gives the algorithm):
+kernels do the same arithmetic in three or four sweeps (docs/models.md §2.2 gives the
+algorithm, :mod:`.fused` the order):
 
-``gap_moments``   moments of the gap on the free set (approach, ``G``, ``Σ g t_old``);
-``direction``     the conjugate direction ``t = g·m + β t`` and ``Σ t``;
-``step_dots``     ``Σ r t`` and ``Σ_Ic r`` after the convolution (and the Winkler term
+``gap_moments``   moments of the gap on the free set (approach, ``G``, ``Σ g t_old``,
+                  ``Σ t_old``);
+``direction``     the conjugate direction ``t = m·(g + β t - shift)``, its violator count
+                  per chunk, and the violators of chunks with few of them;
+``multiply_spectrum_energy``  the spectrum multiply of ``r = K*t`` with ``Σ t·(K*t)``
+                  (Parseval), so the step needs no real-space ``r``;
+``step_dots``     ``Σ r t`` and ``Σ_Ic r`` from a real-space ``r`` (and the Winkler term
                   ``r += t/k``, so a hardening solve needs no extra pass);
-``update``        pressure step, projection onto ``0 <= p <= p_max``, violator search,
-                  free-set update, ``Σ p`` and the displacement axpy ``u -= τ r``, in one
+``update``        pressure step, projection onto ``0 <= p <= p_max``, violators, free-set
+                  update, ``Σ p`` and, if asked, the displacement axpy ``u -= τ r``, in one
                   sweep, recording the few changed points for the sparse update;
+``subtract_scaled``  ``u -= τ r`` when the step left ``u`` alone;
 ``rescale_free``  bounded load control: the free points scaled to the load, the free set
                   rebuilt and ``u`` carried along (:mod:`.bounded_load`).
 
@@ -121,7 +127,7 @@ def gap_moments(u, sigma, h, m, t, shift):
 
 
 @numba.njit(**_INNER)
-def _direction_hard(u, sigma, h, m, t, d, beta):
+def _direction_hard(u, sigma, h, m, t, d, beta, shift):
     """A chunk of ``direction`` under the hard wall: ``(Σ t, violators)``. A constrained
     point has ``p = 0`` here (points leave the free set only by clipping to 0), so the
     pressure need not be read."""
@@ -129,7 +135,7 @@ def _direction_hard(u, sigma, h, m, t, d, beta):
     k = 0
     for i in range(u.size):
         g = sigma * u[i] - h[i] - d
-        v = (g + beta * t[i]) * m[i]
+        v = (g + beta * t[i] - shift) * m[i]
         t[i] = v
         acc += v
         # unloaded and penetrating (branch-free)
@@ -138,13 +144,13 @@ def _direction_hard(u, sigma, h, m, t, d, beta):
 
 
 @numba.njit(**_INNER)
-def _direction_bounded(u, sigma, h, m, t, d, beta, p, p_max):
+def _direction_bounded(u, sigma, h, m, t, d, beta, shift, p, p_max):
     """A chunk of ``direction`` under ``0 <= p <= p_max``: ``(Σ t, violators)``."""
     acc = 0.0
     k = 0
     for i in range(u.size):
         g = sigma * u[i] - h[i] - d
-        v = (g + beta * t[i]) * m[i]
+        v = (g + beta * t[i] - shift) * m[i]
         t[i] = v
         acc += v
         q = sigma * p[i]
@@ -156,12 +162,19 @@ def _direction_bounded(u, sigma, h, m, t, d, beta, p, p_max):
 
 
 @numba.njit(**_JIT)
-def direction(u, sigma, h, m, t, d, beta, p, p_max, bounded, violators):
-    """``t ← m·(sigma·u - h - d) + beta·t`` in place (m); returns ``Σ t``.
+def direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, vidx, vg):
+    """``t ← m·(sigma·u - h - d + beta·t - shift)`` in place (m); returns ``Σ t``.
+
+    Load control passes ``shift = beta·Σ t_old / nc``, which keeps ``Σ t = 0`` on the free
+    set (:mod:`.fused`); displacement control passes 0.
 
     Also counts, per chunk into ``violators``, the constrained points that should be free
-    (the violator test of ``update``, which does not depend on the step: ``t = 0`` there),
-    so ``update`` visits with its scalar loop only the chunks that have one.
+    (the violator test of ``update``, which does not depend on the step: ``t = 0`` there).
+    A chunk with at most ``SLOTS`` of them records their flat indices into ``vidx[c, :]``
+    and their gaps (m) into ``vg[c, :]``, in index order, so that ``update`` visits only
+    those points and its clipped ones instead of running its scalar loop over the chunk;
+    ``violators[c]`` is then their number as ``update`` tests them, or ``SLOTS + 1`` if
+    that exceeds the slots.
     """
     n = u.size
     nch = (n + CHUNK - 1) // CHUNK
@@ -171,9 +184,15 @@ def direction(u, sigma, h, m, t, d, beta, p, p_max, bounded, violators):
         hi = min(n, lo + CHUNK)
         uc, hc, mc, tc, pc = u[lo:hi], h[lo:hi], m[lo:hi], t[lo:hi], p[lo:hi]
         if bounded:
-            acc, k = _direction_bounded(uc, sigma, hc, mc, tc, d, beta, pc, p_max[lo:hi])
+            acc, k = _direction_bounded(uc, sigma, hc, mc, tc, d, beta, shift, pc, p_max[lo:hi])
+            if 0 < k <= SLOTS:
+                k = _record_violators(
+                    uc, sigma, hc, mc, d, pc, p_max[lo:hi], True, lo, vidx[c], vg[c]
+                )
         else:
-            acc, k = _direction_hard(uc, sigma, hc, mc, tc, d, beta)
+            acc, k = _direction_hard(uc, sigma, hc, mc, tc, d, beta, shift)
+            if 0 < k <= SLOTS:
+                k = _record_violators(uc, sigma, hc, mc, d, pc, p_max, False, lo, vidx[c], vg[c])
         part[c] = acc
         violators[c] = k
     total = 0.0
@@ -229,7 +248,27 @@ def step_dots(r, t, m, compliance, winkler):
 
 @numba.njit(**_JIT)
 def update(
-    p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, idx, val, counts, keep_mask
+    p,
+    p_new,
+    u,
+    r,
+    t,
+    h,
+    m,
+    p_max,
+    bounded,
+    sigma,
+    d,
+    tau,
+    violators,
+    idx,
+    val,
+    counts,
+    keep_mask,
+    with_u,
+    vidx,
+    vg,
+    record_max,
 ):
     """One CG step in one sweep (stored fields, true value = ``sigma`` × stored).
 
@@ -238,7 +277,9 @@ def update(
     point leaves the free set and its direction is zeroed); then a constrained point that
     should be free (unloaded and penetrating with room to rise, or at ``p_max`` and open)
     moves by ``-tau·g`` and joins the free set, as in :class:`amontons.contact.cg.HardWall`
-    and :class:`~amontons.contact.cg.BoundedWall`. ``u`` gets ``-tau/sigma·r`` in place.
+    and :class:`~amontons.contact.cg.BoundedWall`. With ``with_u``, ``u`` gets
+    ``-tau/sigma·r`` in place; without, ``u`` and ``r`` are not read (the caller brings ``u``
+    to the new pressure itself, :mod:`.fused`).
 
     ``p_max`` (Pa) has one entry per point when ``bounded`` is 1, else one entry, ignored
     (no upper bound). Changed points are recorded per chunk in ``idx[c, :]`` (flat index)
@@ -246,8 +287,12 @@ def update(
     ``counts[c, 0/1]`` get the number clipped / added in chunk ``c``.
 
     Each chunk is first checked for clipped points by a vectorised pass (its violators were
-    counted by ``direction`` into ``violators``); the few chunks with an event run the
-    scalar loop that records them, the rest a vectorised step.
+    counted, and recorded in ``vidx``, ``vg``, by ``direction``). A chunk without events
+    takes a vectorised step; one with a few takes it too and then visits only its clipped
+    points and its recorded violators, in index order. A chunk with more than
+    ``record_max`` events (the most the caller applies as point responses: beyond, it
+    takes ``u`` afresh and needs no records) runs a branch-free sweep that records nothing
+    but the counts.
 
     With ``keep_mask`` (the bounded load step, :mod:`.bounded_load`) the free set ``m`` and
     the direction ``t`` are left as they were (the events are still recorded), so that the
@@ -268,34 +313,35 @@ def update(
         tc, hc, mc = t[lo:hi], h[lo:hi], m[lo:hi]
         if bounded:
             ubc = p_max[lo:hi]
-            events = violators[c] or _clips_bounded(pc, tc, mc, ubc, sigma, step)
+            nclips = _clips_bounded(pc, tc, mc, ubc, sigma, step)
         else:
             ubc = p_max
-            events = violators[c] or _clips_hard(pc, tc, mc, step)
-        if events:
-            acc, accb, pen, nclip, nadd = _chunk_with_events(
-                pc,
-                pnc,
-                uc,
-                rc,
-                tc,
-                hc,
-                mc,
-                ubc,
-                bounded,
-                sigma,
-                d,
-                tau,
-                idx[c],
-                val[c],
-                lo,
-                keep_mask,
-            )
+            nclips = _clips_hard(pc, tc, mc, step)
+        nv = violators[c]
+        if (nv or nclips) and nv + nclips > min(record_max, SLOTS):
+            if not (bounded or keep_mask or with_u):
+                acc, accb, pen, nclip, nadd = _chunk_bulk_hard(
+                    pc, pnc, uc, tc, hc, mc, sigma, d, tau
+                )
+            else:
+                # every constrained point tested, records past the slots dropped
+                acc, accb, pen, nclip, nadd = _chunk_events(
+                    pc, pnc, uc, rc, tc, hc, mc, ubc, bounded, sigma, d, tau, idx[c], val[c],
+                    lo, keep_mask, with_u, vidx[c], vg[c], 0, True,
+                )  # fmt: skip
+        elif nv or nclips:
+            acc, accb, pen, nclip, nadd = _chunk_events(
+                pc, pnc, uc, rc, tc, hc, mc, ubc, bounded, sigma, d, tau, idx[c], val[c], lo,
+                keep_mask, with_u, vidx[c], vg[c], nv, False,
+            )  # fmt: skip
         elif bounded:
-            acc, accb = _chunk_step_bounded(pc, pnc, uc, rc, tc, ubc, sigma, step)
+            acc, accb = _chunk_step_bounded(pc, pnc, uc, rc, tc, ubc, sigma, step, with_u)
             pen, nclip, nadd = 0.0, 0, 0
-        else:
+        elif with_u:
             acc = _chunk_step(pc, pnc, uc, rc, tc, step)
+            accb, pen, nclip, nadd = 0.0, 0.0, 0, 0
+        else:
+            acc = _chunk_step_p(pc, pnc, tc, step)
             accb, pen, nclip, nadd = 0.0, 0.0, 0, 0
         part[c, 0] = acc
         part[c, 1] = pen
@@ -344,7 +390,18 @@ def _chunk_step(p, p_new, u, r, t, step):
 
 
 @numba.njit(**_INNER)
-def _chunk_step_bounded(p, p_new, u, r, t, p_max, sigma, step):
+def _chunk_step_p(p, p_new, t, step):
+    """``_chunk_step`` without the displacement: ``p_new = p - step·t``; ``Σ p_new``."""
+    acc = 0.0
+    for i in range(p.size):
+        q = p[i] - step * t[i]
+        p_new[i] = q
+        acc += q
+    return acc
+
+
+@numba.njit(**_INNER)
+def _chunk_step_bounded(p, p_new, u, r, t, p_max, sigma, step, with_u):
     """Event-free step of a bounded chunk: as ``_chunk_step``, plus ``Σ p_new`` over the
     points at ``p_max`` (constrained points there keep ``t = 0``, so they stay)."""
     acc = 0.0
@@ -354,75 +411,187 @@ def _chunk_step_bounded(p, p_new, u, r, t, p_max, sigma, step):
         p_new[i] = q
         acc += q
         accb += q * (sigma * q >= p_max[i])
-        u[i] -= step * r[i]
+    if with_u:
+        for i in range(p.size):
+            u[i] -= step * r[i]
     return acc, accb
 
 
-@numba.njit(cache=True)
-def _chunk_with_events(
-    p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, idx, val, lo, keep_mask
-):
-    """The step of a chunk starting at flat index ``lo``, with its projection and violators
-    recorded (``update``)."""
+@numba.njit(**_INNER)
+def _chunk_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau):
+    """The step of a chunk with many events under the hard wall, the free set updated and
+    ``u`` left alone, without records: ``_point_event``'s rules written branch-free for the
+    vectoriser (a constrained point has ``p = 0`` under the hard wall: points leave the
+    free set only by clipping to 0). Returns as ``_chunk_events``."""
     step = tau / sigma
     acc = 0.0
-    accb = 0.0
     pen = 0.0
     nclip = 0
     nadd = 0
     for i in range(p.size):
-        ub = p_max[i] if bounded else math.inf
-        free = m[i] != 0
+        free = m[i]
         q = p[i] - step * t[i]
-        pn = sigma * q
-        if free:
-            cval = 0.0
-            if pn < 0.0:
-                cval = -pn
-                pn = 0.0
-                free = False
-            elif pn > ub:
-                cval = ub - pn
-                pn = ub
-                free = False
-            if not free:
-                q = pn / sigma
-                if not keep_mask:
-                    m[i] = 0
-                    t[i] = 0.0
-                k = nclip + nadd
-                if k < SLOTS:
-                    idx[k] = lo + i
-                    val[k] = cval
-                nclip += 1
-        if not free:
-            g = sigma * u[i] - h[i] - d
-            rise = pn <= 0.0 and g < 0.0 and pn < ub
-            fall = pn >= ub and g > 0.0 and pn > 0.0
-            if rise or fall:
-                added = -tau * g
-                joined = pn + added
-                if keep_mask:
-                    # the bounded load step projects the joining points too, as its numpy
-                    # version (.bounded_load.bounded_load_step) does
-                    if joined < 0.0 or joined > ub:
-                        joined = min(max(joined, 0.0), ub)
-                        added = joined - pn
-                else:
-                    m[i] = 1
-                q = joined / sigma
-                k = nclip + nadd
-                if k < SLOTS:
-                    idx[k] = lo + i
-                    val[k] = added
-                nadd += 1
-                pen = max(pen, abs(g))
+        clip = free & (q < 0.0)
+        g = sigma * u[i] - h[i] - d
+        join = ((free == 0) | clip) & (g < 0.0)
+        q = -step * g if join else (0.0 if clip else q)
+        m[i] = (free & (clip == 0)) | join
+        t[i] = 0.0 if clip else t[i]
         p_new[i] = q
         acc += q
-        if bounded and sigma * q >= ub:
-            accb += q
-        u[i] -= step * r[i]
-    return acc, accb, pen, nclip, nadd
+        pen = max(pen, -g if join else 0.0)
+        nclip += clip
+        nadd += join
+    return acc, 0.0, pen, nclip, nadd
+
+
+@numba.njit(cache=True)
+def _record_violators(u, sigma, h, m, d, p, p_max, bounded, lo, vidx, vg):
+    """Record a chunk's violators (``direction``) with ``update``'s test and arithmetic
+    (plain IEEE, no reassociation); returns their number, ``SLOTS + 1`` past the slots."""
+    k = 0
+    for i in range(u.size):
+        if m[i] != 0:
+            continue
+        g = sigma * u[i] - h[i] - d
+        if bounded:
+            q = sigma * p[i]
+            ub = p_max[i]
+            hit = (q <= 0.0 and g < 0.0 and q < ub) or (q >= ub and g > 0.0 and q > 0.0)
+        else:
+            hit = g < 0.0
+        if hit:
+            if k == SLOTS:
+                return SLOTS + 1
+            vidx[k] = lo + i
+            vg[k] = g
+            k += 1
+    return k
+
+
+@numba.njit(cache=True)
+def _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo, keep_mask, g, known, ev):
+    """The projection and violator test of point ``i`` of a chunk after its step
+    (``p_new[i] = p - tau/sigma·t``): a free point pushed out of ``[0, p_max]`` is clipped
+    (and leaves the free set, its direction zeroed, unless ``keep_mask``); a constrained
+    point that should be free (unloaded and penetrating, or at ``p_max`` and open) moves by
+    ``-tau·g`` (projected onto ``[0, p_max]`` with ``keep_mask``) and joins. ``g`` is its
+    gap if ``known``. ``ev`` holds ``[nclip, nadd]``; returns the
+    ``|g|`` of a joining point, else 0."""
+    free = m[i] != 0
+    q = p_new[i]
+    pn = sigma * q
+    pen = 0.0
+    if free:
+        cval = 0.0
+        if pn < 0.0:
+            cval = -pn
+            pn = 0.0
+            free = False
+        elif pn > ub:
+            cval = ub - pn
+            pn = ub
+            free = False
+        if not free:
+            q = pn / sigma
+            if not keep_mask:
+                m[i] = 0
+                t[i] = 0.0
+            k = ev[0] + ev[1]
+            if k < SLOTS:
+                idx[k] = lo + i
+                val[k] = cval
+            ev[0] += 1
+    if not free:
+        if not known:
+            g = sigma * u[i] - h[i] - d
+        rise = pn <= 0.0 and g < 0.0 and pn < ub
+        fall = pn >= ub and g > 0.0 and pn > 0.0
+        if rise or fall:
+            added = -tau * g
+            joined = pn + added
+            if keep_mask:
+                if joined < 0.0 or joined > ub:
+                    joined = min(max(joined, 0.0), ub)
+                    added = joined - pn
+            else:
+                m[i] = 1
+            q = joined / sigma
+            k = ev[0] + ev[1]
+            if k < SLOTS:
+                idx[k] = lo + i
+                val[k] = added
+            ev[1] += 1
+            pen = abs(g)
+    p_new[i] = q
+    return pen
+
+
+@numba.njit(cache=True)
+def _chunk_events(
+    p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, idx, val, lo, keep_mask, with_u,
+    vidx, vg, nv, scan_all,
+):  # fmt: skip
+    """The step of a chunk with events: the step for every point, then ``_point_event``
+    for its clipped points and the ``nv`` violators ``direction`` recorded in ``vidx``,
+    ``vg``, merged in index order; with ``scan_all``, for its clipped points and every
+    constrained point (their gaps taken here). Returns ``(Σ p_new, Σ p_new at p_max,
+    max |g| of the joining points, clipped, joined)``."""
+    step = tau / sigma
+    for i in range(p.size):
+        p_new[i] = p[i] - step * t[i]
+    ev = np.zeros(2, dtype=np.int64)
+    pen = 0.0
+    vk = 0
+    inf = math.inf
+    for i in range(p.size):
+        ub = p_max[i] if bounded else inf
+        if m[i] == 0:
+            if scan_all:
+                e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo,
+                                 keep_mask, 0.0, False, ev)  # fmt: skip
+                pen = max(pen, e)
+            continue
+        pn = sigma * p_new[i]
+        if pn < 0.0 or pn > ub:
+            while vk < nv and vidx[vk] - lo < i:
+                j = vidx[vk] - lo
+                ubj = p_max[j] if bounded else inf
+                e = _point_event(j, p_new, u, t, h, m, ubj, sigma, d, tau, idx, val, lo,
+                                 keep_mask, vg[vk], True, ev)  # fmt: skip
+                pen = max(pen, e)
+                vk += 1
+            e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo,
+                             keep_mask, 0.0, False, ev)  # fmt: skip
+            pen = max(pen, e)
+    while vk < nv:
+        j = vidx[vk] - lo
+        ubj = p_max[j] if bounded else inf
+        e = _point_event(j, p_new, u, t, h, m, ubj, sigma, d, tau, idx, val, lo,
+                         keep_mask, vg[vk], True, ev)  # fmt: skip
+        pen = max(pen, e)
+        vk += 1
+    acc, accb = _chunk_sums(p_new, p_max, bounded, sigma)
+    if with_u:
+        for i in range(p.size):
+            u[i] -= step * r[i]
+    return acc, accb, pen, ev[0], ev[1]
+
+
+@numba.njit(**_INNER)
+def _chunk_sums(p_new, p_max, bounded, sigma):
+    """``(Σ p_new, Σ p_new over the points at p_max)`` of a chunk (stored units)."""
+    acc = 0.0
+    accb = 0.0
+    if bounded:
+        for i in range(p_new.size):
+            q = p_new[i]
+            acc += q
+            accb += q * (sigma * q >= p_max[i])
+    else:
+        for i in range(p_new.size):
+            acc += p_new[i]
+    return acc, accb
 
 
 @numba.njit(cache=True)
@@ -614,6 +783,51 @@ def multiply_spectrum(spec, multiplier):
         mrow = multiplier[i]
         for j in range(row.size):
             row[j] = row[j] * mrow[j]
+
+
+@numba.njit(**_JIT)
+def multiply_spectrum_energy(spec, multiplier, nyquist):
+    """``spec *= multiplier`` in place, as :func:`multiply_spectrum`, and return
+    ``Σ w·multiplier·|spec|²`` taken before the product: with ``spec`` the rfft2 half-spectrum
+    of a real field ``x`` and ``multiplier`` the kernel spectrum over the number of grid
+    points, that is ``Σ x·(K*x)`` (Parseval), the CG step's denominator, without the inverse
+    transform. ``nyquist``: the last column is the Nyquist one (even full length) and is
+    counted once, like column 0. Rows are summed in order: the same bits on any thread
+    count."""
+    n0, m1 = spec.shape
+    part = np.zeros(n0)
+    last = m1 - 1
+    for i in prange(n0):
+        row = spec[i]
+        mrow = multiplier[i]
+        z0 = row[0]
+        e0 = mrow[0] * (z0.real * z0.real + z0.imag * z0.imag)
+        zl = row[last]
+        el = mrow[last] * (zl.real * zl.real + zl.imag * zl.imag) if nyquist and last else 0.0
+        part[i] = 2.0 * _row_product_energy(row, mrow) - e0 - el
+    total = 0.0
+    for i in range(n0):
+        total += part[i]
+    return total
+
+
+@numba.njit(**_INNER)
+def _row_product_energy(row, mrow):
+    """``row *= mrow`` in place; returns ``Σ_j mrow_j |row_j|²`` taken before."""
+    acc = 0.0
+    for j in range(row.size):
+        z = row[j]
+        k = mrow[j]
+        acc += k * (z.real * z.real + z.imag * z.imag)
+        row[j] = z * k
+    return acc
+
+
+@numba.njit(**_JIT)
+def subtract_scaled(u, r, step):
+    """``u -= step·r`` in place (the displacement's share of a CG step, m)."""
+    for i in prange(u.size):
+        u[i] -= step * r[i]
 
 
 def changed_points(counts, idx_buf, val_buf):

@@ -121,7 +121,7 @@ class PlasticState:
     iterations: int
     residual: float
     history: np.ndarray
-    convolutions: int
+    convolutions: float
     outer_iterations: int
     resets: int = 0
     status: int = CONVERGED
@@ -138,7 +138,7 @@ class _Tally:
     """Work summed over the conjugate-gradient solves of one step."""
 
     iterations: int = 0
-    convolutions: int = 0
+    convolutions: float = 0.0
     resets: int = 0
     history: list = field(default_factory=list)
 

@@ -108,13 +108,13 @@ class CoarseLevel:
         Grid shape of the level, pixels.
     iterations : int
         Conjugate-gradient iterations on that level.
-    convolutions : int
-        Convolutions performed on that level.
+    convolutions : float
+        Convolutions performed on that level, in FFT pairs (as :class:`SolveInfo`).
     """
 
     shape: tuple[int, int]
     iterations: int
-    convolutions: int
+    convolutions: float
 
 
 @dataclass(frozen=True)
@@ -130,9 +130,11 @@ class SolveInfo:
         increments: one bounded Polonsky–Keer solve under the load or approach, then the
         plastic update) or ``"appendix"`` (the appendix's iterative scheme: bounded solve,
         plastic increment, repeat, with a root find on the approach under load control).
-    convolutions : int
-        Convolutions on the finest grid. Plastic routes under load control: those of the
-        final approach only (the root find's trial approaches are not counted).
+    convolutions : float
+        Convolutions on the finest grid, in FFT pairs: a forward transform whose inverse the
+        solver skipped counts 0.5 (:mod:`amontons.contact.fused`). Plastic routes under load
+        control: those of the final approach only (the root find's trial approaches are not
+        counted).
     steepest_descent_resets : int
         Conjugate-gradient restarts from steepest descent (see :mod:`amontons.contact.cg`),
         counted like ``convolutions``.
@@ -162,7 +164,7 @@ class SolveInfo:
     """
 
     route: str
-    convolutions: int
+    convolutions: float
     steepest_descent_resets: int
     outer_iterations: int
     coarse_levels: tuple[CoarseLevel, ...]

@@ -59,7 +59,7 @@ def _diagnostics(result: ContactResult) -> dict:
         "residual": float(result.residual),
         "route": info.route,
         "outer_iterations": int(info.outer_iterations),
-        "convolutions": int(info.convolutions),
+        "convolutions": float(info.convolutions),
         "wall_time_s": float(info.wall_time_s),
     }
 
