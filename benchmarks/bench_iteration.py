@@ -8,7 +8,10 @@ same effort and threads and timed in the same process, alternating with the solv
 remainder is ratio minus convolutions per iteration: everything an iteration does besides
 its FFT pairs (element-wise work, spectrum multiply, point responses). "in conv" is the
 time inside the operator calls (the FFT pairs plus their spectrum multiply) in pairs per
-iteration, so "ratio − in conv" is the element-wise work alone. Medians of --repeats.
+iteration, so "ratio − in conv" is the element-wise work alone. "ratio, cold pair" divides
+by a pair timed after a sweep over 128 MB: back to back, a pair whose arrays fit in the
+last-level cache (1024² here) runs from it, which an FFT inside an iteration never does.
+Medians of --repeats.
 
 Paths: ``fused`` (numba kernels, the default of the solver) and ``numpy`` (the reference
 loop, ``kernels=False``). The solve runs inside ``threadpool_limits(1)`` as
@@ -110,14 +113,16 @@ def run(n, periodic, path, threads, effort, repeats):
     pair.real[...] = np.random.default_rng(0).random(pair.shape)
     kernels = path == "fused"
     solve_once(op, h, load, kernels, threads)  # warm-up: plans, kernels, caches
-    ratios, per_it, pairs, in_conv = [], [], [], []
+    ratios, per_it, pairs, in_conv, cold_ratios = [], [], [], [], []
     for _ in range(repeats):
         pair_t = _pair_time(pair)
+        cold_t = _pair_time(pair, cold=True)
         dt, conv_s, out = solve_once(op, h, load, kernels, threads)
         pair_t = 0.5 * (pair_t + _pair_time(pair))
         it = out.iterations
         per_it.append(dt / it)
         pairs.append(pair_t)
+        cold_ratios.append(dt / it / cold_t)
         ratios.append(dt / it / pair_t)
         in_conv.append(conv_s / it / pair_t)
     conv_per_it = out.convolutions / out.iterations
@@ -135,6 +140,7 @@ def run(n, periodic, path, threads, effort, repeats):
         "convolutions / iteration": conv_per_it,
         "FFT pair ms": statistics.median(pairs) * 1e3,
         "ratio": ratio,
+        "ratio, cold pair": statistics.median(cold_ratios),
         "remainder": ratio - conv_per_it,
         "in conv (pairs)": conv,
         "element-wise (pairs)": ratio - conv,
@@ -148,10 +154,19 @@ def run(n, periodic, path, threads, effort, repeats):
     }
 
 
-def _pair_time(pair, calls=5):
-    """Median time of one FFT pair over ``calls`` calls, s."""
+# larger than the last-level cache (32 MB here): touched before a "cold" pair
+_FLUSH = np.zeros(128 * 2**20 // 8)
+
+
+def _pair_time(pair, calls=5, cold=False):
+    """Median time of one FFT pair over ``calls`` calls, s. Back to back (the default,
+    the floor of the tables) a pair whose arrays fit in the last-level cache (1024²: 16 MB)
+    runs from it; ``cold`` sweeps a 128 MB array before each call (untimed), so the pair
+    meets its data in memory as an FFT inside an iteration does."""
     ts = []
     for _ in range(calls):
+        if cold:
+            np.add(_FLUSH, 1.0, out=_FLUSH)
         t0 = time.perf_counter()
         pair()
         ts.append(time.perf_counter() - t0)

@@ -50,6 +50,9 @@ CHUNK = 16384
 # point responses only when there are at most this many in total (.fused.SPARSE_MAX), so a
 # chunk never needs more slots than that.
 SLOTS = 64
+# Points per block of update's search for clipped points in a chunk with a few events:
+# blocks without one are passed over after a vectorised test.
+SCAN = 256
 
 # fastmath "reassoc" only: it lets LLVM vectorise the reductions (several partial sums per
 # chunk instead of one serial chain, ~4x faster here); the summation order is then fixed by
@@ -327,12 +330,12 @@ def update(
                 # every constrained point tested, records past the slots dropped
                 acc, accb, pen, nclip, nadd = _chunk_events(
                     pc, pnc, uc, rc, tc, hc, mc, ubc, bounded, sigma, d, tau, idx[c], val[c],
-                    lo, keep_mask, with_u, vidx[c], vg[c], 0, True,
+                    lo, keep_mask, with_u, vidx[c], vg[c], 0, 0, True,
                 )  # fmt: skip
         elif nv or nclips:
             acc, accb, pen, nclip, nadd = _chunk_events(
                 pc, pnc, uc, rc, tc, hc, mc, ubc, bounded, sigma, d, tau, idx[c], val[c], lo,
-                keep_mask, with_u, vidx[c], vg[c], nv, False,
+                keep_mask, with_u, vidx[c], vg[c], nv, nclips, False,
             )  # fmt: skip
         elif bounded:
             acc, accb = _chunk_step_bounded(pc, pnc, uc, rc, tc, ubc, sigma, step, with_u)
@@ -426,23 +429,25 @@ def _chunk_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau):
     step = tau / sigma
     acc = 0.0
     pen = 0.0
-    nclip = 0
-    nadd = 0
+    nclip = 0.0
+    nadd = 0.0
+    # 0/1 factors in float64 throughout: mixed uint8/bool lanes kept LLVM from vectorising
     for i in range(p.size):
-        free = m[i]
+        free = np.float64(m[i])
         q = p[i] - step * t[i]
-        clip = free & (q < 0.0)
+        clip = free * (q < 0.0)
         g = sigma * u[i] - h[i] - d
-        join = ((free == 0) | clip) & (g < 0.0)
-        q = -step * g if join else (0.0 if clip else q)
-        m[i] = (free & (clip == 0)) | join
-        t[i] = 0.0 if clip else t[i]
+        join = max(1.0 - free, clip) * (g < 0.0)
+        keep = free - clip
+        q = keep * q - join * (step * g)
+        m[i] = np.uint8(keep + join)
+        t[i] = t[i] * (1.0 - clip)
         p_new[i] = q
         acc += q
-        pen = max(pen, -g if join else 0.0)
+        pen = max(pen, -g * join)
         nclip += clip
         nadd += join
-    return acc, 0.0, pen, nclip, nadd
+    return acc, 0.0, pen, int(nclip), int(nadd)
 
 
 @numba.njit(cache=True)
@@ -527,15 +532,29 @@ def _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo, keep_mas
     return pen
 
 
+@numba.njit(**_INNER)
+def _block_clips(p_new, m, p_max, bounded, sigma, b0, b1):
+    """Whether points ``b0:b1`` hold a free point the step took out of ``[0, p_max]``."""
+    k = 0
+    if bounded:
+        for i in range(b0, b1):
+            q = sigma * p_new[i]
+            k += (m[i] != 0) & ((q < 0.0) | (q > p_max[i]))
+    else:
+        for i in range(b0, b1):
+            k += (m[i] != 0) & (p_new[i] < 0.0)
+    return k > 0
+
+
 @numba.njit(cache=True)
 def _chunk_events(
     p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, idx, val, lo, keep_mask, with_u,
-    vidx, vg, nv, scan_all,
+    vidx, vg, nv, nclips, scan_all,
 ):  # fmt: skip
     """The step of a chunk with events: the step for every point, then ``_point_event``
-    for its clipped points and the ``nv`` violators ``direction`` recorded in ``vidx``,
-    ``vg``, merged in index order; with ``scan_all``, for its clipped points and every
-    constrained point (their gaps taken here). Returns ``(Σ p_new, Σ p_new at p_max,
+    for its ``nclips`` clipped points and the ``nv`` violators ``direction`` recorded in
+    ``vidx``, ``vg``, merged in index order; with ``scan_all``, for its clipped points and
+    every constrained point (their gaps taken here). Returns ``(Σ p_new, Σ p_new at p_max,
     max |g| of the joining points, clipped, joined)``."""
     step = tau / sigma
     for i in range(p.size):
@@ -544,26 +563,33 @@ def _chunk_events(
     pen = 0.0
     vk = 0
     inf = math.inf
-    for i in range(p.size):
-        ub = p_max[i] if bounded else inf
-        if m[i] == 0:
-            if scan_all:
-                e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo,
-                                 keep_mask, 0.0, False, ev)  # fmt: skip
-                pen = max(pen, e)
-            continue
-        pn = sigma * p_new[i]
-        if pn < 0.0 or pn > ub:
-            while vk < nv and vidx[vk] - lo < i:
-                j = vidx[vk] - lo
-                ubj = p_max[j] if bounded else inf
-                e = _point_event(j, p_new, u, t, h, m, ubj, sigma, d, tau, idx, val, lo,
-                                 keep_mask, vg[vk], True, ev)  # fmt: skip
-                pen = max(pen, e)
-                vk += 1
-            e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo,
-                             keep_mask, 0.0, False, ev)  # fmt: skip
-            pen = max(pen, e)
+    n = p.size
+    if scan_all or nclips:
+        # blocks of SCAN points without a clipped one (found branch-free) are skipped
+        for b0 in range(0, n, SCAN):
+            b1 = min(n, b0 + SCAN)
+            if not scan_all and not _block_clips(p_new, m, p_max, bounded, sigma, b0, b1):
+                continue
+            for i in range(b0, b1):
+                ub = p_max[i] if bounded else inf
+                if m[i] == 0:
+                    if scan_all:
+                        e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val,
+                                         lo, keep_mask, 0.0, False, ev)  # fmt: skip
+                        pen = max(pen, e)
+                    continue
+                pn = sigma * p_new[i]
+                if pn < 0.0 or pn > ub:
+                    while vk < nv and vidx[vk] - lo < i:
+                        j = vidx[vk] - lo
+                        ubj = p_max[j] if bounded else inf
+                        e = _point_event(j, p_new, u, t, h, m, ubj, sigma, d, tau, idx, val,
+                                         lo, keep_mask, vg[vk], True, ev)  # fmt: skip
+                        pen = max(pen, e)
+                        vk += 1
+                    e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo,
+                                     keep_mask, 0.0, False, ev)  # fmt: skip
+                    pen = max(pen, e)
     while vk < nv:
         j = vidx[vk] - lo
         ubj = p_max[j] if bounded else inf
