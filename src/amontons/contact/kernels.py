@@ -451,26 +451,50 @@ def _chunk_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau):
 
 
 @numba.njit(cache=True)
-def _record_violators(u, sigma, h, m, d, p, p_max, bounded, lo, vidx, vg):
-    """Record a chunk's violators (``direction``) with ``update``'s test and arithmetic
-    (plain IEEE, no reassociation); returns their number, ``SLOTS + 1`` past the slots."""
+def _block_violators(u, sigma, h, m, d, p, p_max, bounded, b0, b1):
+    """Whether points ``b0:b1`` hold a violator (``_record_violators``' test, branch-free;
+    no fast-math, so it agrees with the scalar test to the last bit)."""
     k = 0
-    for i in range(u.size):
-        if m[i] != 0:
-            continue
-        g = sigma * u[i] - h[i] - d
-        if bounded:
+    if bounded:
+        for i in range(b0, b1):
+            g = sigma * u[i] - h[i] - d
             q = sigma * p[i]
             ub = p_max[i]
-            hit = (q <= 0.0 and g < 0.0 and q < ub) or (q >= ub and g > 0.0 and q > 0.0)
-        else:
-            hit = g < 0.0
-        if hit:
-            if k == SLOTS:
-                return SLOTS + 1
-            vidx[k] = lo + i
-            vg[k] = g
-            k += 1
+            hit = ((q <= 0.0) & (g < 0.0) & (q < ub)) | ((q >= ub) & (g > 0.0) & (q > 0.0))
+            k += (m[i] == 0) & hit
+    else:
+        for i in range(b0, b1):
+            k += (m[i] == 0) & (sigma * u[i] - h[i] - d < 0.0)
+    return k > 0
+
+
+@numba.njit(cache=True)
+def _record_violators(u, sigma, h, m, d, p, p_max, bounded, lo, vidx, vg):
+    """Record a chunk's violators (``direction``) with ``update``'s test and arithmetic
+    (plain IEEE, no reassociation); returns their number, ``SLOTS + 1`` past the slots.
+    Blocks of ``SCAN`` points without one are passed over after a vectorised test."""
+    k = 0
+    n = u.size
+    for b0 in range(0, n, SCAN):
+        b1 = min(n, b0 + SCAN)
+        if not _block_violators(u, sigma, h, m, d, p, p_max, bounded, b0, b1):
+            continue
+        for i in range(b0, b1):
+            if m[i] != 0:
+                continue
+            g = sigma * u[i] - h[i] - d
+            if bounded:
+                q = sigma * p[i]
+                ub = p_max[i]
+                hit = (q <= 0.0 and g < 0.0 and q < ub) or (q >= ub and g > 0.0 and q > 0.0)
+            else:
+                hit = g < 0.0
+            if hit:
+                if k == SLOTS:
+                    return SLOTS + 1
+                vidx[k] = lo + i
+                vg[k] = g
+                k += 1
     return k
 
 
@@ -574,9 +598,15 @@ def _chunk_events(
                 ub = p_max[i] if bounded else inf
                 if m[i] == 0:
                     if scan_all:
-                        e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val,
-                                         lo, keep_mask, 0.0, False, ev)  # fmt: skip
-                        pen = max(pen, e)
+                        # the violator test inline: most constrained points pass it
+                        g = sigma * u[i] - h[i] - d
+                        pn = sigma * p_new[i]
+                        rise = pn <= 0.0 and g < 0.0 and pn < ub
+                        fall = pn >= ub and g > 0.0 and pn > 0.0
+                        if rise or fall:
+                            e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx,
+                                             val, lo, keep_mask, g, True, ev)  # fmt: skip
+                            pen = max(pen, e)
                     continue
                 pn = sigma * p_new[i]
                 if pn < 0.0 or pn > ub:
