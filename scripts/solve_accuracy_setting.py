@@ -86,7 +86,7 @@ def main(
             "area_um2": r.area * 1e12,
             "rendered_area_um2": area,
             "iterations": int(r.iterations),
-            "convolutions": int(r.info.convolutions),
+            "convolutions": float(r.info.convolutions),
             "solve_s": float(r.info.wall_time_s),
         }
         for r, area in zip(results, rendered, strict=True)

@@ -52,14 +52,14 @@ def main(point: str, study: dict, levelled_path: str, record: dict, summary_path
                 "load_mn": r.load * 1e3,
                 "area_um2": r.area * 1e12,
                 "iterations": int(r.iterations),
-                "convolutions": int(r.info.convolutions),
+                "convolutions": float(r.info.convolutions),
             }
             for r in results
         ],
     }
     write_json(summary_path, summary)
     log.info(
-        "%s (ratio %g) at %s: %.2f s, %d convolutions",
+        "%s (ratio %g) at %s: %.2f s, %g convolutions",
         model,
         ratio,
         point,

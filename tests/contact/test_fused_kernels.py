@@ -252,7 +252,7 @@ def test_update_records_few_events_and_counts_many(record_max):
     """update's two event paths, the recording one (a chunk's clipped points and the
     violators direction recorded) and the branch-free one (no records), give the numpy
     step's pressure, free set and counts; the recording one lists exactly the changed
-    points and the pressure each event added."""
+    points and the pressure each event added, and only it says its records are complete."""
     rng = np.random.default_rng(4)
     n = 2 * K.CHUNK + 100
     m = (rng.random(n) < 0.4).astype(np.uint8)
@@ -281,7 +281,7 @@ def test_update_records_few_events_and_counts_many(record_max):
     val = np.zeros((nch, K.SLOTS))
     counts = np.zeros((nch, 2), dtype=np.int64)
     mm, pp, t2 = m.copy(), p.copy(), t.copy()
-    psum, pen, _ = K.update(
+    psum, pen, _, complete = K.update(
         pp, pp, u.copy(), np.zeros(n), t2, h, mm, np.full(1, np.inf), False, sigma, d, tau,
         viol, idx, val, counts, False, False, vidx, vg, record_max,
     )  # fmt: skip
@@ -292,6 +292,8 @@ def test_update_records_few_events_and_counts_many(record_max):
     assert (counts[:, 0].sum(), counts[:, 1].sum()) == (clip.sum(), join.sum())
     assert psum == pytest.approx(ref_p.sum(), rel=1e-13)
     assert pen == pytest.approx(np.abs(g[join]).max(), rel=1e-15)
+    # the records are complete unless a chunk was swept without them
+    assert complete == (record_max == K.SLOTS)
     if record_max == K.SLOTS:
         got_idx, got_val = K.changed_points(counts, idx, val)
         step = p - tau / sigma * t

@@ -231,7 +231,7 @@ class BoundedLoadSweep:
         """
         q = self.spare
         violators, vidx, vg = found
-        total, pen, at_bound = _k.update(
+        total, pen, at_bound, complete = _k.update(
             p, q, u, r, t, h, m, self.p_max, True, 1.0, d, tau, violators,
             idx_buf, val_buf, counts, True, True, vidx, vg, self.sparse_max,
         )  # fmt: skip
@@ -240,7 +240,8 @@ class BoundedLoadSweep:
         if rest < 0.0 or (rest > 0.0 and not free_sum > 0.0):
             return self._numpy_step(p, u, r, t, h, m, d, tau)
         changed = int(counts.sum())
-        sparse = changed <= self.sparse_max
+        # records complete: no chunk was swept without them (kernels.update)
+        sparse = changed <= self.sparse_max and complete
         if sparse:
             idx, vals = _k.changed_points(counts, idx_buf, val_buf)
             self._add_responses(u, idx, vals)

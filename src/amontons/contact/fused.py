@@ -50,9 +50,10 @@ from .stall import StallMonitor
 
 # Most changed points (clipped + added) applied to u as point responses instead of a full
 # convolution. One point costs a sweep of the real-space kernel (kernels.add_point_responses,
-# ~0.6 ms at 1024² periodic, ~0.9 ms at 1024² non-periodic) against ~9 ms for a periodic
-# convolution and ~35 ms for a padded one (benchmarks/README.md, "Fewer convolutions"), so
-# the break-even is ~15 points periodic and ~40 padded; the limits stay below it.
+# ~0.6 ms at 1024² periodic, ~0.9 ms at 1024² non-periodic). Following the step also takes
+# the inverse transform of K*t, which a full update skips: at 1024² periodic that is 6.6 ms
+# against 12.4 ms for the convolution, so the break-even is ~10 points periodic
+# (benchmarks/README.md, "Fewer convolutions").
 SPARSE_MAX_PERIODIC = 12
 # Largest Σa²/G of the one-pass moments about the previous approach (see _centred_moments).
 RECENTRE = 1e3
@@ -332,6 +333,7 @@ def _loop(
             # (this pass is paid only in the last iterations; otherwise p is updated in place)
             p_old = np.copy(p) if p_old is None else _copy(p, p_old)
         how = None  # how u followed the step, when the bounded load step says
+        n_sparse = 0  # above sparse_max when update's records are incomplete
         if sweep is not None:
             p, m, n_clip, n_add, pen, how, backtracked = sweep.step(
                 p, u, r, t, h, m, d, tau, found, idx_buf, val_buf, counts
@@ -344,7 +346,7 @@ def _loop(
             conv(p, u)
             how = "full: bounded load"
         else:
-            psum, pen, _ = _k.update(
+            psum, pen, _, complete = _k.update(
                 p, p, u, r, t, h, m, p_max, bounded, sigma, d, tau,
                 violators, idx_buf, val_buf, counts, False, not split, vidx, vg,
                 sparse_max if sparse_ok else -1,
@@ -352,6 +354,9 @@ def _loop(
             n_clip = int(counts[:, 0].sum())
             n_add = int(counts[:, 1].sum())
             backtracked = False
+            if not complete:
+                # a chunk swept without records: u cannot follow by point responses
+                n_sparse = sparse_max + 1
         if backtracked:
             delta = 0.0
             resets += 1
@@ -381,10 +386,14 @@ def _loop(
             else:
                 since_fresh += 1
             updates[how] += 1
-        elif since_fresh >= refresh or (changes and not (sparse_ok and changes <= sparse_max)):
+        elif since_fresh >= refresh or (
+            changes and not (sparse_ok and max(changes, n_sparse) <= sparse_max)
+        ):
             conv(p, u)
             since_fresh = 0
-            updates["full: changes" if changes > sparse_max else "full: refresh"] += 1
+            updates[
+                "full: changes" if max(changes, n_sparse) > sparse_max else "full: refresh"
+            ] += 1
         else:
             updates["point responses" if changes else "linear"] += 1
             if split:

@@ -50,8 +50,8 @@ CHUNK = 16384
 # point responses only when there are at most this many in total (.fused.SPARSE_MAX), so a
 # chunk never needs more slots than that.
 SLOTS = 64
-# Points per block of update's search for clipped points in a chunk with a few events:
-# blocks without one are passed over after a vectorised test.
+# Points per block of update's search for clipped points and direction's for violators in a
+# chunk with a few: blocks without one are passed over after a vectorised test.
 SCAN = 256
 
 # fastmath "reassoc" only: it lets LLVM vectorise the reductions (several partial sums per
@@ -176,8 +176,9 @@ def direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, v
     A chunk with at most ``SLOTS`` of them records their flat indices into ``vidx[c, :]``
     and their gaps (m) into ``vg[c, :]``, in index order, so that ``update`` visits only
     those points and its clipped ones instead of running its scalar loop over the chunk;
-    ``violators[c]`` is then their number as ``update`` tests them, or ``SLOTS + 1`` if
-    that exceeds the slots.
+    ``violators[c]`` is then their number as recorded, or ``SLOTS + 1`` if that exceeds the
+    slots; a chunk with more than ``SLOTS`` keeps its vectorised count (``update`` only asks
+    whether it exceeds ``SLOTS``).
     """
     n = u.size
     nch = (n + CHUNK - 1) // CHUNK
@@ -281,8 +282,9 @@ def update(
     should be free (unloaded and penetrating with room to rise, or at ``p_max`` and open)
     moves by ``-tau·g`` and joins the free set, as in :class:`amontons.contact.cg.HardWall`
     and :class:`~amontons.contact.cg.BoundedWall`. With ``with_u``, ``u`` gets
-    ``-tau/sigma·r`` in place; without, ``u`` and ``r`` are not read (the caller brings ``u``
-    to the new pressure itself, :mod:`.fused`).
+    ``-tau/sigma·r`` in place; without, ``u`` is not written (the gaps of the points that
+    may join are still read from it) and ``r`` is not read: the caller brings ``u`` to the
+    new pressure itself (:mod:`.fused`).
 
     ``p_max`` (Pa) has one entry per point when ``bounded`` is 1, else one entry, ignored
     (no upper bound). Changed points are recorded per chunk in ``idx[c, :]`` (flat index)
@@ -293,9 +295,11 @@ def update(
     counted, and recorded in ``vidx``, ``vg``, by ``direction``). A chunk without events
     takes a vectorised step; one with a few takes it too and then visits only its clipped
     points and its recorded violators, in index order. A chunk with more than
-    ``record_max`` events (the most the caller applies as point responses: beyond, it
-    takes ``u`` afresh and needs no records) runs a branch-free sweep that records nothing
-    but the counts.
+    ``min(record_max, SLOTS)`` clipped points and violators (``record_max``: the most the
+    caller applies as point responses; beyond, it takes ``u`` afresh and needs no records)
+    runs, under the hard wall without ``keep_mask`` or ``with_u``, a branch-free sweep that
+    records nothing but the counts, and otherwise a scan of every constrained point that
+    records up to ``SLOTS`` events.
 
     With ``keep_mask`` (the bounded load step, :mod:`.bounded_load`) the free set ``m`` and
     the direction ``t`` are left as they were (the events are still recorded), so that the
@@ -303,11 +307,15 @@ def update(
     ``[0, p_max]`` too; the caller rebuilds ``m`` and ``t`` after its rescale.
 
     Returns ``(Σ p_new, max |g| over the added points, Σ p_new over the points at
-    p_max)`` (stored units; the last is 0 without a bound).
+    p_max, records complete)`` (stored units; the third is 0 without a bound). The records
+    are complete unless a chunk took one of the two sweeps for many events: the caller must
+    then take ``u`` afresh whatever the counts say (they would say so too, unless two
+    compiled tests of a gap at round-off level disagreed).
     """
     n = p.size
     nch = (n + CHUNK - 1) // CHUNK
     part = np.zeros((nch, 3))
+    partial = np.zeros(nch, dtype=np.int64)
     step = tau / sigma
     for c in prange(nch):
         lo = c * CHUNK
@@ -322,6 +330,7 @@ def update(
             nclips = _clips_hard(pc, tc, mc, step)
         nv = violators[c]
         if (nv or nclips) and nv + nclips > min(record_max, SLOTS):
+            partial[c] = 1
             if not (bounded or keep_mask or with_u):
                 acc, accb, pen, nclip, nadd = _chunk_bulk_hard(
                     pc, pnc, uc, tc, hc, mc, sigma, d, tau
@@ -354,11 +363,13 @@ def update(
     total = 0.0
     pen = 0.0
     at_bound = 0.0
+    complete = True
     for c in range(nch):
         total += part[c, 0]
         pen = max(pen, part[c, 1])
         at_bound += part[c, 2]
-    return total, pen, at_bound
+        complete = complete and partial[c] == 0
+    return total, pen, at_bound, complete
 
 
 @numba.njit(**_INNER)
@@ -439,9 +450,10 @@ def _chunk_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau):
         g = sigma * u[i] - h[i] - d
         join = max(1.0 - free, clip) * (g < 0.0)
         keep = free - clip
-        q = keep * q - join * (step * g)
+        # as _point_event: a joining point at (0 - tau·g)/sigma, a clipped one at 0
+        q = q if keep else ((-tau * g) / sigma if join else 0.0)
         m[i] = np.uint8(keep + join)
-        t[i] = t[i] * (1.0 - clip)
+        t[i] = 0.0 if clip else t[i]
         p_new[i] = q
         acc += q
         pen = max(pen, -g * join)
@@ -452,8 +464,13 @@ def _chunk_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau):
 
 @numba.njit(cache=True)
 def _block_violators(u, sigma, h, m, d, p, p_max, bounded, b0, b1):
-    """Whether points ``b0:b1`` hold a violator (``_record_violators``' test, branch-free;
-    no fast-math, so it agrees with the scalar test to the last bit)."""
+    """Whether points ``b0:b1`` hold a violator (``_record_violators``' test, branch-free).
+    Compiled inside ``direction`` it takes that kernel's fast-math flags (numba passes them
+    to callees), like every helper here: the gaps of the different loops agree because
+    LLVM associates ``sigma·u - h - d`` the same way in each, not by guarantee; a gap at
+    round-off level that two loops judge differently changes no answer (convergence is
+    judged on a fresh ``u``) and cannot corrupt ``u`` (``update`` reports its records
+    complete only when no chunk took a sweep without them)."""
     k = 0
     if bounded:
         for i in range(b0, b1):
@@ -470,8 +487,8 @@ def _block_violators(u, sigma, h, m, d, p, p_max, bounded, b0, b1):
 
 @numba.njit(cache=True)
 def _record_violators(u, sigma, h, m, d, p, p_max, bounded, lo, vidx, vg):
-    """Record a chunk's violators (``direction``) with ``update``'s test and arithmetic
-    (plain IEEE, no reassociation); returns their number, ``SLOTS + 1`` past the slots.
+    """Record a chunk's violators (``direction``) with ``update``'s test and arithmetic;
+    returns their number, ``SLOTS + 1`` past the slots.
     Blocks of ``SCAN`` points without one are passed over after a vectorised test."""
     k = 0
     n = u.size
