@@ -130,6 +130,14 @@ def gap_moments(u, sigma, h, m, t, shift):
 
 
 @numba.njit(**_INNER)
+def _should_join(q, g, ub):
+    """The violator test: a constrained point with pressure ``q`` (Pa) and gap ``g`` (m)
+    should be free if it is unloaded and penetrating with room to rise, or at ``ub`` and
+    open (branch-free, so loops that use it still vectorise)."""
+    return ((q <= 0.0) & (g < 0.0) & (q < ub)) | ((q >= ub) & (g > 0.0) & (q > 0.0))
+
+
+@numba.njit(**_INNER)
 def _direction_hard(u, sigma, h, m, t, d, beta, shift):
     """A chunk of ``direction`` under the hard wall: ``(Σ t, violators)``. A constrained
     point has ``p = 0`` here (points leave the free set only by clipping to 0), so the
@@ -158,9 +166,7 @@ def _direction_bounded(u, sigma, h, m, t, d, beta, shift, p, p_max):
         acc += v
         q = sigma * p[i]
         ub = p_max[i]
-        rise = (q <= 0.0) & (g < 0.0) & (q < ub)
-        fall = (q >= ub) & (g > 0.0) & (q > 0.0)
-        k += (m[i] == 0) & (rise | fall)
+        k += (m[i] == 0) & _should_join(q, g, ub)
     return acc, k
 
 
@@ -477,8 +483,7 @@ def _block_violators(u, sigma, h, m, d, p, p_max, bounded, b0, b1):
             g = sigma * u[i] - h[i] - d
             q = sigma * p[i]
             ub = p_max[i]
-            hit = ((q <= 0.0) & (g < 0.0) & (q < ub)) | ((q >= ub) & (g > 0.0) & (q > 0.0))
-            k += (m[i] == 0) & hit
+            k += (m[i] == 0) & _should_join(q, g, ub)
     else:
         for i in range(b0, b1):
             k += (m[i] == 0) & (sigma * u[i] - h[i] - d < 0.0)
@@ -503,7 +508,7 @@ def _record_violators(u, sigma, h, m, d, p, p_max, bounded, lo, vidx, vg):
             if bounded:
                 q = sigma * p[i]
                 ub = p_max[i]
-                hit = (q <= 0.0 and g < 0.0 and q < ub) or (q >= ub and g > 0.0 and q > 0.0)
+                hit = _should_join(q, g, ub)
             else:
                 hit = g < 0.0
             if hit:
@@ -551,9 +556,7 @@ def _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx, val, lo, keep_mas
     if not free:
         if not known:
             g = sigma * u[i] - h[i] - d
-        rise = pn <= 0.0 and g < 0.0 and pn < ub
-        fall = pn >= ub and g > 0.0 and pn > 0.0
-        if rise or fall:
+        if _should_join(pn, g, ub):
             added = -tau * g
             joined = pn + added
             if keep_mask:
@@ -618,9 +621,7 @@ def _chunk_events(
                         # the violator test inline: most constrained points pass it
                         g = sigma * u[i] - h[i] - d
                         pn = sigma * p_new[i]
-                        rise = pn <= 0.0 and g < 0.0 and pn < ub
-                        fall = pn >= ub and g > 0.0 and pn > 0.0
-                        if rise or fall:
+                        if _should_join(pn, g, ub):
                             e = _point_event(i, p_new, u, t, h, m, ub, sigma, d, tau, idx,
                                              val, lo, keep_mask, g, True, ev)  # fmt: skip
                             pen = max(pen, e)
@@ -810,9 +811,7 @@ def worst_violation(p, u, h, d, m, p_max, bounded):
         ub = p_max[i] if bounded else math.inf
         g = u[i] - h[i] - d
         pi = p[i]
-        rise = pi <= 0.0 and g < 0.0 and pi < ub
-        fall = pi >= ub and g > 0.0 and pi > 0.0
-        if m[i] == 0 and (rise or fall):
+        if m[i] == 0 and _should_join(pi, g, ub):
             pen = max(pen, abs(g))
     return pen
 
