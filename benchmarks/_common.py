@@ -36,10 +36,10 @@ PINNED = "--pinned" in sys.argv
 HURST, RMS_SLOPE, PBAR = 0.8, 0.1, 0.005
 E_STAR = 1.0  # units are arbitrary but consistent; the solver is SI-agnostic in scale
 
-# The benchmarks time the solver, so they plan FFTs by measurement, passed explicitly as
-# planner_effort=TIMING_EFFORT: FFTW_MEASURE gives faster convolutions than the solver's
-# deterministic default FFTW_ESTIMATE (README, "FFTW planner effort"), at the price of plans,
-# and last bits, that can change from run to run. Plans are built before the timings.
+# The benchmarks time the solver with measured FFT plans, passed explicitly as
+# planner_effort=TIMING_EFFORT (the solver's default since 2026-11-24, FFTW_ESTIMATE before:
+# tables measured before then ran the solver's own default on the explicit effort anyway).
+# Plans are built before the timings.
 TIMING_EFFORT = "FFTW_MEASURE"
 
 

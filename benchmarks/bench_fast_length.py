@@ -3,7 +3,8 @@
 The Hockney-padded operator used to work on exactly 2n × 2n; it now pads each axis to
 ``fast_length(2n)`` (:func:`amontons.contact.fft.fast_length`), which gives the same field
 to round-off. For each window n this times, on one thread with the solver's default
-planner effort (FFTW_ESTIMATE, deterministic; ``--effort`` to change it):
+planner effort (FFTW_MEASURE since 2026-11-24, FFTW_ESTIMATE when the README's table was
+measured; ``--effort`` to change it):
 
 * one pruned convolution (ms), calls alternating between the 2n operator ("before") and
   the fast one ("after"), median of ``--repeats`` rounds of 3 calls each;

@@ -11,6 +11,8 @@ time inside the operator calls (the FFT pairs plus their spectrum multiply) in p
 iteration, so "ratio − in conv" is the element-wise work alone. "ratio, cold pair" divides
 by a pair timed after a sweep over 128 MB: back to back, a pair whose arrays fit in the
 last-level cache (1024² here) runs from it, which an FFT inside an iteration never does.
+"ratio, MEASURE pair" divides by the floor the issue names (issue 23): a pair planned with
+FFTW_MEASURE on the same threads, back to back, whatever effort the solver plans with.
 Medians of --repeats.
 
 Paths: ``fused`` (numba kernels, the default of the solver) and ``numpy`` (the reference
@@ -104,19 +106,23 @@ def solve_once(op, h, load, kernels, threads):
 
 def run(n, periodic, path, threads, effort, repeats):
     h, load = problem(n, periodic)
-    effort = resolve_planner_effort(effort, threads, "pyfftw")
+    effort = resolve_planner_effort(effort)
     op = get_operator(
         h.shape, 1.0, E_STAR, periodic=periodic, threads=threads, planner_effort=effort
     )
     fft_shape = h.shape if periodic else op.padded_shape  # fast lengths >= 2n
     pair = RealFFT2Pair(fft_shape, threads=threads, planner_effort=effort)
     pair.real[...] = np.random.default_rng(0).random(pair.shape)
+    measured = RealFFT2Pair(fft_shape, threads=threads, planner_effort="FFTW_MEASURE")
+    measured.real[...] = pair.real
     kernels = path == "fused"
     solve_once(op, h, load, kernels, threads)  # warm-up: plans, kernels, caches
     ratios, per_it, pairs, in_conv, cold_ratios = [], [], [], [], []
+    measured_pairs, measured_ratios, measured_conv = [], [], []
     for _ in range(repeats):
         pair_t = _pair_time(pair)
         cold_t = _pair_time(pair, cold=True)
+        measured_t = _pair_time(measured)
         dt, conv_s, out = solve_once(op, h, load, kernels, threads)
         pair_t = 0.5 * (pair_t + _pair_time(pair))
         it = out.iterations
@@ -125,6 +131,9 @@ def run(n, periodic, path, threads, effort, repeats):
         cold_ratios.append(dt / it / cold_t)
         ratios.append(dt / it / pair_t)
         in_conv.append(conv_s / it / pair_t)
+        measured_pairs.append(measured_t)
+        measured_ratios.append(dt / it / measured_t)
+        measured_conv.append(conv_s / it / measured_t)
     conv_per_it = out.convolutions / out.iterations
     ratio = statistics.median(ratios)
     conv = statistics.median(in_conv)
@@ -144,6 +153,11 @@ def run(n, periodic, path, threads, effort, repeats):
         "remainder": ratio - conv_per_it,
         "in conv (pairs)": conv,
         "element-wise (pairs)": ratio - conv,
+        "MEASURE pair ms": statistics.median(measured_pairs) * 1e3,
+        "ratio, MEASURE pair": statistics.median(measured_ratios),
+        "element-wise (MEASURE pairs)": statistics.median(
+            [r - c for r, c in zip(measured_ratios, measured_conv, strict=True)]
+        ),
         "area": float(np.mean(out.pressure > 0)),
         # how u followed each step: linear (no changed point), point responses, or a full
         # convolution because too many points changed / for the periodic refresh

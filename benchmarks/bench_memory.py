@@ -4,8 +4,8 @@ Each case runs in a fresh subprocess; the peak resident set size (``ru_maxrss``)
 process minus the baseline of an identical process that only imports the solver and builds
 the height field gives the memory the solve itself needs. tracemalloc peaks (numpy
 allocations only; FFTW work arrays from pyfftw are numpy arrays too) are quoted alongside.
-Nothing is timed, so the solve uses the solver's default planner effort (FFTW_ESTIMATE), as
-the pipeline does.
+Nothing is timed, so the solve uses the solver's default planner effort (FFTW_ESTIMATE until
+2026-11-24, FFTW_MEASURE since), as the pipeline does.
 
     python benchmarks/bench_memory.py           # 1024², 2048²
     python benchmarks/bench_memory.py --quick   # 256², 512²

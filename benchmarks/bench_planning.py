@@ -2,10 +2,11 @@
 
 For the periodic operator (rfft2 + irfft2 of n²) and the pruned non-periodic operator
 (padded 2n²), plans are built with FFTW_ESTIMATE, FFTW_MEASURE and FFTW_PATIENT
-(``planner_effort=``) in fresh subprocesses (FFTW wisdom is per process, so every planning
-starts cold) and one convolution is timed (median). The solver's default is FFTW_ESTIMATE,
-the one deterministic effort (same plan, same bytes in every run); the table says what
-``planner_effort="FFTW_MEASURE"`` buys per convolution and costs in planning.
+(``planner_effort=``) in fresh subprocesses with the wisdom file switched off
+(``AMONTONS_FFTW_WISDOM=""``), so every planning starts cold, and one convolution is timed
+(median). The solver's default is FFTW_MEASURE, planned once per machine and kept on disk
+(docs/models.md §2.1, "FFT plans"); the table says what it buys per convolution over
+FFTW_ESTIMATE and what the first planning costs.
 
     python benchmarks/bench_planning.py           # 1024²
     python benchmarks/bench_planning.py --quick   # 256²
@@ -14,6 +15,7 @@ the one deterministic effort (same plan, same bytes in every run); the table say
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -53,7 +55,11 @@ def main():
                     n=n, periodic=periodic, threads=args.threads, repeats=repeats, effort=effort
                 )
                 proc = subprocess.run(
-                    [sys.executable, "-c", code], capture_output=True, text=True, check=True
+                    [sys.executable, "-c", code],
+                    capture_output=True,
+                    text=True,
+                    check=True,
+                    env=dict(os.environ, AMONTONS_FFTW_WISDOM=""),  # plan cold
                 )
                 r = json.loads(proc.stdout.strip().splitlines()[-1])
                 rows.append(

@@ -60,10 +60,11 @@ Options
     hardness with local increments, one bounded CG under the force constraint; the default
     there) or ``"appendix"`` (the appendix's iterative scheme; the only route for
     volume-conserving increments); None picks the default. ``planner_effort``: FFTW
-    planner effort; None (default) is ``"FFTW_ESTIMATE"`` on one thread (deterministic: the
-    same bytes in every run) and ``"FFTW_MEASURE"`` with ``threads > 1`` (plans that use
-    the threads; chosen by timing, so not reproducible bit for bit). An unknown value of
-    either raises :class:`ContactInputError` naming the allowed values.
+    planner effort; None (default) is ``"FFTW_MEASURE"``, whose plans are timed once per
+    machine and kept on disk as FFTW wisdom (:mod:`amontons.contact.wisdom`), so every
+    process uses the same plans and gives the same bytes; ``"FFTW_ESTIMATE"`` plans
+    without timing or disk (slower FFTs). An unknown value of either raises
+    :class:`ContactInputError` naming the allowed values.
 
 Warnings
     :class:`IgnoredOptionWarning` (a ``UserWarning``), once per call, for an option given

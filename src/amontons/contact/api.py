@@ -127,12 +127,15 @@ def solve(
         outer loop).
     planner_effort : str, optional
         FFTW planner effort, one of "FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT",
-        "FFTW_EXHAUSTIVE". None (default): ``"FFTW_ESTIMATE"`` on one thread, which is
-        deterministic (same plan, same result bytes in every run), and ``"FFTW_MEASURE"``
-        with ``threads > 1``, whose plans use the threads (ESTIMATE's do not) but are
-        chosen by timing, so the last bits can change from run to run (the answer agrees
-        with the one-thread one to 1e-10; benchmarks/README.md). Operators are cached per
-        effort. An effort given with the numpy backend is ignored, with a warning.
+        "FFTW_EXHAUSTIVE". None (default): ``"FFTW_MEASURE"``: each plan is timed once per
+        machine and kept on disk as FFTW wisdom (:mod:`amontons.contact.wisdom`, file
+        ``$AMONTONS_FFTW_WISDOM`` or ``~/.cache/amontons``), which every later process
+        imports, so the same plan and the same result bytes in every run on the machine.
+        Its plans use ``threads`` (ESTIMATE's do not) and were 1.2-1.7× faster than
+        ``"FFTW_ESTIMATE"``'s on one thread (benchmarks/README.md); ESTIMATE plans by
+        heuristics, without timing or disk. A plan for another thread count differs in
+        round-off only (the answer agrees with the one-thread one to 1e-10). Operators are
+        cached per effort. An effort given with the numpy backend is ignored, with a warning.
     raise_on_failure : bool
         True (default): a solve that does not converge raises :class:`ConvergenceError`.
         False: it returns a :class:`ContactResult` with ``success=False``, its ``status``

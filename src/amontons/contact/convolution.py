@@ -81,7 +81,8 @@ class PeriodicConvolution(_MultiplierMixin):
         FFTW threads.
     planner_effort : str
         FFTW planner effort, one of :data:`amontons.contact.fft.PLANNER_EFFORTS`
-        (default ``"FFTW_ESTIMATE"``: deterministic).
+        (default ``"FFTW_MEASURE"``, with the machine's wisdom on disk:
+        :mod:`amontons.contact.wisdom`).
     """
 
     periodic = True
@@ -241,7 +242,8 @@ class NonPeriodicConvolution(_MultiplierMixin):
         Use the pruned transform (default) or the plain ``m0 × m1`` one.
     planner_effort : str
         FFTW planner effort, one of :data:`amontons.contact.fft.PLANNER_EFFORTS`
-        (default ``"FFTW_ESTIMATE"``: deterministic).
+        (default ``"FFTW_MEASURE"``, with the machine's wisdom on disk:
+        :mod:`amontons.contact.wisdom`).
     padded_shape : (m0, m1), optional
         The FFT grid, ``m >= 2n`` on each axis; default :func:`fast_padded_shape` (the
         same result to round-off, faster). ``(2n0, 2n1)`` gives plain Hockney padding (tests

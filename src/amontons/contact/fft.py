@@ -7,12 +7,15 @@ themselves cached per (shape, spacing, E*, backend, threads, planner effort), so
 plan is built once per process and reused across iterations, solves and load steps.
 
 Planner effort is an explicit argument (no environment variable). The default,
-``FFTW_ESTIMATE``, picks the plan by heuristics: the same plan, hence the same round-off
-and the same output bytes, in every run. ``FFTW_MEASURE`` (and ``FFTW_PATIENT``,
-``FFTW_EXHAUSTIVE``) time candidate algorithms while planning, so the plan, and the last
-bits of every result, can change from run to run; benchmarks/README.md measures what they
-gain (512²: ~5 % per periodic convolution, ~25 % per pruned non-periodic one, for
-0.4-0.6 s of planning per operator).
+``FFTW_MEASURE``, times candidate algorithms while planning and keeps the fastest; its
+choice is written to FFTW wisdom on disk (:mod:`amontons.contact.wisdom`), which every
+later process on the machine imports, so the plan, the round-off and the output bytes are
+the same from run to run, and planning is paid once per transform and machine (0.3 s for
+a 1024² pair). ``FFTW_ESTIMATE`` picks plans by heuristics without timing anything or
+touching the disk; at one thread its pairs took 1.2× (1024²) to 1.7× (2048²) the measured
+ones here (benchmarks/README.md, "FFTW planner effort"). ``FFTW_PATIENT`` and
+``FFTW_EXHAUSTIVE`` time more candidates (20 s and 150 s of planning for a 1024² and a
+2048² pair).
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 import numpy as np  # noqa: E402
 
 from .result import ContactInputError  # noqa: E402
+from .wisdom import shared_wisdom  # noqa: E402
 
 try:  # pyfftw is optional: numpy.fft is the fallback
     import pyfftw
@@ -41,15 +45,13 @@ except ImportError:  # pragma: no cover - depends on the environment
 
 BACKENDS = ("pyfftw", "numpy")
 
-# FFTW planner flags, cheapest first; only the first is deterministic.
+# FFTW planner flags, cheapest first.
 PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
-DEFAULT_PLANNER_EFFORT = "FFTW_ESTIMATE"
-# Planner effort of a multi-threaded solve when none is given: FFTW_ESTIMATE's plans do not
-# use a second thread here (1024² pair: 8.50 ms on 1 thread, 8.35 ms on 2), FFTW_MEASURE's
-# do (5.38 ms on 2); benchmarks/README.md, "A second core". The price is the determinism
-# of the plan: results can differ in the last bits from run to run (tests hold them to
-# 1e-10 of the one-thread answer).
-THREADED_PLANNER_EFFORT = "FFTW_MEASURE"
+# The planner effort of a solve when none is given, on any number of threads: measured plans
+# (kept on disk, so reproducible) were 1.2-1.7x faster than FFTW_ESTIMATE's on one thread
+# and, unlike ESTIMATE's, use a second thread (1024² pair: 8.50 ms on 1 thread, 8.35 ms on
+# 2 with ESTIMATE, 5.38 ms on 2 with MEASURE; benchmarks/README.md, "A second core").
+DEFAULT_PLANNER_EFFORT = "FFTW_MEASURE"
 
 
 def resolve_backend(backend: str | None) -> str:
@@ -86,15 +88,11 @@ def check_planner_effort(planner_effort: str) -> str:
     return planner_effort
 
 
-def resolve_planner_effort(planner_effort: str | None, threads: int, backend: str) -> str:
+def resolve_planner_effort(planner_effort: str | None) -> str:
     """The planner effort of a solve: ``planner_effort`` if given (checked), else
-    :data:`DEFAULT_PLANNER_EFFORT` on one thread (deterministic) and
-    :data:`THREADED_PLANNER_EFFORT` on several (plans that use them); numpy.fft does not
-    plan, so its effort is always the default."""
+    :data:`DEFAULT_PLANNER_EFFORT` (numpy.fft does not plan; its operators ignore it)."""
     if planner_effort is not None:
         return check_planner_effort(planner_effort)
-    if threads > 1 and backend == "pyfftw":
-        return THREADED_PLANNER_EFFORT
     return DEFAULT_PLANNER_EFFORT
 
 
@@ -137,18 +135,21 @@ def fftw_plan(
 
     The plan's kind (r2c, c2r, c2c) follows from the dtypes. Inverse transforms are
     normalised like :func:`numpy.fft.ifft` (divide by the transform length) when called,
-    not through ``execute()``. ``planner_effort`` is one of :data:`PLANNER_EFFORTS`.
-    Planning with FFTW_MEASURE or more overwrites ``src`` and ``dst``: callers fill the
-    arrays after planning.
+    not through ``execute()``. ``planner_effort`` is one of :data:`PLANNER_EFFORTS`; above
+    FFTW_ESTIMATE the plan is built with the machine's wisdom on disk
+    (:func:`amontons.contact.wisdom.shared_wisdom`). Planning with FFTW_MEASURE or more
+    overwrites ``src`` and ``dst``: callers fill the arrays after planning.
     """
     effort = check_planner_effort(planner_effort)
     direction = "FFTW_BACKWARD" if inverse else "FFTW_FORWARD"
     # Inverse plans only ever read scratch spectra, so FFTW may overwrite them (faster c2r).
     # Forward plans must not: their inputs hold the permanent zero padding.
     flags = (effort, "FFTW_DESTROY_INPUT") if inverse else (effort,)
-    return pyfftw.FFTW(
-        src, dst, axes=tuple(axes), direction=direction, flags=flags, threads=int(threads)
-    )
+    kw = {"axes": tuple(axes), "direction": direction, "flags": flags, "threads": int(threads)}
+    if effort == "FFTW_ESTIMATE":  # no timing: nothing to share between processes
+        return pyfftw.FFTW(src, dst, **kw)
+    with shared_wisdom():
+        return pyfftw.FFTW(src, dst, **kw)
 
 
 class RealFFT2Pair:

@@ -64,7 +64,7 @@ def solve_options(
     max_iter = default_max_iter(shape) if max_iter is None else check_count("max_iter", max_iter)
     threads = check_threads(threads)
     backend = resolve_backend(backend)
-    planner_effort = resolve_planner_effort(planner_effort, threads, backend)
+    planner_effort = resolve_planner_effort(planner_effort)
     check_method(method)
     law = None if plasticity is None else check_law(plasticity)
     route = "elastic" if law is None else resolve_route(law, method)
