@@ -13,6 +13,9 @@ by a pair timed after a sweep over 128 MB: back to back, a pair whose arrays fit
 last-level cache (1024² here) runs from it, which an FFT inside an iteration never does.
 "ratio, MEASURE pair" divides by the floor the issue names (issue 23): a pair planned with
 FFTW_MEASURE on the same threads, back to back, whatever effort the solver plans with.
+"sweep floor" is what the element-wise work cannot go below on this machine: the bytes the
+three sweeps of a periodic iteration must move (SWEEP_BYTES per point) at the memory
+bandwidth of a three-array ``np.add`` timed in the same process, in MEASURE pairs.
 Medians of --repeats.
 
 Paths: ``fused`` (numba kernels, the default of the solver) and ``numpy`` (the reference
@@ -119,6 +122,7 @@ def run(n, periodic, path, threads, effort, repeats):
     solve_once(op, h, load, kernels, threads)  # warm-up: plans, kernels, caches
     ratios, per_it, pairs, in_conv, cold_ratios = [], [], [], [], []
     measured_pairs, measured_ratios, measured_conv = [], [], []
+    bandwidth = _stream_bandwidth(h.size)
     for _ in range(repeats):
         pair_t = _pair_time(pair)
         cold_t = _pair_time(pair, cold=True)
@@ -158,6 +162,11 @@ def run(n, periodic, path, threads, effort, repeats):
         "element-wise (MEASURE pairs)": statistics.median(
             [r - c for r, c in zip(measured_ratios, measured_conv, strict=True)]
         ),
+        "memory GB/s": bandwidth / 1e9,
+        "sweep floor (MEASURE pairs)": SWEEP_BYTES
+        * h.size
+        / bandwidth
+        / statistics.median(measured_pairs),
         "area": float(np.mean(out.pressure > 0)),
         # how u followed each step: linear (no changed point), point responses, or a full
         # convolution because too many points changed / for the periodic refresh
@@ -170,6 +179,25 @@ def run(n, periodic, path, threads, effort, repeats):
 
 # larger than the last-level cache (32 MB here): touched before a "cold" pair
 _FLUSH = np.zeros(128 * 2**20 // 8)
+
+
+# Bytes per grid point the element-wise work of one iteration must move (float64 fields,
+# uint8 free mask): gap_moments reads u, h, t, m (25); direction reads u, h, t, m and writes
+# t (33); update reads p, t, m and writes p, m (26).
+SWEEP_BYTES = 25 + 33 + 26
+
+
+def _stream_bandwidth(size, calls=9):
+    """Memory bandwidth of one core, bytes/s: ``np.add`` of two float64 arrays of ``size``
+    into a third (24 bytes per point), each call after the 128 MB sweep, median."""
+    a, b, c = (np.full(size, v) for v in (1.0, 2.0, 0.0))
+    ts = []
+    for _ in range(calls):
+        np.add(_FLUSH, 1.0, out=_FLUSH)
+        t0 = time.perf_counter()
+        np.add(a, b, out=c)
+        ts.append(time.perf_counter() - t0)
+    return 24 * size / statistics.median(ts)
 
 
 def _pair_time(pair, calls=5, cold=False):
