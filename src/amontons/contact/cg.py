@@ -577,18 +577,21 @@ def _finish(
     extra=None,
 ):
     """The CGOutcome of a finished loop (``p`` Pa and ``u = K*p`` m, flat and fresh);
-    raises ConvergenceError on failure when ``raise_on_failure``."""
+    raises ConvergenceError on failure when ``raise_on_failure``. ``p`` and ``u`` are the
+    loop's own arrays, allocated for this solve: the outcome holds them without a copy (at
+    2048² two copies and a temporary cost ~0.2 s of fresh pages per solve)."""
+    gap = np.subtract(u, h)
     if load_control and p.sum() > 0:
         m = np.empty(p.size)
         nc = constraint.free_mask(p, m, np.empty(p.size, dtype=bool))
         if nc:
-            d = float(np.dot(u - h, m) / nc)
+            d = float(np.dot(gap, m) / nc)
         else:
             # bounded, every loaded point at the bound: the force does not fix d
             from .bounded_load import fully_bound_approach
 
             d = fully_bound_approach(u, h, p, d)
-    gap = u - h - d
+    gap -= d
     hist = np.asarray(history)
     status, message = _status_message(converged, stalled, it, residual, tol, shape, p)
     if status != CONVERGED and raise_on_failure:
@@ -601,8 +604,8 @@ def _finish(
             status=status,
         )
     return CGOutcome(
-        pressure=np.array(p.reshape(shape)),
-        displacement_field=np.array(u.reshape(shape)),
+        pressure=p.reshape(shape),
+        displacement_field=u.reshape(shape),
         gap=gap.reshape(shape),
         rigid_displacement=float(d),
         iterations=it,
