@@ -131,7 +131,7 @@ def solve(
         machine and kept on disk as FFTW wisdom (:mod:`amontons.contact.wisdom`, file
         ``$AMONTONS_FFTW_WISDOM`` or ``~/.cache/amontons``), which every later process
         imports, so the same plan and the same result bytes in every run on the machine.
-        Its plans use ``threads`` (ESTIMATE's do not) and were 1.2-1.7× faster than
+        Its plans use ``threads`` (ESTIMATE's do not) and were 1.1-1.7× faster than
         ``"FFTW_ESTIMATE"``'s on one thread (benchmarks/README.md); ESTIMATE plans by
         heuristics, without timing or disk. A plan for another thread count differs in
         round-off only (the answer agrees with the one-thread one to 1e-10). Operators are

@@ -12,7 +12,7 @@ choice is written to FFTW wisdom on disk (:mod:`amontons.contact.wisdom`), which
 later process on the machine imports, so the plan, the round-off and the output bytes are
 the same from run to run, and planning is paid once per transform and machine (0.3 s for
 a 1024² pair). ``FFTW_ESTIMATE`` picks plans by heuristics without timing anything or
-touching the disk; at one thread its pairs took 1.2× (1024²) to 1.7× (2048²) the measured
+touching the disk; at one thread its pairs took 1.1-1.4× (1024²) and 1.6-1.7× (2048²) the measured
 ones here (benchmarks/README.md, "FFTW planner effort"). ``FFTW_PATIENT`` and
 ``FFTW_EXHAUSTIVE`` time more candidates (20 s and 150 s of planning for a 1024² and a
 2048² pair).
@@ -48,7 +48,7 @@ BACKENDS = ("pyfftw", "numpy")
 # FFTW planner flags, cheapest first.
 PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
 # The planner effort of a solve when none is given, on any number of threads: measured plans
-# (kept on disk, so reproducible) were 1.2-1.7x faster than FFTW_ESTIMATE's on one thread
+# (kept on disk, so reproducible) were 1.1-1.7x faster than FFTW_ESTIMATE's on one thread
 # and, unlike ESTIMATE's, use a second thread (1024² pair: 8.50 ms on 1 thread, 8.35 ms on
 # 2 with ESTIMATE, 5.38 ms on 2 with MEASURE; benchmarks/README.md, "A second core").
 DEFAULT_PLANNER_EFFORT = "FFTW_MEASURE"
