@@ -20,6 +20,7 @@ ones here (benchmarks/README.md, "FFTW planner effort"). ``FFTW_PATIENT`` and
 
 from __future__ import annotations
 
+import contextlib
 import os
 
 # pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
@@ -145,11 +146,12 @@ def fftw_plan(
     # Inverse plans only ever read scratch spectra, so FFTW may overwrite them (faster c2r).
     # Forward plans must not: their inputs hold the permanent zero padding.
     flags = (effort, "FFTW_DESTROY_INPUT") if inverse else (effort,)
-    kw = {"axes": tuple(axes), "direction": direction, "flags": flags, "threads": int(threads)}
-    if effort == "FFTW_ESTIMATE":  # no timing: nothing to share between processes
-        return pyfftw.FFTW(src, dst, **kw)
-    with shared_wisdom():
-        return pyfftw.FFTW(src, dst, **kw)
+    # ESTIMATE times nothing: nothing to share between processes
+    timed = effort != "FFTW_ESTIMATE"
+    with shared_wisdom() if timed else contextlib.nullcontext():
+        return pyfftw.FFTW(
+            src, dst, axes=tuple(axes), direction=direction, flags=flags, threads=int(threads)
+        )
 
 
 class RealFFT2Pair:

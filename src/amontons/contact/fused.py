@@ -333,7 +333,7 @@ def _loop(
             # (this pass is paid only in the last iterations; otherwise p is updated in place)
             p_old = np.copy(p) if p_old is None else _copy(p, p_old)
         how = None  # how u followed the step, when the bounded load step says
-        n_sparse = 0  # above sparse_max when update's records are incomplete
+        complete = True  # update's records hold every changed point (kernels.update)
         if sweep is not None:
             p, m, n_clip, n_add, pen, how, backtracked = sweep.step(
                 p, u, r, t, h, m, d, tau, found, idx_buf, val_buf, counts
@@ -354,9 +354,6 @@ def _loop(
             n_clip = int(counts[:, 0].sum())
             n_add = int(counts[:, 1].sum())
             backtracked = False
-            if not complete:
-                # a chunk swept without records: u cannot follow by point responses
-                n_sparse = sparse_max + 1
         if backtracked:
             delta = 0.0
             resets += 1
@@ -374,6 +371,8 @@ def _loop(
         if load_control and not bounded_load:
             sigma = load / (pixel_area * psum)
         changes = n_clip + n_add
+        # a chunk swept without records: u cannot follow by point responses either
+        too_many = changes > sparse_max or not complete
         if how is not None:
             # the bounded load step brought u to K*p itself (sigma stays 1)
             if how.startswith("full"):
@@ -386,14 +385,10 @@ def _loop(
             else:
                 since_fresh += 1
             updates[how] += 1
-        elif since_fresh >= refresh or (
-            changes and not (sparse_ok and max(changes, n_sparse) <= sparse_max)
-        ):
+        elif since_fresh >= refresh or (changes and not (sparse_ok and not too_many)):
             conv(p, u)
             since_fresh = 0
-            updates[
-                "full: changes" if max(changes, n_sparse) > sparse_max else "full: refresh"
-            ] += 1
+            updates["full: changes" if too_many else "full: refresh"] += 1
         else:
             updates["point responses" if changes else "linear"] += 1
             if split:

@@ -21,6 +21,7 @@ of node. docs/models.md §2.1 ("FFT plans") says what this means for reproducibi
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import json
 import os
@@ -53,6 +54,7 @@ def _cpu_description() -> str:
     return "\n".join(ln for ln in lines if ln.split(":")[0].strip() in wanted)
 
 
+@functools.cache
 def machine_key() -> str:
     """12 hex digits naming this kind of machine and FFTW build."""
     import pyfftw
@@ -171,10 +173,13 @@ def shared_wisdom():
         if shared:
             on_disk = _import(path)
         yield
+        if not shared:
+            return
+        known = pyfftw.export_wisdom()
         # the process may know plans the file lacks (planned before, or with another file)
-        if shared and _entries(pyfftw.export_wisdom()) != _entries(on_disk):
+        if _entries(known) != _entries(on_disk):
             try:
-                _write_atomically(path, pyfftw.export_wisdom())
+                _write_atomically(path, known)
             except OSError as exc:
                 _warn_unshared(path, exc)
 
