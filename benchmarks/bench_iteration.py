@@ -223,7 +223,7 @@ def main():
     ap.add_argument(
         "--effort",
         default=None,
-        help="FFTW planner effort (default: the solver's, ESTIMATE on 1 thread, MEASURE on more)",
+        help="FFTW planner effort (default: the solver's, FFTW_MEASURE with the wisdom on disk)",
     )
     ap.add_argument("--paths", nargs="*", default=["fused", "numpy"], choices=["fused", "numpy"])
     ap.add_argument(

@@ -58,6 +58,15 @@ def fast_padded_shape(shape) -> tuple[int, int]:
 
 
 class _MultiplierMixin:
+    def _multiply(self) -> None:
+        """``spec *= multiplier`` on the operator's threads, by the numba kernel: numpy's
+        complex-by-real product casts the multiplier to complex through a buffer and runs
+        at 2.3x the kernel's time on one thread (1.1 against 0.5 ms at 1024², 4.1 against
+        1.8 ms at 2048²; benchmarks/README.md, benchmark 1), the same bits (the imaginary
+        part of the cast is an exact zero)."""
+        with _kernels.kernel_threads(self.threads):
+            _kernels.multiply_spectrum(self._spec, self._mult_scaled)
+
     @property
     def multiplier(self) -> np.ndarray:
         """Kernel spectrum on the rfft2 half-spectrum, m/Pa (see :mod:`.greens`)."""
@@ -187,15 +196,6 @@ class PeriodicConvolution(_MultiplierMixin):
         self._inv.execute()
         out[...] = self._real
         return out
-
-    def _multiply(self) -> None:
-        """``spec *= multiplier`` on the operator's threads (numba kernel when threads > 1:
-        numpy's multiply is serial and would be the one serial step of the convolution)."""
-        if self.threads > 1:
-            with _kernels.kernel_threads(self.threads):
-                _kernels.multiply_spectrum(self._spec, self._mult_scaled)
-        else:
-            self._spec *= self._mult_scaled
 
     def real_space_kernel(self) -> np.ndarray:
         """The periodic kernel ``G = irfft2(2/(E*|q|))`` on the grid, m/Pa (built once)."""
@@ -370,7 +370,7 @@ class NonPeriodicConvolution(_MultiplierMixin):
         m0, m1 = self.padded_shape
         if self.backend == "pyfftw":
             self.forward(p)
-            self._spec *= self._mult_scaled
+            self._multiply()
             if out is None:
                 out = np.empty(self.shape)
             return self.inverse(out)
