@@ -21,6 +21,8 @@ $(STAMP): pyproject.toml | $(BIN)/python
 install: $(STAMP)
 
 reproduce: $(STAMP)
+	# the solver's kernels into numba's cache (if cold) before the first job, not inside it
+	$(BIN)/python -c "from amontons.contact.kernel_cache import main; main()"
 	$(BIN)/snakemake --profile profiles/default --cores $(CORES) --configfile config/config.yaml
 	$(BIN)/snakemake --profile profiles/default --cores $(CORES) --configfile config/config.yaml \
 		--report results/full/report.html

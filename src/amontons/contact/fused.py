@@ -112,15 +112,17 @@ def _winkler_parts(operator):
     base = getattr(operator, "operator", None)
     if compliance is None or base is None:
         return operator, None
-    return base, np.ascontiguousarray(compliance, dtype=np.float64).ravel()
+    # a fresh writable copy: a read-only array is another type to the compiled kernels,
+    # which would then compile in this process (.kernel_cache)
+    return base, np.array(compliance, dtype=np.float64).ravel()
 
 
 def _bound_array(constraint, n):
     """``(p_max per point, bounded flag)`` for the kernels (Pa)."""
     if not constraint.bounded:
         return np.full(1, np.inf), False
-    p_max = np.broadcast_to(np.asarray(constraint.p_max, dtype=np.float64), (n,))
-    return np.ascontiguousarray(p_max), True
+    # a fresh writable copy (broadcast_to gives a read-only view), as in _winkler_parts
+    return np.array(np.broadcast_to(constraint.p_max, (n,)), dtype=np.float64), True
 
 
 def _loop(

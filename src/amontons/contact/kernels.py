@@ -23,10 +23,10 @@ algorithm, :mod:`.fused` the order):
 Arrays are flat float64 (the free set ``m`` is uint8). Sums are taken over fixed chunks of
 ``CHUNK`` points and the partial sums added in chunk order, so every result is the same bit
 for bit whatever the number of threads (``threads`` only decides who computes which
-chunk). Kernels are compiled with ``parallel=True`` and cached on disk (``cache=True``):
-the first call in a fresh environment compiles them (a few seconds, benchmarks/README.md),
-later processes load them. The thread count is set per call through
-:func:`numba.set_num_threads` (see :func:`kernel_threads`).
+chunk). Kernels are compiled with ``parallel=True`` and cached on disk (``cache=True``),
+and every process runs them from that cache: on a cold one the first call compiles them in
+a child process first (~45 s, :mod:`.kernel_cache` says why). The thread count is set per
+call through :func:`numba.set_num_threads` (see :func:`kernel_threads`).
 
 Units: pressures in Pa, lengths in m; ``sigma`` is the dimensionless scale of the stored
 pressure and displacement (true value = ``sigma`` × stored), which lets load control rescale
@@ -41,6 +41,8 @@ import math
 import numba
 import numpy as np
 from numba import prange
+
+from . import kernel_cache as _kernel_cache
 
 # Points per chunk of a reduction: fixed, so partial sums (and results) do not depend on the
 # thread count; small enough to balance 2-8 threads from 512² on, large enough that the
@@ -68,7 +70,10 @@ def n_chunks(n: int) -> int:
 
 @contextlib.contextmanager
 def kernel_threads(threads: int):
-    """Run the kernels on ``threads`` threads (clipped to numba's pool) within the block."""
+    """Run the kernels on ``threads`` threads (clipped to numba's pool) within the block;
+    the first call of a process first makes sure they run from numba's disk cache
+    (:mod:`.kernel_cache`)."""
+    _kernel_cache.ensure_cached(ENTRY_POINTS)
     old = numba.get_num_threads()
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     try:
@@ -978,3 +983,20 @@ def changed_points(counts, idx_buf, val_buf):
     idx = np.concatenate([idx_buf[c, : per[c]] for c in rows])
     vals = np.concatenate([val_buf[c, : per[c]] for c in rows])
     return idx, vals
+
+
+# the kernels called from Python (the others are compiled into them)
+ENTRY_POINTS = (
+    gap_moments,
+    direction,
+    step_dots,
+    update,
+    rescale_free,
+    relative_change,
+    free_mask,
+    worst_violation,
+    add_point_responses,
+    multiply_spectrum,
+    multiply_spectrum_energy,
+    subtract_scaled,
+)
