@@ -387,7 +387,7 @@ def _loop(
             else:
                 since_fresh += 1
             updates[how] += 1
-        elif since_fresh >= refresh or (changes and not (sparse_ok and not too_many)):
+        elif since_fresh >= refresh or (changes and (too_many or not sparse_ok)):
             conv(p, u)
             since_fresh = 0
             updates["full: changes" if too_many else "full: refresh"] += 1

@@ -118,8 +118,9 @@ def warm_up_cases():
 def main() -> None:
     """Compile the kernels into the cache if it is cold (``make reproduce``, and the child
     of :func:`ensure_cached`)."""
+    global _checked
     from . import kernels
 
     if os.environ.get(_CHILD) or is_cold(kernels.ENTRY_POINTS):
-        os.environ[_CHILD] = "1"
+        _checked = True  # this process compiles: its warm-up must not start another child
         warm_up()
