@@ -25,7 +25,7 @@ Arrays are flat float64 (the free set ``m`` is uint8). Sums are taken over fixed
 for bit whatever the number of threads (``threads`` only decides who computes which
 chunk). Kernels are compiled with ``parallel=True`` and cached on disk (``cache=True``),
 and every process runs them from that cache: on a cold one the first call compiles them in
-a child process first (~45 s, :mod:`.kernel_cache` says why). The thread count is set per
+a child process first (25-45 s, :mod:`.kernel_cache` says why). The thread count is set per
 call through :func:`numba.set_num_threads` (see :func:`kernel_threads`).
 
 Units: pressures in Pa, lengths in m; ``sigma`` is the dimensionless scale of the stored
