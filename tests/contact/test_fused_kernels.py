@@ -247,11 +247,13 @@ def _step_reference(p, u, t, h, m, sigma, d, tau):
     return q, m_new, clip, join, g
 
 
-@pytest.mark.parametrize("record_max", [K.SLOTS, -1])
+@pytest.mark.parametrize("record_max", [K.SLOTS, 4, -1])
 def test_update_records_few_events_and_counts_many(record_max):
-    """update's two event paths, the recording one (a chunk's clipped points and the
-    violators direction recorded) and the branch-free one (no records), give the numpy
-    step's pressure, free set and counts; the recording one lists exactly the changed
+    """update's event paths give the numpy step's pressure, free set and counts: the
+    recording one (a chunk's clipped points and the violators direction recorded), the same
+    pass when a chunk's events outnumber ``record_max`` (4: two violators recorded, three
+    clipped points and the joins found in the step) and the branch-free sweep of a chunk
+    whose violators alone outnumber it (-1). The recording one lists exactly the changed
     points and the pressure each event added, and only it says its records are complete."""
     rng = np.random.default_rng(4)
     n = 2 * K.CHUNK + 100
@@ -260,15 +262,17 @@ def test_update_records_few_events_and_counts_many(record_max):
     t = np.where(m == 1, rng.normal(size=n), 0.0)
     u, h = rng.normal(size=n), rng.normal(size=n)
     sigma, d = 1.3, 0.0
-    # constrained points open (g = 1), but two per chunk penetrating (g = -0.5); three free
-    # points per chunk that the step drives below 0
+    # constrained points open (g = 1), but two per chunk penetrating (g = -0.5), one among
+    # three free points per chunk that the step drives below 0, one in a block of its own
     tau = 1e-3
     h[m == 0] = sigma * u[m == 0] - d - 1.0
     for c in range(K.n_chunks(n)):
         lo = c * K.CHUNK
         free = lo + np.flatnonzero(m[lo : lo + 200])[:3]
         t[free] = p[free] * sigma / tau * 1.5 + 1.0
-        fixed = lo + np.flatnonzero(m[lo : lo + 200] == 0)[:2]
+        fixed = lo + np.flatnonzero(m[lo : lo + 200] == 0)[:1]
+        far = lo + 2 * K.SCAN + np.flatnonzero(m[lo + 2 * K.SCAN : lo + 3 * K.SCAN] == 0)[:1]
+        fixed = np.concatenate([fixed, far[far < n]])
         h[fixed] = sigma * u[fixed] - d + 0.5
     ref_p, ref_m, clip, join, g = _step_reference(p.copy(), u, t, h, m, sigma, d, tau)
     nch = K.n_chunks(n)
@@ -285,7 +289,7 @@ def test_update_records_few_events_and_counts_many(record_max):
         pp, pp, u.copy(), np.zeros(n), t2, h, mm, np.full(1, np.inf), False, sigma, d, tau,
         viol, idx, val, counts, False, False, vidx, vg, record_max,
     )  # fmt: skip
-    assert clip.sum() == 3 * nch and join.sum() >= 2 * nch
+    assert clip.sum() == 3 * nch and join.sum() >= 2 * nch - 1
     assert np.allclose(pp, ref_p, rtol=1e-14, atol=0)
     assert np.array_equal(mm, ref_m)
     assert not np.any(t2[clip])
