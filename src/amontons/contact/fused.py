@@ -49,11 +49,13 @@ from .result import CONVERGED, STALLED, ConvergenceError
 from .stall import StallMonitor
 
 # Most changed points (clipped + added) applied to u as point responses instead of a full
-# convolution. One point costs a sweep of the real-space kernel (kernels.add_point_responses,
-# ~0.6 ms at 1024² periodic, ~0.9 ms at 1024² non-periodic). Following the step also takes
-# the inverse transform of K*t, which a full update skips: at 1024² periodic that is 6.6 ms
-# against 12.4 ms for the convolution, so the break-even is ~10 points periodic
-# (benchmarks/README.md, "Fewer convolutions").
+# convolution. One point costs a sweep of the real-space kernel (kernels.add_point_responses:
+# 0.3-0.7 ms at 1024² periodic, 0.5-1.0 ms non-periodic, 1.5-2.6 ms at 2048² periodic, the
+# less the more points share the sweep). Following the step also takes the inverse transform
+# of K*t, which a full update skips, so the break-even is the points whose responses cost
+# a convolution less its inverse: ~12 at 1024² and ~17 at 2048² periodic, ~38 at 1024²
+# non-periodic (benchmarks/bench_point_responses.py; benchmarks/README.md, "Fewer
+# convolutions", which says why the limits were not raised).
 SPARSE_MAX_PERIODIC = 12
 # Largest Σa²/G of the one-pass moments about the previous approach (see _centred_moments).
 RECENTRE = 1e3
