@@ -375,7 +375,8 @@ def _loop(
         if load_control and not bounded_load:
             sigma = load / (pixel_area * psum)
         changes = n_clip + n_add
-        # a chunk swept without records: u cannot follow by point responses either
+        # a chunk with more events than its records hold: u cannot follow by point
+        # responses either
         too_many = changes > sparse_max or not complete
         if how is not None:
             # the bounded load step brought u to K*p itself (sigma stays 1)

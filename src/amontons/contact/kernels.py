@@ -334,8 +334,10 @@ def update(
     and otherwise a scan of every constrained point that records up to ``SLOTS`` events.
     Any other chunk takes a vectorised step block by block that finds the block's clipped
     points as it goes; only a block with a clipped point or a recorded violator then visits
-    those points, in index order, from L1. One pass over ``p``, ``t`` and ``m``: a chunk's
-    clipped points are not counted beforehand.
+    those points, in index order, from L1, or, under the hard wall without ``keep_mask`` or
+    ``with_u`` once the chunk's events pass that limit, treats its clipped points
+    branch-free. One pass over ``p``, ``t`` and ``m``: a chunk's clipped points are not
+    counted beforehand.
 
     With ``keep_mask`` (the bounded load step, :mod:`.bounded_load`) the free set ``m`` and
     the direction ``t`` are left as they were (the events are still recorded), so that the
@@ -344,9 +346,10 @@ def update(
 
     Returns ``(Σ p_new, max |g| over the added points, Σ p_new over the points at
     p_max, records complete)`` (stored units; the third is 0 without a bound). The records
-    are complete unless a chunk took one of the two sweeps for many events: the caller must
-    then take ``u`` afresh whatever the counts say (they would say so too, unless two
-    compiled tests of a gap at round-off level disagreed).
+    are complete unless a chunk had more events than ``min(record_max, SLOTS)`` (its
+    records may then be partial or missing): the caller must then take ``u`` afresh
+    whatever the counts say (they would say so too, unless two compiled tests of a gap at
+    round-off level disagreed).
     """
     n = p.size
     nch = (n + CHUNK - 1) // CHUNK
@@ -397,8 +400,8 @@ def _chunk_update(
     idx, val, lo, keep_mask, with_u, vidx, vg, nv, record_max,
 ):  # fmt: skip
     """One chunk of :func:`update` (its docstring), by the cheapest routine its violators
-    allow. Returns ``(Σ p_new, max |g| over added points, Σ p_new at p_max, clipped,
-    added, swept without records)``."""
+    allow. Returns ``(Σ p_new, Σ p_new at p_max, max |g| over added points, clipped,
+    added, records incomplete)``."""
     limit = min(record_max, SLOTS)
     if nv > 0 and nv > limit:
         # the violators alone make the chunk one with many events: no records
@@ -412,7 +415,7 @@ def _chunk_update(
         return acc, accb, pen, nclip, nadd, True
     acc, accb, pen, nclip, nadd = _chunk_step_events(
         pc, pnc, uc, rc, tc, hc, mc, ubc, bounded, sigma, d, tau, idx, val, lo, keep_mask,
-        with_u, vidx, vg, nv,
+        with_u, vidx, vg, nv, limit,
     )  # fmt: skip
     events = nclip + nadd
     return acc, accb, pen, nclip, nadd, events > 0 and events > limit
@@ -447,7 +450,7 @@ def _block_step(p, p_new, t, m, p_max, bounded, sigma, step):
 @numba.njit(**_INNER)
 def _chunk_step_events(
     p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, idx, val, lo, keep_mask, with_u,
-    vidx, vg, nv,
+    vidx, vg, nv, limit,
 ):  # fmt: skip
     """The step of a chunk whose violators ``direction`` recorded (``nv`` of them, in
     ``vidx``, ``vg``), in one pass, block by block (``SCAN`` points): the block's vectorised
@@ -455,8 +458,14 @@ def _chunk_step_events(
     gets ``_point_event`` for those points from L1, merged in index order, and its sums
     taken again. Counting the clipped points in a pass of their own before the step cost
     a read of ``p``, ``t`` and ``m`` per iteration (~1 ms at 2048²). Records past the slots
-    are dropped (the caller knows from the counts). Returns ``(Σ p_new, Σ p_new at p_max,
-    max |g| of the joining points, clipped, joined)``."""
+    are dropped (the caller knows from the counts).
+
+    Once a block takes the chunk's events past ``limit`` its records are of no use (the
+    caller follows the step by a convolution), so under the hard wall (without
+    ``keep_mask`` or ``with_u``) that block's and every later block's clipped points are
+    handled branch-free (``_block_clips_hard``): visited one by one, a chunk with thousands
+    took 4× the old count-then-sweep. Returns ``(Σ p_new, Σ p_new at p_max, max |g| of the
+    joining points, clipped, joined)``."""
     step = tau / sigma
     n = p.size
     ev = np.zeros(2, dtype=np.int64)
@@ -465,6 +474,8 @@ def _chunk_step_events(
     pen = 0.0
     vk = 0
     inf = math.inf
+    branch_free = not (bounded or keep_mask or with_u)
+    pens = np.empty(SCAN)
     for b0 in range(0, n, SCAN):
         b1 = min(n, b0 + SCAN)
         ub_b = p_max[b0:b1] if bounded else p_max
@@ -475,7 +486,16 @@ def _chunk_step_events(
             acc += a
             accb += ab
             continue
-        if k:
+        if k and branch_free and ev[0] + ev[1] + k > limit:
+            c, j = _block_clips_hard(
+                p_new[b0:b1], u[b0:b1], t[b0:b1], h[b0:b1], m[b0:b1], sigma, d, tau,
+                pens[: b1 - b0],
+            )  # fmt: skip
+            ev[0] += c
+            ev[1] += j
+            if j:
+                pen = max(pen, _max_from_zero(pens[: b1 - b0]))
+        elif k:
             for i in range(b0, b1):
                 if m[i] == 0:
                     continue
@@ -506,6 +526,30 @@ def _chunk_step_events(
         for i in range(n):
             u[i] -= step * r[i]
     return acc, accb, pen, ev[0], ev[1]
+
+
+@numba.njit(**_INNER)
+def _block_clips_hard(p_new, u, t, h, m, sigma, d, tau, pens):
+    """The clipped points of a block after its step (``p_new = p - tau/sigma·t``) under the
+    hard wall, branch-free: a free point the step took below 0 leaves the free set at 0,
+    its direction zeroed, or stays in it at ``-tau·g/sigma`` if it penetrates, as
+    ``_point_event`` rules; constrained points are left alone. ``pens[i]`` gets the
+    penetration ``-g`` of a point that stays, 0 elsewhere. Returns ``(clipped, stayed)``."""
+    nclip = 0
+    nadd = 0
+    for i in range(p_new.size):
+        free = m[i] != 0
+        q = p_new[i]
+        clip = free & (q < 0.0)
+        g = sigma * u[i] - h[i] - d
+        join = clip & (g < 0.0)
+        p_new[i] = q if not clip else ((-tau * g) / sigma if join else 0.0)
+        m[i] = (free & (not clip)) | join
+        t[i] = 0.0 if clip else t[i]
+        pens[i] = -g if join else 0.0
+        nclip += clip
+        nadd += join
+    return nclip, nadd
 
 
 @numba.njit(**_INNER)
