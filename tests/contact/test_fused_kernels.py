@@ -134,7 +134,8 @@ def test_point_responses_equal_the_convolution(periodic):
     np.add.at(c, idx, vals)
     ref = op(c.reshape(n0, n1))
     u = np.zeros((n0, n1))
-    K.add_point_responses(u, op.real_space_kernel(), idx, vals)
+    with K.kernel_threads(1):
+        K.add_point_responses(u, op.real_space_kernel(), idx, vals)
     assert np.abs(u - ref).max() <= 1e-12 * np.abs(ref).max()
 
 
@@ -227,7 +228,8 @@ def test_load_control_direction_has_zero_sum_on_the_free_set():
     viol = np.zeros(K.n_chunks(n), dtype=np.int64)
     vidx = np.zeros((K.n_chunks(n), K.SLOTS), dtype=np.int64)
     vg = np.zeros((K.n_chunks(n), K.SLOTS))
-    K.direction(u, 1.0, h, m, t, d, beta, shift, p, np.full(1, np.inf), False, viol, vidx, vg)
+    with K.kernel_threads(1):
+        K.direction(u, 1.0, h, m, t, d, beta, shift, p, np.full(1, np.inf), False, viol, vidx, vg)
     assert abs(t.sum()) <= 1e-12 * np.abs(t).sum()
     assert not np.any(t[m == 0])
 
@@ -280,15 +282,17 @@ def test_update_records_few_events_and_counts_many(record_max):
     vidx = np.zeros((nch, K.SLOTS), dtype=np.int64)
     vg = np.zeros((nch, K.SLOTS))
     tt = t.copy()
-    K.direction(u, sigma, h, m, tt, d, 0.0, 0.0, p, np.full(1, np.inf), False, viol, vidx, vg)
+    with K.kernel_threads(1):
+        K.direction(u, sigma, h, m, tt, d, 0.0, 0.0, p, np.full(1, np.inf), False, viol, vidx, vg)
     idx = np.zeros((nch, K.SLOTS), dtype=np.int64)
     val = np.zeros((nch, K.SLOTS))
     counts = np.zeros((nch, 2), dtype=np.int64)
     mm, pp, t2 = m.copy(), p.copy(), t.copy()
-    psum, pen, _, complete = K.update(
-        pp, pp, u.copy(), np.zeros(n), t2, h, mm, np.full(1, np.inf), False, sigma, d, tau,
-        viol, idx, val, counts, False, False, vidx, vg, record_max,
-    )  # fmt: skip
+    with K.kernel_threads(1):
+        psum, pen, _, complete = K.update(
+            pp, pp, u.copy(), np.zeros(n), t2, h, mm, np.full(1, np.inf), False, sigma, d, tau,
+            viol, idx, val, counts, False, False, vidx, vg, record_max,
+        )  # fmt: skip
     assert clip.sum() == 3 * nch and join.sum() >= 2 * nch - 1
     assert np.allclose(pp, ref_p, rtol=1e-14, atol=0)
     assert np.array_equal(mm, ref_m)

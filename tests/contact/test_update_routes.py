@@ -170,7 +170,10 @@ def test_update_against_numpy(bounded, keep_mask, with_u, inplace, record_max):
     viol = np.zeros(nch, dtype=np.int64)
     vidx = np.zeros((nch, S), dtype=np.int64)
     vg = np.zeros((nch, S))
-    K.direction(u, sigma, h, m, t.copy(), d, 0.0, 0.0, p, pm, bounded, viol, vidx, vg)
+    # through kernel_threads, as the solver calls them: it loads the kernels from numba's
+    # cache (a cold one is filled by a child process first, .kernel_cache)
+    with K.kernel_threads(1):
+        K.direction(u, sigma, h, m, t.copy(), d, 0.0, 0.0, p, pm, bounded, viol, vidx, vg)
     ref = _reference(p, u, r, t, h, m, pmax, bounded, sigma, d, tau, keep_mask, with_u)
     q, m_ref, t_ref, u_ref, clip, join, recs, at_b, pen_ref = ref
     chunk = np.arange(n) // K.CHUNK
@@ -186,29 +189,11 @@ def test_update_against_numpy(bounded, keep_mask, with_u, inplace, record_max):
     pn = pp if inplace else np.full(n, np.nan)
     uu = u.copy()
     mm, tt = m.copy(), t.copy()
-    total, pen, at_bound, complete = K.update(
-        pp,
-        pn,
-        uu,
-        r,
-        tt,
-        h,
-        mm,
-        pm,
-        bounded,
-        sigma,
-        d,
-        tau,
-        viol,
-        idx,
-        val,
-        counts,
-        keep_mask,
-        with_u,
-        vidx,
-        vg,
-        record_max,
-    )
+    with K.kernel_threads(1):
+        total, pen, at_bound, complete = K.update(
+            pp, pn, uu, r, tt, h, mm, pm, bounded, sigma, d, tau, viol, idx, val, counts,
+            keep_mask, with_u, vidx, vg, record_max,
+        )  # fmt: skip
     np.testing.assert_allclose(pn, q, rtol=1e-13, atol=1e-300)
     assert np.array_equal(mm, m_ref)
     assert np.array_equal(tt, t_ref)
