@@ -67,12 +67,25 @@ def header(title: str, args) -> None:
     )
 
 
-def median_time(fn, repeats: int, warmup: int = 1) -> float:
-    """Median wall time of ``fn()`` over ``repeats`` calls after ``warmup`` calls, s."""
+# larger than the last-level cache (32 MB here): swept before a "cold" call
+_FLUSH = np.zeros(128 * 2**20 // 8)
+
+
+def evict_caches() -> None:
+    """Sweep a 128 MB array, so that the next call meets its data in memory, as the
+    transforms and sweeps inside a CG iteration do."""
+    np.add(_FLUSH, 1.0, out=_FLUSH)
+
+
+def median_time(fn, repeats: int, warmup: int = 1, cold: bool = False) -> float:
+    """Median wall time of ``fn()`` over ``repeats`` calls after ``warmup`` calls, s;
+    ``cold`` evicts the caches before each timed call (untimed)."""
     for _ in range(warmup):
         fn()
     ts = []
     for _ in range(repeats):
+        if cold:
+            evict_caches()
         t0 = time.perf_counter()
         fn()
         ts.append(time.perf_counter() - t0)

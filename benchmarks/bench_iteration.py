@@ -38,6 +38,7 @@ import numpy as np
 from _common import (
     E_STAR,
     header,
+    median_time,
     parser,
     rough_load,
     rough_surface,
@@ -177,10 +178,6 @@ def run(n, periodic, path, threads, effort, repeats):
     }
 
 
-# larger than the last-level cache (32 MB here): touched before a "cold" pair
-_FLUSH = np.zeros(128 * 2**20 // 8)
-
-
 # Bytes per grid point the element-wise work of one iteration must move (float64 fields,
 # uint8 free mask): gap_moments reads u, h, t, m (25); direction reads u, h, t, m and writes
 # t (33); update reads p, t, m and writes p, m (26).
@@ -191,13 +188,7 @@ def _stream_bandwidth(size, calls=9):
     """Memory bandwidth of one core, bytes/s: ``np.add`` of two float64 arrays of ``size``
     into a third (24 bytes per point), each call after the 128 MB sweep, median."""
     a, b, c = (np.full(size, v) for v in (1.0, 2.0, 0.0))
-    ts = []
-    for _ in range(calls):
-        np.add(_FLUSH, 1.0, out=_FLUSH)
-        t0 = time.perf_counter()
-        np.add(a, b, out=c)
-        ts.append(time.perf_counter() - t0)
-    return 24 * size / statistics.median(ts)
+    return 24 * size / median_time(lambda: np.add(a, b, out=c), calls, warmup=0, cold=True)
 
 
 def _pair_time(pair, calls=5, cold=False):
@@ -205,14 +196,7 @@ def _pair_time(pair, calls=5, cold=False):
     the floor of the tables) a pair whose arrays fit in the last-level cache (1024²: 16 MB)
     runs from it; ``cold`` sweeps a 128 MB array before each call (untimed), so the pair
     meets its data in memory as an FFT inside an iteration does."""
-    ts = []
-    for _ in range(calls):
-        if cold:
-            np.add(_FLUSH, 1.0, out=_FLUSH)
-        t0 = time.perf_counter()
-        pair()
-        ts.append(time.perf_counter() - t0)
-    return statistics.median(ts)
+    return median_time(pair, calls, warmup=0, cold=cold)
 
 
 def main():

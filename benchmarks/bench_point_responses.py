@@ -28,20 +28,7 @@ from amontons.contact import kernels
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
 
-_FLUSH = np.ones(16 * 1024 * 1024)  # 128 MB, swept before each timed call
-BINS = ((0, 0), (1, 12), (13, 20), (21, 32), (33, 64), (65, None))
-
-
-def _cold(fn):
-    def run():
-        np.add(_FLUSH, 1.0, out=_FLUSH)
-        fn()
-
-    return run
-
-
-def _flush_time(repeats):
-    return median_time(lambda: np.add(_FLUSH, 1.0, out=_FLUSH), repeats)
+BINS = ((0, 0), (1, 12), (13, 20), (21, 32), (33, 64), (65, np.inf))
 
 
 def point_costs(n, periodic, repeats, threads):
@@ -53,18 +40,19 @@ def point_costs(n, periodic, repeats, threads):
     rng = np.random.default_rng(0)
     u = np.zeros((n, n))
     p = rng.random((n, n))
-    flush = _flush_time(repeats)
     out = {}
     with kernels.kernel_threads(threads):
         for k in (1, 8):
             idx = rng.integers(0, n * n, size=k)
             vals = rng.normal(size=k)
-            call = _cold(lambda i=idx, v=vals: kernels.add_point_responses(u, green, i, v))
-            t = median_time(call, repeats)
-            out[f"ms / point ({k})"] = (t - flush) * 1e3 / k
-    conv = median_time(_cold(lambda: op(p, out=u)), repeats) - flush
+
+            def call(i=idx, v=vals):
+                kernels.add_point_responses(u, green, i, v)
+
+            out[f"ms / point ({k})"] = median_time(call, repeats, cold=True) * 1e3 / k
+    conv = median_time(lambda: op(p, out=u), repeats, cold=True)
     op.forward(p)
-    inverse = median_time(_cold(lambda: op.inverse(u)), repeats) - flush
+    inverse = median_time(lambda: op.inverse(u), repeats, cold=True)
     out["inverse ms"] = inverse * 1e3
     out["convolution ms"] = conv * 1e3
     out["break-even points"] = (conv - inverse) * 1e3 / out["ms / point (8)"]
@@ -94,9 +82,7 @@ def changes_per_iteration(n):
         kernels.update = update
     c = np.asarray(counts)
     return {
-        f"{lo}-{hi if hi is not None else ''}": int(
-            np.count_nonzero((c >= lo) & (c <= (hi if hi is not None else c.max())))
-        )
+        f"{lo}-{hi if np.isfinite(hi) else ''}": int(np.count_nonzero((c >= lo) & (c <= hi)))
         for lo, hi in BINS
     }
 
