@@ -4,7 +4,7 @@ and its timing points (docs/accuracy.md, "Timing model")."""
 
 import logging
 
-from amontons.accuracy.timing import fit_timing_model
+from amontons.accuracy.timing_fit import fit_timing_model
 from amontons.io.files import read_json, write_json
 from amontons.runlog import run_logged
 

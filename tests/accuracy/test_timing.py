@@ -7,11 +7,11 @@ import pytest
 
 from amontons.accuracy.timing import (
     convolutions_per_load,
-    fit_timing_model,
     predict,
     stiffness_ratio,
     yield_ratio,
 )
+from amontons.accuracy.timing_fit import fit_timing_model
 
 # the law the synthetic points obey: elastic [b0, b_periodic, b_tol, b_extent]; plastic
 # (offset, gamma); time c_0 + c_conv·work; memory m0 + m1·N

@@ -1,7 +1,7 @@
 """The timing model (docs/accuracy.md, "Timing model"): a solve's wall time and peak memory
 from its FFT grid, its contact model and its tolerance, fitted to the accuracy study's
 measured points. :func:`predict` is pure Python (the workflow sizes jobs with it while it
-builds the DAG); :func:`fit_timing_model` needs numpy.
+builds the DAG); amontons.accuracy.timing_fit fits it, with numpy.
 
 Per load series of L loads on an FFT grid of N points (n² periodic, the padded (2n)²-ish
 grid of a window otherwise):
@@ -36,7 +36,7 @@ takes z/(1+z) = 1, the elastic limit, which over-predicts soft layers and low yi
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 from amontons.resources import fft_points
 
@@ -122,7 +122,8 @@ def predict(
     """(wall time s, peak memory MB) of a load series of ``loads`` loads of ``model`` on a
     ``side_px`` grid at ``tol``: ``contact_px`` the Hertz contact diameter at the largest load
     in pixels (None or periodic: the grid's side), ``ratio`` its z (:data:`PLASTIC_RATIO`;
-    None: the elastic limit). ``record``: the JSON :func:`fit_timing_model` writes."""
+    None: the elastic limit). ``record``: the JSON that
+    amontons.accuracy.timing_fit.fit_timing_model writes."""
     points = fft_points(side_px, periodic)
     extent = side_px if periodic or contact_px is None else contact_px
     count = loads * convolutions_per_load(
@@ -138,71 +139,6 @@ def _elastic_features(tol: float, periodic: bool, contact_px: float) -> list[flo
     return [1.0, float(periodic), math.log10(1.0 / tol), 2.0 * math.log(contact_px)]
 
 
-def _features(point: Mapping) -> list[float]:
+def point_features(point: Mapping) -> list[float]:
+    """The elastic count's features of a measured point (amontons.accuracy.timing_fit)."""
     return _elastic_features(point["tol"], point["periodic"], point["contact_px"])
-
-
-def _fit_elastic(rows: Sequence[Mapping]) -> dict:
-    import numpy as np
-
-    x = np.array([_features(p) for p in rows])
-    y = np.log([p["convolutions"] / p["loads"] for p in rows])
-    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-    return {"coef": [float(c) for c in coef], "points": len(rows)}
-
-
-def _fit_plastic(rows: Sequence[Mapping], elastic: Mapping) -> dict:
-    """offset a and exponent γ of a plastic model over the elastic count: least squares in
-    logs; γ = 0 where the points hold fewer than two distinct ratios."""
-    import numpy as np
-
-    b = np.array(elastic["coef"])
-    base = np.array([np.dot(b, _features(p)) for p in rows])
-    excess = np.log([p["convolutions"] / p["loads"] for p in rows]) - base
-    ratios = np.array([p["ratio"] for p in rows], float)
-    share = np.log(ratios / (1.0 + ratios))
-    if len(np.unique(np.round(share, 6))) < 2:
-        return {"offset": float(excess.mean()), "gamma": 0.0, "points": len(rows)}
-    x = np.column_stack([np.ones_like(share), share])
-    (offset, gamma), *_ = np.linalg.lstsq(x, excess, rcond=None)
-    return {"offset": float(offset), "gamma": float(gamma), "points": len(rows)}
-
-
-def fit_timing_model(points: Sequence[Mapping]) -> dict:
-    """Fit the model to measured solves: each point a mapping with model, fft_points,
-    periodic, contact_px (periodic: the side), loads, tol, convolutions (all loads), ratio
-    (z of a plastic model), wall_time_s and peak_rss_mb.
-    Convolutions by least squares in logs (elastic first, each plastic model as its excess
-    over the elastic count); time by non-negative least squares in relative terms (each
-    point weighted by 1/t, so small solves count as much as large ones); memory by the line
-    under which no point lies above by more than its own measurement (its largest excess
-    over the fitted baseline)."""
-    import numpy as np
-    from scipy.optimize import nnls
-
-    elastic_rows = [p for p in points if p["model"] == "elastic"]
-    if not elastic_rows:
-        raise ValueError("the timing model needs elastic solves: none among the points")
-    counts = {"elastic": _fit_elastic(elastic_rows)}
-    for model in sorted({p["model"] for p in points} - {"elastic"}):
-        rows = [p for p in points if p["model"] == model and p.get("ratio") is not None]
-        if rows:
-            counts[model] = _fit_plastic(rows, counts["elastic"])
-    n = np.array([p["fft_points"] for p in points], float)
-    t = np.array([p["wall_time_s"] for p in points], float)
-    work = np.array([p["convolutions"] for p in points], float) * n * np.log2(n)
-    (c_0, c_conv), _ = nnls(np.column_stack([np.ones_like(n), work]) / t[:, None], np.ones_like(t))
-    memory = np.array([p["peak_rss_mb"] for p in points], float)
-    m1, m0 = np.polyfit(n, memory, 1)
-    m0 += float(np.max(memory - (m0 + m1 * n)))
-    ratio = (c_0 + c_conv * work) / t
-    return {
-        "time": {"c_0": float(c_0), "c_conv": float(c_conv)},
-        "memory": {"m0": float(m0), "m1": float(m1)},
-        "convolutions": counts,
-        "fit": {
-            "points": len(points),
-            "time_ratio_range": [float(ratio.min()), float(ratio.max())],
-            "note": "predicted / measured wall time at the measured convolutions",
-        },
-    }
