@@ -35,7 +35,7 @@ include: "workflow/rules/accuracy.smk"
 rule all:
     default_target: True
     input:
-        material_outputs(MATERIALS) + study_overview_outputs(),
+        TARGETS.material(MATERIALS) + RUN.study.overview_outputs(),
     localrule: True
 
 
@@ -46,5 +46,5 @@ for _material in MATERIALS:
         name:
             _material
         input:
-            material_outputs([_material]),
+            TARGETS.material([_material]),
         localrule: True

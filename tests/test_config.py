@@ -11,13 +11,13 @@ from amontons.config import (
     RESERVED_NAMES,
     ConfigError,
     check_selected_materials,
-    load_workflow_config,
     merge_config,
     parse_loads_mn,
     read_config,
     read_sample_sheet,
     validate,
 )
+from amontons.workflow.run import load_workflow_config
 
 
 def _config(repo, name="config.yaml"):

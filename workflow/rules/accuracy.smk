@@ -2,16 +2,14 @@
 # the grid in config `accuracy`, each setting a job of its own, compared with a converged
 # reference; the table, the error-versus-time figure with its Pareto fronts, the presets the
 # fronts propose, and the timing model. Target: `snakemake accuracy`.
-ACCURACY = f"{RESULTS}/accuracy"
-ACCURACY_LOGS = f"{LOGS}/accuracy"
 
 
 rule solve_accuracy_setting:
     input:
-        unpack(accuracy_sphere_inputs),
+        unpack(RUN.accuracy.sphere_inputs),
     output:
-        summary=f"{ACCURACY}/{{problem}}/{{setting}}/summary.json",
-        fields=f"{ACCURACY}/{{problem}}/{{setting}}/pressure.h5",
+        summary=PATHS.accuracy_setting(ACCURACY_SUMMARY, "{problem}", "{setting}"),
+        fields=PATHS.accuracy_setting(ACCURACY_FIELDS, "{problem}", "{setting}"),
     log:
         f"{ACCURACY_LOGS}/{{problem}}/{{setting}}/solve_accuracy_setting.log",
     benchmark:
@@ -30,21 +28,18 @@ rule solve_accuracy_setting:
         study=lambda wc: sorted_keys(
             {k: config["accuracy"][k] for k in ("grid", "reference", "periodic")}
         ),
-        record=lambda wc: {
-            **scene_sphere_record(ACCURACY_SPHERE),
-            "sphere": ACCURACY_SPHERE,
-        },
+        record=lambda wc: RUN.accuracy.sphere_record(),
         fluorescence_pixel_nm=pixel_nm(ACCURACY_SPHERE),
-        otsu=otsu_settings(),
+        otsu=OTSU,
     script:
         "../../scripts/solve_accuracy_setting.py"
 
 
 rule solve_timing_point:
     input:
-        levelled=accuracy_levelled_map(),
+        levelled=RUN.accuracy.levelled_map(),
     output:
-        summary=f"{ACCURACY}/timing/{{point}}/summary.json",
+        summary=PATHS.timing_point("{point}"),
     log:
         f"{ACCURACY_LOGS}/timing/{{point}}/solve_timing_point.log",
     benchmark:
@@ -61,18 +56,15 @@ rule solve_timing_point:
         study=lambda wc: sorted_keys(
             {"timing_points": config["accuracy"]["timing_points"]}
         ),
-        record=lambda wc: {
-            **scene_sphere_record(ACCURACY_SPHERE),
-            "sphere": ACCURACY_SPHERE,
-        },
+        record=lambda wc: RUN.accuracy.sphere_record(),
     script:
         "../../scripts/solve_timing_point.py"
 
 
 rule tabulate_accuracy:
     input:
-        summaries=accuracy_files("summary.json"),
-        fields=accuracy_files("pressure.h5"),
+        summaries=RUN.accuracy.files(ACCURACY_SUMMARY),
+        fields=RUN.accuracy.files(ACCURACY_FIELDS),
     output:
         table=f"{ACCURACY}/accuracy.csv",
         presets=f"{ACCURACY}/presets.json",
@@ -97,7 +89,7 @@ rule tabulate_accuracy:
 
 rule plot_accuracy:
     input:
-        table=f"{ACCURACY}/accuracy.csv",
+        table=rules.tabulate_accuracy.output.table,
     output:
         png=report(
             f"{ACCURACY}/accuracy.png",
@@ -124,8 +116,8 @@ rule plot_accuracy:
 
 rule fit_timing_model:
     input:
-        summaries=accuracy_files("summary.json"),
-        timing_points=timing_point_files(),
+        summaries=RUN.accuracy.files(ACCURACY_SUMMARY),
+        timing_points=RUN.accuracy.timing_point_files(),
     output:
         model=f"{ACCURACY}/timing_model.json",
     log:
@@ -144,8 +136,8 @@ rule fit_timing_model:
 
 rule accuracy:
     input:
-        f"{ACCURACY}/accuracy.csv",
-        f"{ACCURACY}/presets.json",
-        f"{ACCURACY}/accuracy.png",
-        f"{ACCURACY}/timing_model.json",
+        rules.tabulate_accuracy.output.table,
+        rules.tabulate_accuracy.output.presets,
+        rules.plot_accuracy.output.png,
+        rules.fit_timing_model.output.model,
     localrule: True

@@ -5,7 +5,7 @@ rule measure_friction:
     input:
         rheometer=lambda wc: per_load_inputs(wc.sphere, "rheometer"),
     output:
-        table=f"{MEASURED}/friction.csv",
+        table=f"{MEASURED}/{FRICTION}",
     log:
         f"{SPHERE_LOGS}/measure_friction.log",
     benchmark:
@@ -25,8 +25,8 @@ rule measure_friction:
 
 rule plot_amontons_deviation:
     input:
-        areas=lambda wc: material_results(wc.material, "contact_area.csv"),
-        friction=lambda wc: material_results(wc.material, "friction.csv"),
+        areas=lambda wc: per_sphere(wc.material, CONTACT_AREA),
+        friction=lambda wc: per_sphere(wc.material, FRICTION),
     output:
         table=report(
             f"{MATERIAL}/amontons.csv",
@@ -42,9 +42,9 @@ rule plot_amontons_deviation:
         ),
         pdf=f"{MATERIAL}/amontons.pdf",
     log:
-        f"{LOGS}/{{material}}/plot_amontons_deviation.log",
+        f"{MATERIAL_LOGS}/plot_amontons_deviation.log",
     benchmark:
-        f"{LOGS}/{{material}}/plot_amontons_deviation.benchmark.tsv"
+        f"{MATERIAL_LOGS}/plot_amontons_deviation.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -62,5 +62,5 @@ rule plot_amontons_deviation:
 rule friction:
     """Target: friction of every sphere and the Amontons-deviation figure of every material."""
     input:
-        friction_outputs(MATERIALS),
+        TARGETS.friction(MATERIALS),
     localrule: True

@@ -3,9 +3,9 @@
 
 rule fit_load_area:
     input:
-        table=f"{MEASURED}/contact_area.csv",
+        table=rules.measure_contact_area.output.table,
     output:
-        fit=f"{MEASURED}/load_area_fit.json",
+        fit=f"{MEASURED}/{LOAD_AREA_FIT}",
     log:
         f"{SPHERE_LOGS}/fit_load_area.log",
     benchmark:
@@ -24,8 +24,8 @@ rule fit_load_area:
 
 rule plot_load_area:
     input:
-        tables=lambda wc: material_results(wc.material, "contact_area.csv"),
-        fits=lambda wc: material_results(wc.material, "load_area_fit.json"),
+        tables=lambda wc: per_sphere(wc.material, CONTACT_AREA),
+        fits=lambda wc: per_sphere(wc.material, LOAD_AREA_FIT),
     output:
         table=f"{MATERIAL}/load_area.csv",
         png=report(
@@ -36,9 +36,9 @@ rule plot_load_area:
         ),
         pdf=f"{MATERIAL}/load_area.pdf",
     log:
-        f"{LOGS}/{{material}}/plot_load_area.log",
+        f"{MATERIAL_LOGS}/plot_load_area.log",
     benchmark:
-        f"{LOGS}/{{material}}/plot_load_area.benchmark.tsv"
+        f"{MATERIAL_LOGS}/plot_load_area.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -56,12 +56,12 @@ rule plot_load_area:
 rule fits:
     """Target: load-area fits of every sphere."""
     input:
-        [f for m in MATERIALS for f in sphere_outputs(m, FIT_RESULTS)],
+        TARGETS.fits(MATERIALS),
     localrule: True
 
 
 rule figures:
     """Target: load-area and Amontons-deviation figures and tables of every material."""
     input:
-        figure_outputs(MATERIALS),
+        TARGETS.figures(MATERIALS),
     localrule: True

@@ -6,7 +6,7 @@ rule measure_contact_area:
     input:
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
-        table=f"{MEASURED}/contact_area.csv",
+        table=f"{MEASURED}/{CONTACT_AREA}",
         png=report(
             f"{MEASURED}/contact_area.png",
             caption="../report/contact_area.rst",
@@ -27,7 +27,7 @@ rule measure_contact_area:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_contact_area.py"
@@ -37,7 +37,7 @@ rule measure_psf:
     input:
         bead=lambda wc: raw_file(wc.sphere, "bead.tif"),
     output:
-        psf=f"{MEASURED}/psf.json",
+        psf=f"{MEASURED}/{PSF}",
         png=report(
             f"{MEASURED}/psf.png",
             caption="../report/psf.rst",
@@ -118,7 +118,7 @@ rule measure_edge_gap:
     params:
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
         newton_rings=config_slice("optics", "newton_rings"),
         data_label=lambda wc: data_label([wc.sphere]),
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
@@ -153,7 +153,7 @@ rule measure_intensity_pressure:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
         intensity=config_slice("optics", "intensity"),
         confidence=config["load_area"]["confidence"],
         data_label=lambda wc: data_label([wc.sphere]),
@@ -165,7 +165,7 @@ rule measure_lifetime:
     input:
         flim=lambda wc: raw_file(wc.sphere, "flim.tif"),
     output:
-        lifetime=f"{MEASURED}/lifetime.json",
+        lifetime=f"{MEASURED}/{LIFETIME}",
     log:
         f"{SPHERE_LOGS}/measure_lifetime.log",
     benchmark:
@@ -178,7 +178,7 @@ rule measure_lifetime:
         runtime=measured_runtime("measure_lifetime"),
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
         lifetime=config_slice("optics", "lifetime"),
     script:
         "../../scripts/measure_lifetime.py"
@@ -186,7 +186,7 @@ rule measure_lifetime:
 
 rule check_hertz:
     input:
-        table=f"{MEASURED}/contact_area.csv",
+        table=rules.measure_contact_area.output.table,
     output:
         table=f"{MEASURED}/hertz_check.csv",
     log:
@@ -209,5 +209,5 @@ rule check_hertz:
 rule optics:
     """Target: every optical measurement of every sphere."""
     input:
-        optics_outputs(MATERIALS),
+        TARGETS.optics(MATERIALS),
     localrule: True

@@ -8,7 +8,7 @@ rule level_afm_map:
     input:
         afm_before=lambda wc: afm_path(wc.sphere, "afm_before"),
     output:
-        levelled=f"{MEASURED}/afm_before_levelled.h5",
+        levelled=f"{MEASURED}/{LEVELLED_MAP}",
     log:
         f"{SPHERE_LOGS}/level_afm_map.log",
     benchmark:
@@ -21,7 +21,7 @@ rule level_afm_map:
         runtime=measured_runtime("level_afm_map"),
     params:
         afm=lambda wc: {
-            **afm_reading(),
+            **AFM_READING,
             "pixel_nm": sheet_value(wc.sphere, "afm_pixel_nm"),
         },
     script:
@@ -30,10 +30,10 @@ rule level_afm_map:
 
 rule simulate_scene:
     input:
-        levelled=f"{MEASURED}/afm_before_levelled.h5",
+        levelled=rules.level_afm_map.output.levelled,
     output:
-        fields=f"{SCENE}/fields.h5",
-        solve=f"{SCENE}/solve.json",
+        fields=f"{SCENE}/{FIELDS}",
+        solve=f"{SCENE}/{SOLVE}",
     log:
         f"{SCENE_LOGS}/simulate_scene.log",
     benchmark:
@@ -44,8 +44,8 @@ rule simulate_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=solve_mem_mb("simulate_scene", lambda wc: (wc.scene, wc.sphere)),
-        runtime=solve_runtime("simulate_scene", lambda wc: (wc.scene, wc.sphere)),
+        mem_mb=solve_mem_mb(lambda wc: (wc.scene, wc.sphere)),
+        runtime=solve_runtime(lambda wc: (wc.scene, wc.sphere)),
     params:
         scene=lambda wc: scene_config(wc.scene),
         sphere=lambda wc: wc.sphere,
@@ -56,9 +56,9 @@ rule simulate_scene:
 
 rule simulate_greenwood_tripp:
     input:
-        levelled=f"{MEASURED}/afm_before_levelled.h5",
+        levelled=rules.level_afm_map.output.levelled,
     output:
-        solve=f"{SCENE}/solve.json",
+        solve=f"{SCENE}/{SOLVE}",
     log:
         f"{SCENE_LOGS}/simulate_greenwood_tripp.log",
     benchmark:
@@ -81,8 +81,8 @@ rule simulate_greenwood_tripp:
 
 rule simulate_synthetic_scene:
     output:
-        fields=f"{SYNTHETIC_SCENE}/fields.h5",
-        solve=f"{SYNTHETIC_SCENE}/solve.json",
+        fields=f"{SYNTHETIC_SCENE}/{FIELDS}",
+        solve=f"{SYNTHETIC_SCENE}/{SOLVE}",
     log:
         f"{SYNTHETIC_SCENE_LOGS}/simulate_scene.log",
     benchmark:
@@ -93,8 +93,8 @@ rule simulate_synthetic_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=solve_mem_mb("simulate_synthetic_scene", lambda wc: (wc.scene, None)),
-        runtime=solve_runtime("simulate_synthetic_scene", lambda wc: (wc.scene, None)),
+        mem_mb=solve_mem_mb(lambda wc: (wc.scene, None)),
+        runtime=solve_runtime(lambda wc: (wc.scene, None)),
     params:
         scene=lambda wc: scene_config(wc.scene),
         sphere=None,
@@ -105,11 +105,11 @@ rule simulate_synthetic_scene:
 
 rule render_scene:
     input:
-        fields=f"{SCENE}/fields.h5",
-        psf=f"{MEASURED}/psf.json",
+        fields=rules.simulate_scene.output.fields,
+        psf=rules.measure_psf.output.psf,
     output:
-        rendered=f"{SCENE}/rendered.h5",
-        table=f"{SCENE}/render.csv",
+        rendered=f"{SCENE}/{RENDERED}",
+        table=f"{SCENE}/{RENDER_TABLE}",
     log:
         f"{SCENE_LOGS}/render_scene.log",
     benchmark:
@@ -126,26 +126,26 @@ rule render_scene:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         rendering=lambda wc: SCENES[wc.scene]["rendering"],
         confinement_floor_mpa=lambda wc: SCENES[wc.scene]["confinement_floor_mpa"],
-        otsu=otsu_settings(),
+        otsu=OTSU,
     script:
         "../../scripts/render_scene.py"
 
 
 rule compare_scene:
     input:
-        rendered=f"{SCENE}/rendered.h5",
-        solve=f"{SCENE}/solve.json",
+        rendered=rules.render_scene.output.rendered,
+        solve=rules.simulate_scene.output.solve,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
-        table=f"{SCENE}/comparison.csv",
-        registration=f"{SCENE}/registration.json",
+        table=f"{SCENE}/{COMPARISON}",
+        registration=f"{SCENE}/{REGISTRATION}",
         png=report(
-            f"{SCENE}/comparison.png",
+            f"{SCENE}/{COMPARISON_FIGURE}.png",
             caption="../report/scene_comparison.rst",
             category="Scenes",
             subcategory="{material}",
         ),
-        pdf=f"{SCENE}/comparison.pdf",
+        pdf=f"{SCENE}/{COMPARISON_FIGURE}.pdf",
     log:
         f"{SCENE_LOGS}/compare_scene.log",
     benchmark:
@@ -161,7 +161,7 @@ rule compare_scene:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/compare_scene.py"
@@ -169,9 +169,9 @@ rule compare_scene:
 
 rule fit_scene:
     input:
-        unpack(scene_fit_inputs),
+        unpack(RUN.scenes.fit_inputs),
     output:
-        fit=f"{SCENE}/scene_fit.json",
+        fit=f"{SCENE}/{SCENE_FIT}",
     log:
         f"{SCENE_LOGS}/fit_scene.log",
     benchmark:
@@ -190,9 +190,9 @@ rule fit_scene:
 
 rule fit_synthetic_scene:
     input:
-        solve=f"{SYNTHETIC_SCENE}/solve.json",
+        solve=rules.simulate_synthetic_scene.output.solve,
     output:
-        fit=f"{SYNTHETIC_SCENE}/scene_fit.json",
+        fit=f"{SYNTHETIC_SCENE}/{SCENE_FIT}",
     log:
         f"{SYNTHETIC_SCENE_LOGS}/fit_scene.log",
     benchmark:
@@ -211,12 +211,8 @@ rule fit_synthetic_scene:
 
 rule tabulate_scenes:
     input:
-        measured=lambda wc: material_results(wc.material, "load_area_fit.json"),
-        scenes=lambda wc: [
-            f"{scene_dir(wc.material, sphere, scene)}/scene_fit.json"
-            for sphere in spheres_of(wc.material)
-            for scene in scene_names(surface="afm_before")
-        ],
+        measured=lambda wc: per_sphere(wc.material, LOAD_AREA_FIT),
+        scenes=lambda wc: RUN.scenes.table_inputs(wc.material),
     output:
         table=report(
             f"{MATERIAL}/scenes.csv",
@@ -225,9 +221,9 @@ rule tabulate_scenes:
             subcategory="{material}",
         ),
     log:
-        f"{LOGS}/{{material}}/tabulate_scenes.log",
+        f"{MATERIAL_LOGS}/tabulate_scenes.log",
     benchmark:
-        f"{LOGS}/{{material}}/tabulate_scenes.benchmark.tsv"
+        f"{MATERIAL_LOGS}/tabulate_scenes.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -237,7 +233,7 @@ rule tabulate_scenes:
     params:
         spheres=lambda wc: spheres_of(wc.material),
         scenes=scene_names(surface="afm_before"),
-        models={name: scene["model"] for name, scene in SCENES.items()},
+        models=RUN.scenes.models(),
     script:
         "../../scripts/tabulate_scenes.py"
 
@@ -245,5 +241,5 @@ rule tabulate_scenes:
 rule scenes:
     """Target: every scene of every sphere, and the synthetic scenes."""
     input:
-        scene_outputs(MATERIALS) + synthetic_scene_outputs(),
+        RUN.scenes.outputs(MATERIALS) + RUN.scenes.synthetic_outputs(),
     localrule: True

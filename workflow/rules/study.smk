@@ -6,13 +6,13 @@
 
 rule scan_scene:
     input:
-        levelled=f"{MEASURED}/afm_before_levelled.h5",
-        psf=f"{MEASURED}/psf.json",
-        registration=lambda wc: f"{scene_dir(wc.material, wc.sphere, SCANS[wc.scan]['scene'])}/registration.json",
+        levelled=rules.level_afm_map.output.levelled,
+        psf=rules.measure_psf.output.psf,
+        registration=RUN.scenes.scan_base_registration,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
-        point=f"{SCAN}/{{value}}/scan_point.json",
-        fields=f"{SCAN}/{{value}}/rendered.h5",
+        point=PATHS.scan_value(SCAN_POINT),
+        fields=PATHS.scan_value(RENDERED),
     log:
         f"{SCAN_LOGS}/{{value}}/scan_scene.log",
     benchmark:
@@ -23,24 +23,24 @@ rule scan_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=solve_mem_mb("scan_scene", scan_solve),
-        runtime=solve_runtime("scan_scene", scan_solve),
+        mem_mb=solve_mem_mb(scan_solve(SCANS)),
+        runtime=solve_runtime(scan_solve(SCANS)),
     params:
         scan=lambda wc: sorted_keys(SCANS[wc.scan]),
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
     script:
         "../../scripts/scan_scene.py"
 
 
 rule best_scan_value:
     input:
-        points=scan_points,
+        points=RUN.scenes.scan_points,
     output:
-        table=f"{SCAN}/scan.csv",
-        best=f"{SCAN}/best.json",
+        table=f"{SCAN}/{SCAN_TABLE}",
+        best=f"{SCAN}/{BEST}",
     log:
         f"{SCAN_LOGS}/best_scan_value.log",
     benchmark:
@@ -60,13 +60,13 @@ rule best_scan_value:
 rule scans:
     """Target: every scan of every sphere, judged."""
     input:
-        scan_outputs(MATERIALS),
+        RUN.scenes.scan_outputs(MATERIALS),
     localrule: True
 
 
 rule tabulate_models:
     input:
-        lambda wc: flat_files(model_table_layout(wc.material)),
+        lambda wc: flat_files(RUN.study.model_table_layout(wc.material)),
     output:
         table=report(
             f"{MATERIAL}/models.csv",
@@ -75,9 +75,9 @@ rule tabulate_models:
             subcategory="{material}",
         ),
     log:
-        f"{LOGS}/{{material}}/tabulate_models.log",
+        f"{MATERIAL_LOGS}/tabulate_models.log",
     benchmark:
-        f"{LOGS}/{{material}}/tabulate_models.benchmark.tsv"
+        f"{MATERIAL_LOGS}/tabulate_models.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -85,9 +85,9 @@ rule tabulate_models:
         mem_mb=measured_mem_mb("tabulate_models"),
         runtime=measured_runtime("tabulate_models"),
     params:
-        layout=lambda wc: model_table_layout(wc.material),
+        layout=lambda wc: RUN.study.model_table_layout(wc.material),
         spheres=lambda wc: spheres_of(wc.material),
-        models={name: scene["model"] for name, scene in SCENES.items()},
+        models=RUN.scenes.models(),
         data_label=lambda wc: data_label(spheres_of(wc.material)),
     script:
         "../../scripts/tabulate_models.py"
@@ -95,9 +95,7 @@ rule tabulate_models:
 
 rule plot_scan_maps:
     input:
-        lambda wc: flat_files(
-            [scan_files(wc.material, wc.sphere, scan) for scan in SCANS]
-        ),
+        lambda wc: flat_files(list(RUN.study.scan_maps(wc).values())),
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
         table=f"{STUDY}/B8_scans.csv",
@@ -119,12 +117,10 @@ rule plot_scan_maps:
         mem_mb=measured_mem_mb("plot_scan_maps"),
         runtime=measured_runtime("plot_scan_maps"),
     params:
-        scans=lambda wc: {
-            scan: scan_files(wc.material, wc.sphere, scan) for scan in SCANS
-        },
+        scans=RUN.study.scan_maps,
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
     script:
         "../../scripts/plot_scan_maps.py"
@@ -132,8 +128,8 @@ rule plot_scan_maps:
 
 rule plot_load_series_maps:
     input:
-        lambda wc: flat_files(load_series_layout(wc)),
-        gt_solve=lambda wc: load_series_layout(wc)["gt_solve"],
+        lambda wc: flat_files(RUN.study.load_series_layout(wc)),
+        gt_solve=lambda wc: RUN.study.load_series_layout(wc)["gt_solve"],
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
     output:
         table=f"{STUDY}/B11_load_series.csv",
@@ -155,11 +151,11 @@ rule plot_load_series_maps:
         mem_mb=measured_mem_mb("plot_load_series_maps"),
         runtime=measured_runtime("plot_load_series_maps"),
     params:
-        elastic=lambda wc: load_series_layout(wc)["elastic"],
-        k_scan=study_k_scan,
+        elastic=lambda wc: RUN.study.load_series_layout(wc)["elastic"],
+        k_scan=RUN.study.k_scan,
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        otsu=otsu_settings(),
+        otsu=OTSU,
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
     script:
         "../../scripts/plot_load_series_maps.py"
@@ -167,7 +163,7 @@ rule plot_load_series_maps:
 
 rule plot_flattening_maps:
     input:
-        lambda wc: flat_files(study_k_scan(wc)),
+        lambda wc: flat_files(RUN.study.k_scan(wc)),
         before=lambda wc: afm_path(wc.sphere, "afm_before"),
         after=lambda wc: afm_path(wc.sphere, "afm_after"),
     output:
@@ -190,9 +186,9 @@ rule plot_flattening_maps:
         mem_mb=measured_mem_mb("plot_flattening_maps"),
         runtime=measured_runtime("plot_flattening_maps"),
     params:
-        k_scan=study_k_scan,
+        k_scan=RUN.study.k_scan,
         afm=lambda wc: {
-            **afm_reading(),
+            **AFM_READING,
             "pixel_nm": sheet_value(wc.sphere, "afm_pixel_nm"),
         },
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
@@ -202,9 +198,9 @@ rule plot_flattening_maps:
 
 rule plot_model_curves:
     input:
-        lambda wc: flat_files(model_curve_layout(wc)),
-        measured=f"{MEASURED}/contact_area.csv",
-        measured_fit=f"{MEASURED}/load_area_fit.json",
+        lambda wc: flat_files(RUN.study.model_curve_layout(wc)),
+        measured=rules.measure_contact_area.output.table,
+        measured_fit=rules.fit_load_area.output.fit,
     output:
         table=f"{STUDY}/B12_models.csv",
         png=report(
@@ -225,8 +221,8 @@ rule plot_model_curves:
         mem_mb=measured_mem_mb("plot_model_curves"),
         runtime=measured_runtime("plot_model_curves"),
     params:
-        scenes=lambda wc: model_curve_layout(wc)["scenes"],
-        scans=lambda wc: model_curve_layout(wc)["scans"],
+        scenes=lambda wc: RUN.study.model_curve_layout(wc)["scenes"],
+        scans=lambda wc: RUN.study.model_curve_layout(wc)["scans"],
         confidence=config["load_area"]["confidence"],
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
     script:
@@ -235,12 +231,8 @@ rule plot_model_curves:
 
 rule plot_curvature_study:
     input:
-        [
-            f"{SYNTHETIC_SCENE.format(scene=scene)}/{name}"
-            for pair in CURVATURE_PAIRS.values()
-            for scene in pair
-            for name in ("solve.json", "scene_fit.json")
-        ],
+        solves=list(RUN.study.curvature_files(SOLVE).values()),
+        fits=list(RUN.study.curvature_files(SCENE_FIT).values()),
     output:
         table=f"{STUDY_RESULTS}/B10_curvature.csv",
         png=report(
@@ -262,32 +254,16 @@ rule plot_curvature_study:
         runtime=measured_runtime("plot_curvature_study"),
     params:
         pairs=CURVATURE_PAIRS,
-        solves={
-            scene: f"{SYNTHETIC_SCENE.format(scene=scene)}/solve.json"
-            for pair in CURVATURE_PAIRS.values()
-            for scene in pair
-        },
-        fits={
-            scene: f"{SYNTHETIC_SCENE.format(scene=scene)}/scene_fit.json"
-            for pair in CURVATURE_PAIRS.values()
-            for scene in pair
-        },
+        solves=RUN.study.curvature_files(SOLVE),
+        fits=RUN.study.curvature_files(SCENE_FIT),
     script:
         "../../scripts/plot_curvature_study.py"
 
 
 rule plot_amontons_study:
     input:
-        amontons=[f"{MATERIAL.format(material=m)}/amontons.csv" for m in MATERIALS],
-        bests=(
-            [
-                f"{scan_dir(m, s, scans_of('k_mpa_per_nm')[0])}/best.json"
-                for m in MATERIALS
-                for s in spheres_of(m)
-            ]
-            if scans_of("k_mpa_per_nm")
-            else []
-        ),
+        amontons=expand(rules.plot_amontons_deviation.output.table, material=MATERIALS),
+        bests=list(RUN.study.k_bests(MATERIALS).values()),
     output:
         table=f"{STUDY_RESULTS}/B13_amontons.csv",
         png=report(
@@ -308,15 +284,7 @@ rule plot_amontons_study:
         mem_mb=measured_mem_mb("plot_amontons_study"),
         runtime=measured_runtime("plot_amontons_study"),
     params:
-        bests=(
-            {
-                s: f"{scan_dir(m, s, scans_of('k_mpa_per_nm')[0])}/best.json"
-                for m in MATERIALS
-                for s in spheres_of(m)
-            }
-            if scans_of("k_mpa_per_nm")
-            else {}
-        ),
+        bests=RUN.study.k_bests(MATERIALS),
         reference_load_mn=config["load_area"]["reference_load_mn"],
         data_label=data_label(SPHERES),
     script:
@@ -326,5 +294,7 @@ rule plot_amontons_study:
 rule study:
     """Target: the scans, the study's figures and model tables."""
     input:
-        scan_outputs(MATERIALS) + study_outputs(MATERIALS) + study_overview_outputs(),
+        RUN.scenes.scan_outputs(MATERIALS)
+        + RUN.study.outputs(MATERIALS)
+        + RUN.study.overview_outputs(),
     localrule: True

@@ -37,5 +37,5 @@ rule measure_topography:
 rule surface:
     """Target: the AFM topography of every sphere."""
     input:
-        [f for m in MATERIALS for f in sphere_outputs(m, SURFACE_RESULTS)],
+        TARGETS.surface(MATERIALS),
     localrule: True

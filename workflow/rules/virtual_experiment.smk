@@ -5,20 +5,20 @@
 
 rule generate_virtual_experiment:
     output:
-        fluorescence=directory(f"{SYNTHETIC}/{{sphere}}/fluorescence"),
-        rheometer=directory(f"{SYNTHETIC}/{{sphere}}/rheometer"),
-        reflection=f"{SYNTHETIC}/{{sphere}}/reflection.tif",
-        bead=f"{SYNTHETIC}/{{sphere}}/bead.tif",
-        absorbance=f"{SYNTHETIC}/{{sphere}}/absorbance.csv",
-        afm_before=f"{SYNTHETIC}/{{sphere}}/afm_before.tif",
-        afm_after=f"{SYNTHETIC}/{{sphere}}/afm_after.tif",
-        truth=f"{SYNTHETIC}/{{sphere}}/truth.json",
+        fluorescence=directory(f"{SYNTHETIC_SPHERE}/fluorescence"),
+        rheometer=directory(f"{SYNTHETIC_SPHERE}/rheometer"),
+        reflection=f"{SYNTHETIC_SPHERE}/reflection.tif",
+        bead=f"{SYNTHETIC_SPHERE}/bead.tif",
+        absorbance=f"{SYNTHETIC_SPHERE}/absorbance.csv",
+        afm_before=f"{SYNTHETIC_SPHERE}/afm_before.tif",
+        afm_after=f"{SYNTHETIC_SPHERE}/afm_after.tif",
+        truth=f"{SYNTHETIC_SPHERE}/{TRUTH}",
     log:
         f"{LOGS}/virtual_experiment/{{sphere}}.log",
     benchmark:
         f"{LOGS}/virtual_experiment/{{sphere}}.benchmark.tsv"
     wildcard_constraints:
-        sphere=flim_spheres_pattern(with_flim=False),
+        sphere=SPHERES.synthetic_pattern(with_flim=False),
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -39,7 +39,7 @@ rule generate_virtual_experiment:
         shear_strength_mpa=lambda wc: sheet_value(wc.sphere, "shear_strength_mpa"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         settings=config_slice("virtual_experiment"),
-        newton_rings=ring_optics(),
+        newton_rings=RING_OPTICS,
         seed=config["seed"],
     script:
         "../../scripts/generate_virtual_experiment.py"
@@ -47,21 +47,21 @@ rule generate_virtual_experiment:
 
 use rule generate_virtual_experiment as generate_virtual_experiment_with_flim with:
     output:
-        fluorescence=directory(f"{SYNTHETIC}/{{sphere}}/fluorescence"),
-        rheometer=directory(f"{SYNTHETIC}/{{sphere}}/rheometer"),
-        reflection=f"{SYNTHETIC}/{{sphere}}/reflection.tif",
-        bead=f"{SYNTHETIC}/{{sphere}}/bead.tif",
-        absorbance=f"{SYNTHETIC}/{{sphere}}/absorbance.csv",
-        afm_before=f"{SYNTHETIC}/{{sphere}}/afm_before.tif",
-        afm_after=f"{SYNTHETIC}/{{sphere}}/afm_after.tif",
-        flim=f"{SYNTHETIC}/{{sphere}}/flim.tif",
-        truth=f"{SYNTHETIC}/{{sphere}}/truth.json",
+        fluorescence=directory(f"{SYNTHETIC_SPHERE}/fluorescence"),
+        rheometer=directory(f"{SYNTHETIC_SPHERE}/rheometer"),
+        reflection=f"{SYNTHETIC_SPHERE}/reflection.tif",
+        bead=f"{SYNTHETIC_SPHERE}/bead.tif",
+        absorbance=f"{SYNTHETIC_SPHERE}/absorbance.csv",
+        afm_before=f"{SYNTHETIC_SPHERE}/afm_before.tif",
+        afm_after=f"{SYNTHETIC_SPHERE}/afm_after.tif",
+        flim=f"{SYNTHETIC_SPHERE}/flim.tif",
+        truth=f"{SYNTHETIC_SPHERE}/{TRUTH}",
     wildcard_constraints:
-        sphere=flim_spheres_pattern(with_flim=True),
+        sphere=SPHERES.synthetic_pattern(with_flim=True),
 
 
 rule virtual_experiment:
     """Target: the virtual experiment of every synthetic sphere."""
     input:
-        [f"{SYNTHETIC}/{s}/truth.json" for s in SPHERES if is_synthetic(s)],
+        TARGETS.virtual_experiment(),
     localrule: True

@@ -16,7 +16,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from amontons.accuracy.timing import PLASTIC_RATIO
-from amontons.config import ConfigError
+from amontons.config.errors import ConfigError
 
 # problem -> (contact model, geometry)
 PROBLEMS = {
@@ -163,3 +163,24 @@ def check_accuracy(config: Mapping, source: str) -> None:
                 f"{source}: accuracy.grid pixel_factor {block['pixel_factor']}; expected "
                 "integers ≥ 1 (multiples of the finest pixel)"
             )
+
+
+def check_accuracy_study(config: Mapping, sheet: Mapping[str, dict], source: str) -> None:
+    """The accuracy study's sphere (null: the first sphere of the first selected material,
+    set in place) must be a sphere of a selected material, and its grid and reference must
+    make sense (:func:`check_accuracy`). ``config``: the whole config; ``sheet``: every
+    sphere's record (amontons.config.sheet)."""
+    study = config["accuracy"]
+    if study["sphere"] is None:
+        # the first sphere of the first selected material: the study runs on any data set
+        study["sphere"] = next(
+            s for m in config["materials"] for s, r in sheet.items() if r["material"] == m
+        )
+    record = sheet.get(study["sphere"])
+    if record is None or record["material"] not in config["materials"]:
+        raise ConfigError(
+            f"{source}: accuracy.sphere = {study['sphere']!r} is not a sphere of the selected "
+            f"materials {list(config['materials'])}; expected one of "
+            f"{', '.join(s for s, r in sheet.items() if r['material'] in config['materials'])}"
+        )
+    check_accuracy(study, source)

@@ -17,8 +17,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from amontons.config import geometry
 from amontons.contact import ContactHardening, PenetrationHardness
-from amontons.physics import hertz
 
 MODELS = ("greenwood_tripp", "elastic", "penetration_hardness", "hardening")
 INCREMENTS = {"local": "local", "volume_conserving": "volume"}
@@ -72,8 +72,7 @@ class Scene:
     @property
     def side_px(self) -> int:
         """Solver grid side, px (even)."""
-        n = int(round(self.window_m / self.pixel_m))
-        return n + n % 2
+        return geometry.side_px(self.window_m, self.pixel_m)
 
     @property
     def plasticity(self) -> PenetrationHardness | ContactHardening | None:
@@ -119,25 +118,12 @@ class Scene:
         return record
 
 
-def _window_m(name: str, config: Mapping, loads_n, radius_m, e_star_pa) -> float:
-    """Window side (m): ``side_px`` × pixel, or ``window_factor`` × the Hertz contact diameter
-    at the largest load."""
-    pixel_m = config["pixel_nm"] * 1e-9
-    if config.get("side_px") is not None:
-        return config["side_px"] * pixel_m
-    if radius_m is None:
-        raise SceneError(f"scene {name}: a flat surface needs side_px (no Hertz diameter)")
-    diameter = 2 * hertz.contact_radius(max(loads_n), radius_m, e_star_pa)
-    return config["window_factor"] * diameter
-
-
-def _solver_pixel_m(config: Mapping, window_m: float) -> float:
-    """Solver pixel (m): ``pixel_nm``, or coarser when a window set by ``window_factor`` would
-    need more than ``max_side_px`` pixels (a large contact then costs no more than the cap)."""
-    pixel_m = config["pixel_nm"] * 1e-9
-    if config.get("side_px") is not None:
-        return pixel_m
-    return max(pixel_m, window_m / config["max_side_px"])
+def _window_m(name: str, config: Mapping, frame: geometry.Frame) -> float:
+    """Window side (m): amontons.config.geometry.window_m, its error as a SceneError."""
+    try:
+        return geometry.window_m(name, config, frame)
+    except geometry.GeometryError as exc:
+        raise SceneError(str(exc)) from exc
 
 
 def _sheet_or(name: str, config: Mapping, key: str, record: Mapping, column: str, scale: float):
@@ -172,25 +158,24 @@ def _model_parameters(name: str, config: Mapping, record: Mapping) -> dict:
 def _scene(
     name: str,
     config: Mapping,
+    frame: geometry.Frame,
     *,
-    e_star_pa: float,
-    radius_m: float | None,
-    loads_n: tuple[float, ...],
     record: Mapping,
     synthetic: SyntheticSurface | None = None,
 ) -> Scene:
-    """The Scene of a config entry, given what its surface decides: E*, radius and loads (SI),
-    the sheet record its null model parameters come from, and a synthetic surface."""
-    window_m = _window_m(name, config, loads_n, radius_m, e_star_pa)
+    """The Scene of a config entry, given what its surface decides (its frame: loads, radius
+    and E*, SI), the sheet record its null model parameters come from, and a synthetic
+    surface."""
+    window_m = _window_m(name, config, frame)
     return Scene(
         name=name,
         surface=config["surface"],
         geometry=config["geometry"],
         model=config["model"],
-        e_star_pa=e_star_pa,
-        radius_m=radius_m,
-        loads_n=loads_n,
-        pixel_m=_solver_pixel_m(config, window_m),
+        e_star_pa=frame.e_star_pa,
+        radius_m=frame.radius_m,
+        loads_n=frame.loads_n,
+        pixel_m=geometry.solver_pixel_m(config, window_m),
         window_m=window_m,
         tol=config["tol"],
         optics=config["optics"],
@@ -205,16 +190,8 @@ def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -
     diameter_mm, e_star_gpa, loads, hardness_mpa, hardening_k_mpa_per_nm)."""
     if config["surface"] != "afm_before":
         raise SceneError(f"scene {name}: surface = {config['surface']!r} is not a sphere's map")
-    loads = config["loads"]
-    loads_mn = list(record["loads"]) if loads == "measured" else [float(f) for f in loads]
-    return _scene(
-        name,
-        config,
-        e_star_pa=float(record["e_star_gpa"]) * 1e9,
-        radius_m=float(record["diameter_mm"]) * 0.5e-3,
-        loads_n=tuple(f * 1e-3 for f in loads_mn),
-        record={**record, "sphere": sphere},
-    )
+    frame = geometry.sphere_frame(config, record)
+    return _scene(name, config, frame, record={**record, "sphere": sphere})
 
 
 def synthetic_scene(name: str, config: Mapping) -> Scene:
@@ -233,15 +210,8 @@ def synthetic_scene(name: str, config: Mapping) -> Scene:
         long_cutoff_m=_scaled(synthetic.get("long_cutoff_um"), 1e-6),
         seed=int(synthetic["seed"]),
     )
-    return _scene(
-        name,
-        config,
-        e_star_pa=synthetic["e_star_gpa"] * 1e9,
-        radius_m=synthetic["radius_mm"] * 1e-3 if config["geometry"] == "sphere" else None,
-        loads_n=tuple(float(f) * 1e-3 for f in config["loads"]),
-        record={"sphere": "(synthetic)"},
-        synthetic=surface,
-    )
+    frame = geometry.synthetic_frame(config)
+    return _scene(name, config, frame, record={"sphere": "(synthetic)"}, synthetic=surface)
 
 
 def _scaled(value, scale):

@@ -1,0 +1,84 @@
+"""A scene's solver window and grid, in SI units: the one geometry that the simulation
+(amontons.simulate.scene) solves on and that the workflow sizes jobs and checks windows with
+(docs/simulate.md, "Window and grid").
+
+A window is ``side_px`` × ``pixel_nm`` where a scene gives ``side_px``, else ``window_factor``
+× the Hertz contact diameter at the largest load; its pixel is ``pixel_nm``, coarsened where
+such a window would need more than ``max_side_px`` pixels. Standard library only: the
+workflow imports it to build its DAG.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import NamedTuple
+
+
+class GeometryError(ValueError):
+    """A scene whose window cannot be set (names the scene and the key)."""
+
+
+class Frame(NamedTuple):
+    """What a scene's surface decides, SI: loads (N, increasing), sphere radius (m; None for
+    a flat surface) and contact modulus E* (Pa)."""
+
+    loads_n: tuple[float, ...]
+    radius_m: float | None
+    e_star_pa: float
+
+
+def sphere_frame(scene: Mapping, record: Mapping) -> Frame:
+    """The frame of a scene on a sphere's AFM map: E* and diameter from its sheet ``record``,
+    and its loads (the sheet's where the scene says 'measured', else the scene's; mN)."""
+    loads = scene["loads"]
+    loads_mn = list(record["loads"]) if loads == "measured" else [float(f) for f in loads]
+    return Frame(
+        loads_n=tuple(f * 1e-3 for f in loads_mn),
+        radius_m=float(record["diameter_mm"]) * 0.5e-3,
+        e_star_pa=float(record["e_star_gpa"]) * 1e9,
+    )
+
+
+def synthetic_frame(scene: Mapping) -> Frame:
+    """The frame of a scene on a synthetic surface, which names E*, loads and (for the sphere
+    geometry) the radius itself."""
+    synthetic = scene["synthetic"]
+    return Frame(
+        loads_n=tuple(float(f) * 1e-3 for f in scene["loads"]),
+        radius_m=synthetic["radius_mm"] * 1e-3 if scene["geometry"] == "sphere" else None,
+        e_star_pa=synthetic["e_star_gpa"] * 1e9,
+    )
+
+
+def hertz_diameter_m(load_n: float, radius_m: float, e_star_pa: float) -> float:
+    """Hertz contact diameter 2a = 2·(3FR/4E*)^(1/3), m (amontons.physics.hertz, to the bit)."""
+    return 2 * float((3 * load_n * radius_m / (4 * e_star_pa)) ** (1 / 3))
+
+
+def window_m(name: str, scene: Mapping, frame: Frame) -> float:
+    """Window side (m) of scene ``name`` (its config entry): ``side_px`` × pixel, or
+    ``window_factor`` × the Hertz contact diameter at the frame's largest load (a flat surface
+    needs ``side_px``)."""
+    pixel_m = scene["pixel_nm"] * 1e-9
+    if scene.get("side_px") is not None:
+        return scene["side_px"] * pixel_m
+    if frame.radius_m is None:
+        raise GeometryError(f"scene {name}: a flat surface needs side_px (no Hertz diameter)")
+    largest = hertz_diameter_m(max(frame.loads_n), frame.radius_m, frame.e_star_pa)
+    return scene["window_factor"] * largest
+
+
+def solver_pixel_m(scene: Mapping, window: float) -> float:
+    """Solver pixel (m) of a scene whose window is ``window`` (m): ``pixel_nm``, or coarser
+    where a window set by ``window_factor`` would need more than ``max_side_px`` pixels (a
+    large contact then costs no more than the cap)."""
+    pixel_m = scene["pixel_nm"] * 1e-9
+    if scene.get("side_px") is not None:
+        return pixel_m
+    return max(pixel_m, window / scene["max_side_px"])
+
+
+def side_px(window: float, pixel_m: float) -> int:
+    """Solver grid side (px, even) of a window (m) at ``pixel_m`` (m)."""
+    n = int(round(window / pixel_m))
+    return n + n % 2

@@ -1,0 +1,66 @@
+"""The config and the sample sheet against their JSON Schemas (workflow/schemas/): every
+violation listed at once, each naming its key, the value and what was expected."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import jsonschema
+import yaml
+
+from amontons.config.errors import ConfigError
+
+
+def load_schema(path: str | Path) -> dict:
+    """Read a JSON Schema written as YAML."""
+    with open(path) as stream:
+        return yaml.safe_load(stream)
+
+
+def _key_path(error: jsonschema.ValidationError) -> str:
+    return ".".join(str(part) for part in error.absolute_path) or "<top level>"
+
+
+def _schema_at(schema: Mapping, error: jsonschema.ValidationError) -> Mapping:
+    node = schema
+    for part in error.absolute_path:
+        if isinstance(part, int):
+            node = node.get("items", {})
+        elif part in node.get("properties", {}):
+            node = node["properties"][part]
+        else:
+            extra = node.get("additionalProperties")
+            node = extra if isinstance(extra, Mapping) else {}
+    return node
+
+
+def _describe(error: jsonschema.ValidationError, schema: Mapping) -> str:
+    where = _key_path(error)
+    if error.validator == "additionalProperties":
+        allowed = sorted(_schema_at(schema, error).get("properties", {}))
+        unknown = sorted(set(error.instance) - set(allowed))
+        return (
+            f"unknown key(s) {', '.join(repr(k) for k in unknown)} in {where}; "
+            f"allowed keys: {', '.join(allowed)}"
+        )
+    if error.validator == "enum":
+        allowed = ", ".join(repr(v) for v in error.validator_value)
+        return f"{where} = {error.instance!r} is not allowed; allowed values: {allowed}"
+    if error.validator == "required":
+        return f"{where}: {error.message}"
+    description = error.schema.get("description", "")
+    expected = f" (expected: {description})" if description else ""
+    return f"{where} = {error.instance!r}: {error.message}{expected}"
+
+
+def validate(data: Mapping, schema: Mapping, source: str) -> None:
+    """Raise ConfigError listing every schema violation of ``data``, each naming its key.
+
+    ``source`` names the file the data came from, for the message.
+    """
+    validator = jsonschema.Draft202012Validator(schema)
+    errors = sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
+    if errors:
+        lines = "\n  ".join(_describe(e, schema) for e in errors)
+        raise ConfigError(f"{source}: invalid configuration\n  {lines}")

@@ -1,0 +1,10 @@
+"""What the Snakemake workflow needs to build its DAG, importable and tested without
+Snakemake (tests/workflow_dag/): run paths (:mod:`~amontons.workflow.paths`), the selected
+spheres and their raw files (:mod:`~amontons.workflow.spheres`), config slices as params
+(:mod:`~amontons.workflow.params`), the expansion of scenes and scans
+(:mod:`~amontons.workflow.scenes`), the study (:mod:`~amontons.workflow.study`), targets
+(:mod:`~amontons.workflow.targets`), the accuracy study (:mod:`~amontons.workflow.accuracy`)
+and cluster resources (:mod:`~amontons.workflow.resources`), tied together by
+:class:`~amontons.workflow.run.WorkflowRun`. Standard library, jsonschema and yaml only: no
+numerical stack is loaded to build a DAG.
+"""

@@ -1,0 +1,118 @@
+"""Cluster resources of each job (docs/cluster.md): each rule's measured wall time and peak
+memory (workflow/resources.json, amontons.resources), and for the solves the accuracy study's
+timing model (workflow/timing_model.json, docs/accuracy.md §6) in their FFT grid, loads,
+tolerance and plastic ratio. The grid is the scene's own (amontons.config.geometry), so that
+what a job asks for grows with what it solves."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+from amontons.accuracy.timing import plastic_ratio, predict
+from amontons.config import geometry
+from amontons.resources import JobResources, mem_mb_of, runtime_min
+from amontons.workflow.spheres import Spheres
+
+# (scene, sphere or None for a synthetic scene[, scan parameter, scan value]) of a job
+SolveOf = Callable[[object], tuple]
+
+
+class SolveResources:
+    """What a run's jobs ask for: measured per rule, predicted per solve."""
+
+    def __init__(
+        self,
+        config: Mapping,
+        spheres: Spheres,
+        measured: JobResources,
+        timing_model: Mapping,
+    ):
+        self.scenes = config["scenes"]
+        self.spheres = spheres
+        self.measured = measured
+        self.timing_model = timing_model
+
+    @classmethod
+    def from_workflow_dir(cls, config: Mapping, spheres: Spheres, folder: str | Path):
+        """Read resources.json and timing_model.json from the workflow folder ``folder``."""
+        folder = Path(folder)
+        with open(folder / "timing_model.json", encoding="utf-8") as stream:
+            timing_model = json.load(stream)
+        measured = JobResources.from_file(folder / "resources.json")
+        return cls(config, spheres, measured, timing_model)
+
+    def runtime(self, rule: str) -> int:
+        """Measured runtime (min) of a job of ``rule``."""
+        return self.measured.runtime_min(rule)
+
+    def mem_mb(self, rule: str) -> int:
+        """Measured memory (MB) of a job of ``rule``."""
+        return self.measured.mem_mb(rule)
+
+    def solve_size(self, scene, sphere=None, scan=None, value=None) -> tuple[str, dict]:
+        """What the timing model needs of a scene's solve on ``sphere`` (None: synthetic),
+        with the scan parameter ``scan`` (p_y_mpa or k_mpa_per_nm) at ``value`` if given:
+        model and the keyword arguments of amontons.accuracy.timing.predict."""
+        spec = self.scenes[scene]
+        if sphere is None:
+            frame = geometry.synthetic_frame(spec)
+            slope = spec["synthetic"].get("rms_slope")
+            law = spec
+        else:
+            row = self.spheres.row(sphere)
+            frame = geometry.sphere_frame(spec, row)
+            slope = None  # the map's slope is known only once it is levelled
+            law = {
+                "p_y_mpa": spec["p_y_mpa"] or row.get("hardness_mpa"),
+                "k_mpa_per_nm": spec["k_mpa_per_nm"] or row.get("hardening_k_mpa_per_nm"),
+            }
+        if scan is not None:
+            law = {**law, scan: float(value)}
+        window = geometry.window_m(scene, spec, frame)
+        pixel = geometry.solver_pixel_m(spec, window)
+        contact_px = None
+        if frame.radius_m is not None:
+            largest = max(frame.loads_n)
+            contact_px = geometry.hertz_diameter_m(largest, frame.radius_m, frame.e_star_pa) / pixel
+        ratio = plastic_ratio(
+            spec["model"],
+            pixel_m=pixel,
+            e_star_pa=frame.e_star_pa,
+            k_pa_per_m=(law.get("k_mpa_per_nm") or 0.0) * 1e15,
+            p_y_pa=(law.get("p_y_mpa") or 0.0) * 1e6,
+            slope_rms=slope,
+        )
+        return spec["model"], {
+            "side_px": geometry.side_px(window, pixel),
+            "periodic": spec["geometry"] == "flat_periodic",
+            "loads": len(frame.loads_n),
+            "tol": spec["tol"],
+            "contact_px": contact_px,
+            "ratio": ratio,
+        }
+
+    def predicted(self, solve_of: SolveOf, wildcards) -> tuple[float, float]:
+        """(wall time s, peak memory MB) the timing model predicts for a job's solve."""
+        model, size = self.solve_size(*solve_of(wildcards))
+        return predict(self.timing_model, model, **size)
+
+    def solve_runtime(self, solve_of: SolveOf):
+        """Runtime (min) of a solve job, as a function of its wildcards: the timing model's
+        prediction with the resources' safety factor."""
+        return lambda wildcards: runtime_min(self.predicted(solve_of, wildcards)[0])
+
+    def solve_mem_mb(self, solve_of: SolveOf):
+        """Memory (MB) of a solve job, as :meth:`solve_runtime`."""
+        return lambda wildcards: mem_mb_of(self.predicted(solve_of, wildcards)[1])
+
+
+def scan_solve(scans: Mapping) -> SolveOf:
+    """A scan job's solve for the timing model: its scene on its sphere at its value."""
+
+    def solve_of(wildcards):
+        scan = scans[wildcards.scan]
+        return scan["scene"], wildcards.sphere, scan["parameter"], wildcards.value
+
+    return solve_of

@@ -1,0 +1,95 @@
+"""A run of the workflow as its DAG sees it: the config checked once, and every helper the
+rules call (paths, spheres, scenes and scans, study, targets, accuracy study, resources),
+built from it. workflow/rules/common.smk only binds these to the names the rules use."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from amontons.accuracy.settings import check_accuracy_study
+from amontons.config.scenes import (
+    check_curvature_pairs,
+    check_scans,
+    check_scenes,
+    resolve_scene_presets,
+)
+from amontons.config.schema import load_schema, validate
+from amontons.config.sheet import (
+    check_reference_load,
+    check_selected_materials,
+    read_sample_sheet,
+)
+from amontons.workflow.accuracy import AccuracyStudy
+from amontons.workflow.paths import RunPaths
+from amontons.workflow.resources import SolveResources
+from amontons.workflow.scenes import Scenes
+from amontons.workflow.spheres import Spheres
+from amontons.workflow.study import Study
+from amontons.workflow.targets import Targets
+
+
+def load_workflow_config(
+    config: Mapping, config_schema: Mapping, sheet_schema: Mapping, source: str
+) -> dict[str, dict]:
+    """Validate a config mapping and its sample sheet, resolving scene presets and the
+    accuracy study's sphere in place; return the sheet records (sphere id → record) of the
+    selected materials. Every check runs before any job; ``source`` names the config file(s)
+    in the messages."""
+    validate(config, config_schema, source)
+    resolve_scene_presets(config, source)
+    sheet = read_sample_sheet(config["materials_sheet"], sheet_schema)
+    check_selected_materials(config["materials"], sheet, source)
+    selected = {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
+    check_reference_load(config["load_area"]["reference_load_mn"], selected, source)
+    check_scenes(config, selected, source)
+    check_scans(config, selected, source)
+    check_curvature_pairs(config, source)
+    check_accuracy_study(config, sheet, source)
+    return selected
+
+
+@dataclass
+class WorkflowRun:
+    """Everything the rules ask of a run (see the module docstring)."""
+
+    config: Mapping
+    paths: RunPaths
+    spheres: Spheres
+    scenes: Scenes
+    study: Study
+    targets: Targets
+    accuracy: AccuracyStudy
+    resources: SolveResources
+
+    @property
+    def materials(self) -> list[str]:
+        return list(self.config["materials"])
+
+    @classmethod
+    def from_config(cls, config: Mapping, workflow_dir: str | Path, source: str) -> WorkflowRun:
+        """Check ``config`` (resolved in place) against the schemas in
+        ``workflow_dir``/schemas and build the run; ``workflow_dir`` also holds the measured
+        resources and the timing model."""
+        schemas = Path(workflow_dir) / "schemas"
+        records = load_workflow_config(
+            config,
+            load_schema(schemas / "config.schema.yaml"),
+            load_schema(schemas / "materials.schema.yaml"),
+            source,
+        )
+        paths = RunPaths(config["run"])
+        spheres = Spheres(records, paths)
+        scenes = Scenes(config, spheres, paths)
+        study = Study(config, spheres, scenes, paths)
+        return cls(
+            config=config,
+            paths=paths,
+            spheres=spheres,
+            scenes=scenes,
+            study=study,
+            targets=Targets(spheres, scenes, study, paths),
+            accuracy=AccuracyStudy(config, spheres, paths),
+            resources=SolveResources.from_workflow_dir(config, spheres, workflow_dir),
+        )

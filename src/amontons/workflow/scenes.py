@@ -1,0 +1,159 @@
+"""The expansion of scenes and scans into jobs (docs/simulate.md, docs/study.md): a scene on
+a sphere's AFM map runs for every selected sphere; a synthetic scene runs once and reads
+nothing of the experiment; each value of a sphere's scan is a job of its own. Only what a
+scene names is scheduled: its comparison files exist only with optics."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from amontons.config.scenes import SCAN_COLUMNS
+from amontons.simulate.scan_grid import scan_values, value_label
+from amontons.workflow import paths as files
+from amontons.workflow.params import sorted_keys
+from amontons.workflow.paths import RunPaths
+from amontons.workflow.spheres import Spheres
+
+
+class Scenes:
+    """The running scenes (config ``run_scenes``) and scans (``run_scans``) of a run."""
+
+    def __init__(self, config: Mapping, spheres: Spheres, paths: RunPaths):
+        self.scenes = {name: config["scenes"][name] for name in config["run_scenes"]}
+        self.scans = {name: config["scans"][name] for name in config["run_scans"]}
+        self.spheres = spheres
+        self.paths = paths
+
+    # scenes
+
+    def names(self, surface=None, model=None, optics=None, field=None) -> list[str]:
+        """Names of the scenes with the given surface, model and optics; ``field``: True for
+        the scenes whose solver gives fields (every model but Greenwood-Tripp), False for GT.
+        """
+        names = []
+        for name, scene in self.scenes.items():
+            if surface is not None and scene["surface"] != surface:
+                continue
+            if model is not None and scene["model"] != model:
+                continue
+            if optics is not None and scene["optics"] != optics:
+                continue
+            if field is not None and (scene["model"] != "greenwood_tripp") != field:
+                continue
+            names.append(name)
+        return names
+
+    def afm_scenes(self) -> list[str]:
+        """The scenes on a sphere's AFM map."""
+        return self.names(surface="afm_before")
+
+    def has_optics(self, scene: str) -> bool:
+        return self.scenes[scene]["optics"] == "microscope"
+
+    def config(self, scene: str) -> dict:
+        """A scene's config entry, as a rule's params (a changed scene re-runs only its
+        jobs)."""
+        return sorted_keys(self.scenes[scene])
+
+    def models(self) -> dict[str, str]:
+        """Each running scene's model."""
+        return {name: scene["model"] for name, scene in self.scenes.items()}
+
+    def first(self, model: str, optics: str | None = None) -> str | None:
+        """The first running AFM scene of ``model`` (and ``optics``), or None."""
+        names = self.names(surface="afm_before", model=model, optics=optics)
+        return names[0] if names else None
+
+    def sphere_scene_outputs(self, material: str, sphere: str, scene: str) -> list[str]:
+        """What a scene of one sphere delivers: its fit and, with optics, its comparison."""
+        out = [self.paths.scene(files.SCENE_FIT, material, sphere, scene)]
+        if self.has_optics(scene):
+            folder = self.paths.scene("", material, sphere, scene)
+            out += files.figure_files(folder, files.COMPARISON_FIGURE)
+            out.append(f"{folder}/{files.REGISTRATION}")
+        return out
+
+    def outputs(self, materials) -> list[str]:
+        """Every AFM scene of every sphere of ``materials`` and each material's scene table."""
+        out = []
+        for material in materials:
+            for sphere in self.spheres.of(material):
+                for scene in self.afm_scenes():
+                    out += self.sphere_scene_outputs(material, sphere, scene)
+            if self.afm_scenes():
+                out.append(f"{self.paths.material(material)}/scenes.csv")
+        return out
+
+    def synthetic_outputs(self) -> list[str]:
+        return [
+            self.paths.synthetic_scene(files.SCENE_FIT, s) for s in self.names(surface="synthetic")
+        ]
+
+    def fit_inputs(self, wildcards) -> dict[str, str]:
+        """A scene's solve and, with optics, its rendered areas."""
+        where = (wildcards.material, wildcards.sphere, wildcards.scene)
+        inputs = {"solve": self.paths.scene(files.SOLVE, *where)}
+        if self.has_optics(wildcards.scene):
+            inputs["render"] = self.paths.scene(files.RENDER_TABLE, *where)
+        return inputs
+
+    def table_inputs(self, material: str) -> list[str]:
+        """Every AFM scene's fit of every sphere of ``material`` (the scene table)."""
+        return [
+            self.paths.scene(files.SCENE_FIT, material, sphere, scene)
+            for sphere in self.spheres.of(material)
+            for scene in self.afm_scenes()
+        ]
+
+    # scans
+
+    def scans_of(self, parameter: str) -> list[str]:
+        """The running scans of ``parameter`` (p_y_mpa or k_mpa_per_nm)."""
+        return [name for name, spec in self.scans.items() if spec["parameter"] == parameter]
+
+    def scan_value_labels(self, sphere: str, scan: str) -> list[str]:
+        """The folder names of a scan's values for one sphere (range_factor × its sheet
+        value)."""
+        spec = self.scans[scan]
+        centre = self.spheres.row(sphere)[SCAN_COLUMNS[spec["parameter"]]]
+        values = scan_values(centre, spec["range_factor"], spec["steps"], spec["spacing"])
+        return [value_label(v) for v in values]
+
+    def scan_points(self, wildcards) -> list[str]:
+        """Every value's result of one sphere's scan."""
+        where = (wildcards.material, wildcards.sphere, wildcards.scan)
+        return [
+            self.paths.scan_value(files.SCAN_POINT, *where, value)
+            for value in self.scan_value_labels(wildcards.sphere, wildcards.scan)
+        ]
+
+    def scan_base_registration(self, wildcards) -> str:
+        """The registration of a scan's base scene on the scan's sphere."""
+        base = self.scans[wildcards.scan]["scene"]
+        return self.paths.scene(files.REGISTRATION, wildcards.material, wildcards.sphere, base)
+
+    def scan_outputs(self, materials) -> list[str]:
+        """Every scan of every sphere of ``materials``: its table and best value."""
+        return [
+            self.paths.scan(name, material, sphere, scan)
+            for material in materials
+            for sphere in self.spheres.of(material)
+            for scan in self.scans
+            for name in (files.SCAN_TABLE, files.BEST)
+        ]
+
+    def scan_files(self, material: str, sphere: str, scan: str) -> dict:
+        """What the study's figures read of one sphere's scan: its judgement, every value's
+        rendered fields and its base scene's registration."""
+        where = (material, sphere, scan)
+        return {
+            "best": self.paths.scan(files.BEST, *where),
+            "table": self.paths.scan(files.SCAN_TABLE, *where),
+            "rendered": [
+                self.paths.scan_value(files.RENDERED, *where, v)
+                for v in self.scan_value_labels(sphere, scan)
+            ],
+            "registration": self.paths.scene(
+                files.REGISTRATION, material, sphere, self.scans[scan]["scene"]
+            ),
+        }

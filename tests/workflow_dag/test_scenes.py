@@ -1,0 +1,106 @@
+"""The expansion of scenes, scans and the study into the files the DAG schedules, on the
+shipped small config: only what a scene names, one job per scan value."""
+
+from types import SimpleNamespace
+
+import pytest
+
+from amontons.config.scenes import SCAN_COLUMNS
+from amontons.simulate.scan_grid import scan_values, value_label
+
+
+def _wildcards(**values):
+    return SimpleNamespace(**values)
+
+
+def test_only_microscope_scenes_deliver_a_comparison(small):
+    scenes = small.scenes
+    with_optics = scenes.names(surface="afm_before", optics="microscope")
+    without = scenes.names(surface="afm_before", optics="none")
+    assert with_optics and without
+    sphere = next(iter(small.spheres))
+    material = small.spheres.material_of(sphere)
+    assert len(scenes.sphere_scene_outputs(material, sphere, without[0])) == 1
+    outputs = scenes.sphere_scene_outputs(material, sphere, with_optics[0])
+    names = sorted(path.rsplit("/", 1)[1] for path in outputs)
+    assert names == [
+        "comparison.csv",
+        "comparison.pdf",
+        "comparison.png",
+        "registration.json",
+        "scene_fit.json",
+    ]
+
+
+def test_a_scenes_fit_reads_its_render_only_with_optics(small):
+    scenes = small.scenes
+    sphere = next(iter(small.spheres))
+    for name in scenes.afm_scenes():
+        wildcards = _wildcards(
+            material=small.spheres.material_of(sphere), sphere=sphere, scene=name
+        )
+        inputs = scenes.fit_inputs(wildcards)
+        assert inputs["solve"].endswith(f"/scenes/{name}/solve.json")
+        assert ("render" in inputs) == scenes.has_optics(name)
+
+
+def test_greenwood_tripp_is_the_one_model_without_fields(small):
+    scenes = small.scenes
+    fields = set(scenes.names(field=True))
+    gt = set(scenes.names(field=False))
+    assert fields.isdisjoint(gt) and fields | gt == set(scenes.scenes)
+    assert all(scenes.scenes[name]["model"] == "greenwood_tripp" for name in gt)
+
+
+def test_a_scan_has_one_point_per_value_around_the_sheets_prior(small):
+    scenes = small.scenes
+    assert scenes.scans
+    sphere = next(iter(small.spheres))
+    for scan, spec in scenes.scans.items():
+        prior = small.spheres.row(sphere)[SCAN_COLUMNS[spec["parameter"]]]
+        expected = scan_values(prior, spec["range_factor"], spec["steps"], spec["spacing"])
+        labels = scenes.scan_value_labels(sphere, scan)
+        assert labels == [value_label(v) for v in expected]
+        assert len(labels) == spec["steps"]
+        wildcards = _wildcards(material=small.spheres.material_of(sphere), sphere=sphere, scan=scan)
+        points = scenes.scan_points(wildcards)
+        assert [p.split("/")[-2] for p in points] == labels
+
+
+def test_without_scans_there_is_no_scan_and_no_study_output(make_run):
+
+    def drop_scans(config):
+        config["run_scans"] = []
+
+    run = make_run(edit=drop_scans)
+    assert run.scenes.scan_outputs(run.materials) == []
+    assert run.study.outputs(run.materials) == []
+    assert run.study.k_bests(run.materials) == {}
+    assert not any("B13" in path for path in run.study.overview_outputs())
+
+
+def test_the_study_figures_of_a_sphere_follow_its_scans_and_scenes(small):
+    sphere = next(iter(small.spheres))
+    material = small.spheres.material_of(sphere)
+    names = {
+        p.rsplit("/", 1)[1].split(".")[0] for p in small.study.sphere_figures(material, sphere)
+    }
+    expected = {"B8_scans", "B12_models", "B9_flattening"}
+    if small.scenes.first("elastic", "microscope") and small.scenes.first("greenwood_tripp"):
+        expected.add("B11_load_series")
+    assert names == expected
+
+
+def test_a_material_target_holds_lifetime_only_where_a_flim_map_exists(small):
+    targets = small.targets.material(small.materials)
+    for sphere in small.spheres:
+        lifetime = small.paths.measured("lifetime.json", small.spheres.material_of(sphere), sphere)
+        assert (lifetime in targets) == small.spheres.has_flim(sphere)
+    assert len(targets) == len(set(targets))
+
+
+def test_a_measurement_of_a_sphere_under_another_material_is_refused(small):
+    sphere = next(iter(small.spheres))
+    others = [m for m in small.materials if m != small.spheres.material_of(sphere)]
+    with pytest.raises(ValueError, match=f"sphere '{sphere}' is"):
+        small.targets.measured(others[0], sphere, "psf.json")
