@@ -14,20 +14,18 @@ log = logging.getLogger(__name__)
 
 def main(
     measured_fits: list[str],
-    scene_fits: list[str],
+    layout: dict[str, dict[str, str]],
     table_path: str,
-    spheres: list[str],
-    scenes: list[str],
     models: dict,
 ) -> None:
+    """``layout``: sphere → scene → its fit, for the spheres whose data run a scene;
+    ``measured_fits``: those spheres' measured load-area fits, in the same order."""
     rows = []
-    per_sphere = len(scenes)
-    for index, sphere in enumerate(spheres):
-        fits = scene_fits[index * per_sphere : (index + 1) * per_sphere]
+    for sphere, measured in zip(layout, measured_fits, strict=True):
         rows += scene_table_rows(
             sphere,
-            read_json(measured_fits[index]),
-            {scene: read_json(path) for scene, path in zip(scenes, fits, strict=True)},
+            read_json(measured),
+            {scene: read_json(path) for scene, path in layout[sphere].items()},
             models,
         )
     table = pd.DataFrame(rows)
@@ -41,9 +39,7 @@ if __name__ == "__main__":
         main,
         sm.log[0],
         measured_fits=list(sm.input.measured),
-        scene_fits=list(sm.input.scenes),
+        layout=sm.params.layout,
         table_path=sm.output.table,
-        spheres=sm.params.spheres,
-        scenes=sm.params.scenes,
         models=sm.params.models,
     )

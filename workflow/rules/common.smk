@@ -4,6 +4,8 @@
 import os
 from functools import partial
 
+from snakemake.logging import logger
+
 from amontons.workflow.params import (
     afm_reading,
     config_slice as _config_slice,
@@ -36,7 +38,7 @@ from amontons.workflow.paths import (
 )
 from amontons.workflow.resources import scan_solve
 from amontons.workflow.run import WorkflowRun
-from amontons.workflow.spheres import names_pattern
+from amontons.workflow.spheres import RHEOMETER, names_pattern
 
 CONFIG_SOURCE = ", ".join(
     str(f) for f in (workflow.overwrite_configfiles or ["config/config.yaml"])
@@ -45,6 +47,9 @@ RUN = WorkflowRun.from_config(
     config, os.path.join(workflow.basedir, "workflow"), CONFIG_SOURCE
 )
 MATERIALS = RUN.materials
+# A sphere's missing optional file removes only what needs it: say so before any job.
+for _line in RUN.left_out():
+    logger.warning(_line)
 
 # Folders of the run (amontons.workflow.paths): patterns with their wildcards.
 PATHS = RUN.paths

@@ -25,8 +25,8 @@ rule measure_friction:
 
 rule plot_amontons_deviation:
     input:
-        areas=lambda wc: per_sphere(wc.material, CONTACT_AREA),
-        friction=lambda wc: per_sphere(wc.material, FRICTION),
+        areas=lambda wc: TARGETS.per_sphere(wc.material, CONTACT_AREA, having=RHEOMETER),
+        friction=lambda wc: TARGETS.per_sphere(wc.material, FRICTION, having=RHEOMETER),
     output:
         table=report(
             f"{MATERIAL}/amontons.csv",
@@ -52,7 +52,7 @@ rule plot_amontons_deviation:
         mem_mb=measured_mem_mb("plot_amontons_deviation"),
         runtime=measured_runtime("plot_amontons_deviation"),
     params:
-        spheres=lambda wc: spheres_of(wc.material),
+        spheres=lambda wc: TARGETS.friction_spheres(wc.material),
         data_label=lambda wc: data_label(spheres_of(wc.material)),
         reference_load_mn=config["load_area"]["reference_load_mn"],
     script:

@@ -35,7 +35,7 @@ rule measure_contact_area:
 
 rule measure_psf:
     input:
-        bead=lambda wc: raw_file(wc.sphere, "bead.tif"),
+        bead=lambda wc: SPHERES.bead_image(wc.sphere),
     output:
         psf=f"{MEASURED}/{PSF}",
         png=report(
@@ -49,6 +49,8 @@ rule measure_psf:
         f"{SPHERE_LOGS}/measure_psf.log",
     benchmark:
         f"{SPHERE_LOGS}/measure_psf.benchmark.tsv"
+    wildcard_constraints:
+        sphere=SPHERES.psf_pattern("bead"),
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -57,15 +59,45 @@ rule measure_psf:
         runtime=measured_runtime("measure_psf"),
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        psf=config_slice("optics", "psf"),
+        # the bead's fit only: a changed stand-in re-runs no measured PSF
+        psf=sorted_keys(
+            {
+                key: config["optics"]["psf"][key]
+                for key in ("profile_radius_nm", "centroid_radius_nm")
+            }
+        ),
         data_label=lambda wc: data_label([wc.sphere]),
     script:
         "../../scripts/measure_psf.py"
 
 
+# A sphere without a bead image takes the config's PSF (optics.psf.stand_in), recorded as such.
+rule stand_in_psf:
+    output:
+        psf=f"{MEASURED}/{PSF}",
+    log:
+        f"{SPHERE_LOGS}/stand_in_psf.log",
+    benchmark:
+        f"{SPHERE_LOGS}/stand_in_psf.benchmark.tsv"
+    wildcard_constraints:
+        sphere=SPHERES.psf_pattern("stand_in"),
+    localrule: True
+    conda:
+        "../envs/amontons.yaml"
+    threads: 1
+    resources:
+        mem_mb=measured_mem_mb("stand_in_psf"),
+        runtime=measured_runtime("stand_in_psf"),
+    params:
+        stand_in=config["optics"]["psf"].get("stand_in"),
+        looked_for=lambda wc: SPHERES.missing(wc.sphere)["bead"],
+    script:
+        "../../scripts/stand_in_psf.py"
+
+
 rule measure_grafting_density:
     input:
-        absorbance=lambda wc: raw_file(wc.sphere, "absorbance.csv"),
+        absorbance=lambda wc: SPHERES.absorbance_spectrum(wc.sphere),
     output:
         density=f"{MEASURED}/grafting_density.json",
         png=report(

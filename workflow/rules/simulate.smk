@@ -211,8 +211,11 @@ rule fit_synthetic_scene:
 
 rule tabulate_scenes:
     input:
-        measured=lambda wc: per_sphere(wc.material, LOAD_AREA_FIT),
-        scenes=lambda wc: RUN.scenes.table_inputs(wc.material),
+        measured=lambda wc: [
+            PATHS.measured(LOAD_AREA_FIT, wc.material, sphere)
+            for sphere in RUN.scenes.table_layout(wc.material)
+        ],
+        scenes=lambda wc: flat_files(RUN.scenes.table_layout(wc.material)),
     output:
         table=report(
             f"{MATERIAL}/scenes.csv",
@@ -231,8 +234,7 @@ rule tabulate_scenes:
         mem_mb=measured_mem_mb("tabulate_scenes"),
         runtime=measured_runtime("tabulate_scenes"),
     params:
-        spheres=lambda wc: spheres_of(wc.material),
-        scenes=scene_names(surface="afm_before"),
+        layout=lambda wc: RUN.scenes.table_layout(wc.material),
         models=RUN.scenes.models(),
     script:
         "../../scripts/tabulate_scenes.py"

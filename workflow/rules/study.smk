@@ -86,7 +86,7 @@ rule tabulate_models:
         runtime=measured_runtime("tabulate_models"),
     params:
         layout=lambda wc: RUN.study.model_table_layout(wc.material),
-        spheres=lambda wc: spheres_of(wc.material),
+        spheres=lambda wc: RUN.study.scanned(wc.material),
         models=RUN.scenes.models(),
         data_label=lambda wc: data_label(spheres_of(wc.material)),
     script:
@@ -262,7 +262,10 @@ rule plot_curvature_study:
 
 rule plot_amontons_study:
     input:
-        amontons=expand(rules.plot_amontons_deviation.output.table, material=MATERIALS),
+        amontons=expand(
+            rules.plot_amontons_deviation.output.table,
+            material=SPHERES.materials_with(MATERIALS, RHEOMETER),
+        ),
         bests=list(RUN.study.k_bests(MATERIALS).values()),
     output:
         table=f"{STUDY_RESULTS}/B13_amontons.csv",

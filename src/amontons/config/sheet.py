@@ -6,6 +6,7 @@ its DAG."""
 from __future__ import annotations
 
 import csv
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -165,3 +166,20 @@ def check_selected_materials(selected: Sequence[str], sheet: Mapping[str, dict],
             f"workflow target; rename them in the sample sheet (reserved: "
             f"{', '.join(sorted(RESERVED_NAMES))})"
         )
+
+
+# Sheet columns that name a raw file shared by many spheres (config/README.md).
+SHARED_FILE_COLUMNS = ("bead_file", "absorbance_file")
+
+
+def check_shared_files(sheet: Mapping[str, dict], source: str | Path) -> None:
+    """A shared file the sheet names must exist (a path from the project folder): a typo
+    stops the run here rather than quietly leaving the spheres without it."""
+    for sphere, record in sheet.items():
+        for column in SHARED_FILE_COLUMNS:
+            path = record.get(column)
+            if path is not None and not os.path.isfile(path):
+                raise ConfigError(
+                    f"{source}, sphere {sphere}: {column} = {path!r} is not a file; expected "
+                    f"the path of a file shared by several spheres, from the project folder"
+                )

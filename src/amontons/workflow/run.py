@@ -19,6 +19,7 @@ from amontons.config.schema import load_schema, validate
 from amontons.config.sheet import (
     check_reference_load,
     check_selected_materials,
+    check_shared_files,
     read_sample_sheet,
 )
 from amontons.workflow.accuracy import AccuracyStudy
@@ -41,6 +42,7 @@ def load_workflow_config(
     resolve_scene_presets(config, source)
     sheet = read_sample_sheet(config["materials_sheet"], sheet_schema)
     check_selected_materials(config["materials"], sheet, source)
+    check_shared_files(sheet, config["materials_sheet"])
     selected = {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
     check_reference_load(config["load_area"]["reference_load_mn"], selected, source)
     check_scenes(config, selected, source)
@@ -67,6 +69,14 @@ class WorkflowRun:
     def materials(self) -> list[str]:
         return list(self.config["materials"])
 
+    def left_out(self) -> list[str]:
+        """Per sphere, what its data do not allow and why (amontons.workflow.spheres)."""
+        return [
+            f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
+            for sphere in self.spheres
+            for line in self.spheres.left_out(sphere)
+        ]
+
     @classmethod
     def from_config(cls, config: Mapping, workflow_dir: str | Path, source: str) -> WorkflowRun:
         """Check ``config`` (resolved in place) against the schemas in
@@ -80,7 +90,9 @@ class WorkflowRun:
             source,
         )
         paths = RunPaths(config["run"])
-        spheres = Spheres(records, paths)
+        spheres = Spheres(
+            records, paths, psf_stand_in=config["optics"]["psf"].get("stand_in") is not None
+        )
         scenes = Scenes(config, spheres, paths)
         study = Study(config, spheres, scenes, paths)
         return cls(

@@ -64,6 +64,20 @@ class Scenes:
         names = self.names(surface="afm_before", model=model, optics=optics)
         return names[0] if names else None
 
+    def runnable(self, sphere: str) -> list[str]:
+        """The AFM scenes a sphere's data allow: its map before the loads for each, and a PSF
+        for those rendered like the microscope."""
+        return [
+            scene
+            for scene in self.afm_scenes()
+            if self.spheres.can_simulate(sphere)
+            and (not self.has_optics(scene) or self.spheres.can_render(sphere))
+        ]
+
+    def runnable_scans(self, sphere: str) -> list[str]:
+        """The scans a sphere's data allow: each registers on a microscope scene."""
+        return list(self.scans) if self.spheres.can_render(sphere) else []
+
     def sphere_scene_outputs(self, material: str, sphere: str, scene: str) -> list[str]:
         """What a scene of one sphere delivers: its fit and, with optics, its comparison."""
         out = [self.paths.scene(files.SCENE_FIT, material, sphere, scene)]
@@ -78,9 +92,9 @@ class Scenes:
         out = []
         for material in materials:
             for sphere in self.spheres.of(material):
-                for scene in self.afm_scenes():
+                for scene in self.runnable(sphere):
                     out += self.sphere_scene_outputs(material, sphere, scene)
-            if self.afm_scenes():
+            if self.table_layout(material):
                 out.append(f"{self.paths.material(material)}/scenes.csv")
         return out
 
@@ -97,13 +111,17 @@ class Scenes:
             inputs["render"] = self.paths.scene(files.RENDER_TABLE, *where)
         return inputs
 
-    def table_inputs(self, material: str) -> list[str]:
-        """Every AFM scene's fit of every sphere of ``material`` (the scene table)."""
-        return [
-            self.paths.scene(files.SCENE_FIT, material, sphere, scene)
+    def table_layout(self, material: str) -> dict[str, dict[str, str]]:
+        """The scene table's inputs: each AFM scene's fit of each sphere of ``material`` that
+        runs it (sphere → scene → path)."""
+        layout = {
+            sphere: {
+                scene: self.paths.scene(files.SCENE_FIT, material, sphere, scene)
+                for scene in self.runnable(sphere)
+            }
             for sphere in self.spheres.of(material)
-            for scene in self.afm_scenes()
-        ]
+        }
+        return {sphere: fits for sphere, fits in layout.items() if fits}
 
     # scans
 
@@ -138,7 +156,7 @@ class Scenes:
             self.paths.scan(name, material, sphere, scan)
             for material in materials
             for sphere in self.spheres.of(material)
-            for scan in self.scans
+            for scan in self.runnable_scans(sphere)
             for name in (files.SCAN_TABLE, files.BEST)
         ]
 

@@ -13,8 +13,11 @@ import re
 from collections.abc import Mapping
 
 from amontons.io.layout import (
+    ABSORBANCE_NAME,
     AFM_SUFFIXES,
+    BEAD_NAME,
     FLUORESCENCE_DIR,
+    REFLECTION_NAME,
     RHEOMETER_DIR,
     afm_file,
     fluorescence_images,
@@ -24,15 +27,46 @@ from amontons.workflow.paths import RunPaths
 
 # The sheet values a scene takes from its sphere.
 SCENE_COLUMNS = ("diameter_mm", "e_star_gpa", "loads", "hardness_mpa", "hardening_k_mpa_per_nm")
+# A sphere's optional raw inputs (config/README.md, "Required and optional files"): without one,
+# exactly the outputs that read it, and what follows from them, are not made.
+REFLECTION, BEAD, ABSORBANCE, AFM_BEFORE, AFM_AFTER, RHEOMETER = (
+    "reflection",
+    "bead",
+    "absorbance",
+    "afm_before",
+    "afm_after",
+    "rheometer",
+)
+# What each optional input adds, and so what a sphere without it does not get.
+OPTIONAL_INPUTS = {
+    REFLECTION: "the gap at the contact edge (edge_gap.json, .png, .pdf)",
+    BEAD: "the measured PSF (psf.json, .png, .pdf) that renders its scenes and scans like "
+    "the microscope",
+    ABSORBANCE: "the grafting density (grafting_density.json, absorbance.png, .pdf)",
+    AFM_BEFORE: "the topography, every scene and scan, the study's figures and the model table",
+    AFM_AFTER: "the topography (topography.json, .png, .pdf) and the flattening (Fig. B.9)",
+    RHEOMETER: "the friction (friction.csv) and its place in the Amontons figures",
+}
+NO_PSF = (
+    "no PSF either (optics.psf.stand_in is null): no microscope scene, no scan, no study "
+    "figure and no model-table row"
+)
+STAND_IN_PSF = "the PSF is optics.psf.stand_in's (psf.json says so); no bead profile figure"
+# Sheet columns that name a file shared by many spheres, in place of the sphere's own.
+SHARED_FILE_COLUMNS = {BEAD: "bead_file", ABSORBANCE: "absorbance_file"}
 
 
 class Spheres:
     """The sheet records (sphere id → record, amontons.config.sheet) of the selected
     materials, in the sheet's order, with the run's paths."""
 
-    def __init__(self, records: Mapping[str, dict], paths: RunPaths):
+    def __init__(self, records: Mapping[str, dict], paths: RunPaths, psf_stand_in: bool = False):
+        """``psf_stand_in``: whether the config gives a PSF (optics.psf.stand_in) for the
+        spheres with no bead image."""
         self.records = dict(records)
         self.paths = paths
+        self.psf_stand_in = psf_stand_in
+        self._missing: dict[str, dict[str, str]] = {}
 
     def __iter__(self):
         return iter(self.records)
@@ -40,9 +74,19 @@ class Spheres:
     def row(self, sphere: str) -> dict:
         return self.records[sphere]
 
-    def of(self, material: str) -> list[str]:
-        """The spheres of ``material``, in sheet order."""
-        return [s for s, row in self.records.items() if row["material"] == material]
+    def of(self, material: str, having: str | None = None) -> list[str]:
+        """The spheres of ``material``, in sheet order; only those with the optional input
+        ``having`` where it is given."""
+        return [
+            s
+            for s, row in self.records.items()
+            if row["material"] == material and (having is None or self.has(s, having))
+        ]
+
+    def materials_with(self, materials, kind: str) -> list[str]:
+        """Those of ``materials`` with at least one sphere that has the optional input
+        ``kind``."""
+        return [m for m in materials if self.of(m, having=kind)]
 
     def material_of(self, sphere: str) -> str:
         return self.records[sphere]["material"]
@@ -106,6 +150,81 @@ class Spheres:
         if self.is_synthetic(sphere) or not present:
             return self.raw_file(sphere, f"{stem}.tif")
         return str(afm_file(folder, stem))
+
+    def bead_image(self, sphere: str) -> str:
+        """The bead image a sphere's PSF is measured from: the sheet's bead_file (shared by
+        many spheres) or the sphere's own bead.tif."""
+        return self.records[sphere].get("bead_file") or self.raw_file(sphere, BEAD_NAME)
+
+    def absorbance_spectrum(self, sphere: str) -> str:
+        """The absorbance spectrum of a sphere's cover slip: the sheet's absorbance_file
+        (shared by the slips of one batch) or the sphere's own absorbance.csv."""
+        shared = self.records[sphere].get("absorbance_file")
+        return shared or self.raw_file(sphere, ABSORBANCE_NAME)
+
+    def missing(self, sphere: str) -> dict[str, str]:
+        """The optional inputs a sphere lacks (:data:`OPTIONAL_INPUTS`), each with what was
+        looked for. The virtual experiment writes every one; a measured sphere's folder is
+        looked at once, when the DAG is built."""
+        if sphere not in self._missing:
+            self._missing[sphere] = {} if self.is_synthetic(sphere) else self._look(sphere)
+        return self._missing[sphere]
+
+    def _look(self, sphere: str) -> dict[str, str]:
+        folder = self.raw_dir(sphere)
+        missing = {}
+        if not os.path.isfile(self.raw_file(sphere, REFLECTION_NAME)):
+            missing[REFLECTION] = f"no {REFLECTION_NAME} in {folder}"
+        elif self.value(sphere, "reflection_load_mn") is None:
+            missing[REFLECTION] = "no reflection_load_mn in the sheet"
+        if not os.path.isfile(self.bead_image(sphere)):
+            missing[BEAD] = f"no {self.bead_image(sphere)}"
+        if not os.path.isfile(self.absorbance_spectrum(sphere)):
+            missing[ABSORBANCE] = f"no {self.absorbance_spectrum(sphere)}"
+        for stem in (AFM_BEFORE, AFM_AFTER):
+            if not any(os.path.isfile(f"{folder}/{stem}{ext}") for ext in AFM_SUFFIXES):
+                missing[stem] = f"no {stem}.* in {folder}"
+        if not os.path.isdir(f"{folder}/{RHEOMETER_DIR}"):
+            missing[RHEOMETER] = f"no {RHEOMETER_DIR}/ folder in {folder}"
+        return missing
+
+    def left_out(self, sphere: str) -> list[str]:
+        """What a sphere's data do not allow, one line per optional input it lacks: what was
+        looked for and what will not be made (a dry run prints these)."""
+        lines = []
+        for kind, why in self.missing(sphere).items():
+            line = f"{why}: {OPTIONAL_INPUTS[kind]} will not be made"
+            if kind == BEAD:
+                line += f"; {NO_PSF if self.psf_source(sphere) is None else STAND_IN_PSF}"
+            lines.append(line)
+        return lines
+
+    def has(self, sphere: str, kind: str) -> bool:
+        """Whether a sphere has the optional input ``kind``."""
+        return kind not in self.missing(sphere)
+
+    def psf_source(self, sphere: str) -> str | None:
+        """Where a sphere's PSF comes from: 'bead' (its image), 'stand_in' (the config's FWHM)
+        or None (neither: nothing of it is rendered like the microscope)."""
+        if self.has(sphere, BEAD):
+            return "bead"
+        return "stand_in" if self.psf_stand_in else None
+
+    def can_simulate(self, sphere: str) -> bool:
+        """A sphere's scenes need its AFM map before the loads."""
+        return self.has(sphere, AFM_BEFORE)
+
+    def can_render(self, sphere: str) -> bool:
+        """A sphere's microscope scenes and scans need its AFM map and a PSF."""
+        return self.can_simulate(sphere) and self.psf_source(sphere) is not None
+
+    def with_input(self, kind: str) -> list[str]:
+        """The spheres that have the optional input ``kind``."""
+        return [s for s in self.records if self.has(s, kind)]
+
+    def psf_pattern(self, source: str) -> str:
+        """Regex matching the spheres whose PSF comes from ``source`` ('bead', 'stand_in')."""
+        return names_pattern([s for s in self.records if self.psf_source(s) == source])
 
     def has_flim(self, sphere: str) -> bool:
         """Synthetic spheres get a FLIM map where the sheet gives flim_load_mn; measured

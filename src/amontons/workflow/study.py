@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from amontons.workflow import paths as files
 from amontons.workflow.paths import RunPaths, figure_files
 from amontons.workflow.scenes import Scenes
-from amontons.workflow.spheres import Spheres
+from amontons.workflow.spheres import AFM_AFTER, RHEOMETER, Spheres
 
 K = "k_mpa_per_nm"
 
@@ -22,6 +22,7 @@ class Study:
         self.curvature_pairs = {
             name: study["curvature_pairs"][name] for name in study["run_curvature_pairs"]
         }
+        self.materials = list(config["materials"])
         self.spheres = spheres
         self.scenes = scenes
         self.paths = paths
@@ -72,7 +73,7 @@ class Study:
         where = (wildcards.material, wildcards.sphere)
         scenes = {
             scene: self._scene_files(*where, scene, with_fit=False)
-            for scene in self.scenes.afm_scenes()
+            for scene in self.scenes.runnable(wildcards.sphere)
         }
         return {"scenes": scenes, "scans": self._best_values(*where)}
 
@@ -83,12 +84,16 @@ class Study:
                 "measured": self.paths.measured(files.LOAD_AREA_FIT, material, sphere),
                 "scenes": {
                     scene: self._scene_files(material, sphere, scene, with_fit=True)
-                    for scene in self.scenes.afm_scenes()
+                    for scene in self.scenes.runnable(sphere)
                 },
                 "scans": self._best_values(material, sphere),
             }
-            for sphere in self.spheres.of(material)
+            for sphere in self.scanned(material)
         }
+
+    def scanned(self, material: str) -> list[str]:
+        """The spheres of ``material`` whose scans run (the model table's rows)."""
+        return [s for s in self.spheres.of(material) if self.scenes.runnable_scans(s)]
 
     def curvature_files(self, name: str) -> dict[str, str]:
         """File ``name`` of every scene of the running curvature pairs (Fig. B.10)."""
@@ -106,16 +111,17 @@ class Study:
         return {
             sphere: self.paths.scan(files.BEST, material, sphere, scan)
             for material in materials
-            for sphere in self.spheres.of(material)
+            for sphere in self.scanned(material)
         }
 
     def sphere_figures(self, material: str, sphere: str) -> list[str]:
         """The study's figures of one sphere that its scans and scenes allow."""
         names = []
-        if self.scenes.scans:
+        if self.scenes.runnable_scans(sphere):
             names += ["B8_scans", "B12_models"]
-        if self.scenes.scans_of(K):
-            names.append("B9_flattening")
+        if self.scenes.scans_of(K) and self.scenes.runnable_scans(sphere):
+            if self.spheres.has(sphere, AFM_AFTER):
+                names.append("B9_flattening")
             if self.scenes.first("elastic", "microscope") and self.scenes.first("greenwood_tripp"):
                 names.append("B11_load_series")
         folder = self.paths.study(material, sphere)
@@ -125,10 +131,10 @@ class Study:
         """The study's outputs of ``materials``: per-sphere figures and each material's model
         table (with scans)."""
         out = []
-        if self.scenes.scans:
-            for material in materials:
-                for sphere in self.spheres.of(material):
-                    out += self.sphere_figures(material, sphere)
+        for material in materials:
+            for sphere in self.spheres.of(material):
+                out += self.sphere_figures(material, sphere)
+            if self.scanned(material):
                 out.append(f"{self.paths.material(material)}/models.csv")
         return out
 
@@ -136,7 +142,7 @@ class Study:
         """The study's figures across materials: Fig. B.13 (with scans) and Fig. B.10 (with
         curvature pairs); built by `all` and `study`, not by a material's target."""
         out = []
-        if self.scenes.scans:
+        if self.scenes.scans and self.spheres.materials_with(self.materials, RHEOMETER):
             out += figure_files(self.paths.study_results, "B13_amontons")
         if self.curvature_pairs:
             out += figure_files(self.paths.study_results, "B10_curvature")

@@ -7,29 +7,37 @@ from __future__ import annotations
 from amontons.workflow import paths as files
 from amontons.workflow.paths import RunPaths, figure_files
 from amontons.workflow.scenes import Scenes
-from amontons.workflow.spheres import Spheres
+from amontons.workflow.spheres import (
+    ABSORBANCE,
+    AFM_AFTER,
+    AFM_BEFORE,
+    BEAD,
+    REFLECTION,
+    RHEOMETER,
+    Spheres,
+)
 from amontons.workflow.study import Study
 
-# Per-sphere results of each stage; lifetime only where a FLIM map exists.
-OPTICS_RESULTS = (
-    files.CONTACT_AREA,
-    "contact_area.png",
-    "contact_area.pdf",
-    files.PSF,
-    "psf.png",
-    "psf.pdf",
-    "grafting_density.json",
-    "absorbance.png",
-    "absorbance.pdf",
-    "edge_gap.json",
-    "edge_gap.png",
-    "edge_gap.pdf",
-    "intensity_pressure.csv",
-    "intensity_pressure_fit.json",
-    "intensity_pressure.png",
-    "intensity_pressure.pdf",
-    "hertz_check.csv",
-)
+# Per-sphere results of each stage, by the optional input each needs (None: only the
+# fluorescence images, which every sphere has; PSF: a PSF, measured or the config's stand-in);
+# lifetime only where a FLIM map exists.
+PSF_NEEDED = "psf"
+OPTICS_RESULTS = {
+    None: (
+        files.CONTACT_AREA,
+        "contact_area.png",
+        "contact_area.pdf",
+        "intensity_pressure.csv",
+        "intensity_pressure_fit.json",
+        "intensity_pressure.png",
+        "intensity_pressure.pdf",
+        "hertz_check.csv",
+    ),
+    PSF_NEEDED: (files.PSF,),
+    BEAD: ("psf.png", "psf.pdf"),
+    ABSORBANCE: ("grafting_density.json", "absorbance.png", "absorbance.pdf"),
+    REFLECTION: ("edge_gap.json", "edge_gap.png", "edge_gap.pdf"),
+}
 FRICTION_RESULTS = (files.FRICTION,)
 SURFACE_RESULTS = ("topography.json", "topography.png", "topography.pdf")
 FIT_RESULTS = (files.LOAD_AREA_FIT,)
@@ -52,13 +60,19 @@ class Targets:
             )
         return self.paths.measured(name, material, sphere)
 
-    def per_sphere(self, material: str, name: str) -> list[str]:
-        """One measurement file per sphere of ``material``."""
-        return [self.measured(material, s, name) for s in self.spheres.of(material)]
+    def per_sphere(self, material: str, name: str, having: str | None = None) -> list[str]:
+        """One measurement file per sphere of ``material`` (with the optional input
+        ``having``, where it is given)."""
+        return [self.measured(material, s, name) for s in self.spheres.of(material, having)]
 
-    def sphere_outputs(self, materials, names) -> list[str]:
+    def sphere_outputs(self, materials, names, having: str | None = None) -> list[str]:
+        """Results ``names`` of every sphere of ``materials`` (with the optional input
+        ``having``, where it is given)."""
         return [
-            self.measured(m, s, n) for m in materials for s in self.spheres.of(m) for n in names
+            self.measured(m, s, n)
+            for m in materials
+            for s in self.spheres.of(m, having)
+            for n in names
         ]
 
     def material_figures(self, materials, names) -> list[str]:
@@ -74,29 +88,49 @@ class Targets:
         """Every optical measurement of every sphere of ``materials``."""
         out = []
         for material in materials:
-            out += self.sphere_outputs([material], OPTICS_RESULTS)
-            out += [
-                self.measured(material, s, files.LIFETIME)
-                for s in self.spheres.of(material)
-                if self.spheres.has_flim(s)
-            ]
+            for sphere in self.spheres.of(material):
+                for needs, names in OPTICS_RESULTS.items():
+                    if self._has(sphere, needs):
+                        out += [self.measured(material, sphere, name) for name in names]
+                if self.spheres.has_flim(sphere):
+                    out.append(self.measured(material, sphere, files.LIFETIME))
         return out
+
+    def _has(self, sphere: str, needs: str | None) -> bool:
+        if needs is None:
+            return True
+        if needs == PSF_NEEDED:
+            return self.spheres.psf_source(sphere) is not None
+        return self.spheres.has(sphere, needs)
+
+    def friction_spheres(self, material: str) -> list[str]:
+        """The spheres of ``material`` whose friction was measured."""
+        return self.spheres.of(material, having=RHEOMETER)
 
     def friction(self, materials) -> list[str]:
         """Friction per sphere and the Amontons-deviation figure and table per material."""
-        return self.sphere_outputs(materials, FRICTION_RESULTS) + self.material_figures(
-            materials, ["amontons"]
-        )
+        return self.sphere_outputs(
+            materials, FRICTION_RESULTS, having=RHEOMETER
+        ) + self.material_figures(self.spheres.materials_with(materials, RHEOMETER), ["amontons"])
 
     def surface(self, materials) -> list[str]:
-        return self.sphere_outputs(materials, SURFACE_RESULTS)
+        """The topography of every sphere with both AFM maps."""
+        return [
+            self.measured(m, s, name)
+            for m in materials
+            for s in self.spheres.of(m, having=AFM_BEFORE)
+            if self.spheres.has(s, AFM_AFTER)
+            for name in SURFACE_RESULTS
+        ]
 
     def fits(self, materials) -> list[str]:
         return self.sphere_outputs(materials, FIT_RESULTS)
 
     def figures(self, materials) -> list[str]:
         """The per-material figures and tables: load-area and Amontons deviation."""
-        return self.material_figures(materials, ["load_area", "amontons"])
+        return self.material_figures(materials, ["load_area"]) + self.material_figures(
+            self.spheres.materials_with(materials, RHEOMETER), ["amontons"]
+        )
 
     def material(self, materials) -> list[str]:
         """Everything a material's target builds: every measurement, fit, figure and table."""
