@@ -81,7 +81,6 @@ rule stand_in_psf:
         f"{SPHERE_LOGS}/stand_in_psf.benchmark.tsv"
     wildcard_constraints:
         sphere=SPHERES.psf_pattern("stand_in"),
-    localrule: True
     conda:
         "../envs/amontons.yaml"
     threads: 1
