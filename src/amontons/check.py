@@ -1,0 +1,198 @@
+"""A data folder checked before a run (README, "Your own data"): per sphere, every raw file
+found with its format, shape and pixel size (from the file, else from the sheet), the loads
+matched, what the run will measure and simulate, and what it cannot, and why.
+
+    python -m amontons.check [--configfile config/mine.yaml ...] [--json]
+
+It reads the config as Snakemake does (config/config.yaml, then each ``--configfile`` merged
+over it), builds the same plan as the workflow (amontons.workflow) and opens each raw file
+once. It writes nothing. Its exit status is 1 where the run would stop before any job (a bad
+config, or fluorescence images that do not match the sheet's loads), else 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from amontons.config import ConfigError, read_config
+from amontons.io.absorbance import read_absorbance_csv
+from amontons.io.heightmap import read_heights
+from amontons.io.layout import AFM_SUFFIXES, FLIM_NAME, REFLECTION_NAME, RawDataError
+from amontons.io.rheometer import read_rheometer_csv
+from amontons.io.tiff import read_tiff
+from amontons.workflow.run import WorkflowRun
+from amontons.workflow.spheres import AFM_AFTER, AFM_BEFORE, RHEOMETER, Spheres
+
+# The workflow folder of a clone or an editable install (schemas, measured resources).
+WORKFLOW_DIR = Path(__file__).resolve().parents[2] / "workflow"
+
+
+def _tiff(path: str) -> dict:
+    image = read_tiff(path)
+    return {
+        "shape": list(image.data.shape),
+        "dtype": str(image.data.dtype),
+        "pixel_nm": None if image.pixel_x_m is None else image.pixel_x_m * 1e9,
+    }
+
+
+def _height_map(path: str) -> dict:
+    raw = read_heights(path)
+    return {
+        "shape": list(raw.heights.shape),
+        "pixel_nm": None if raw.pixel_x_m is None else raw.pixel_x_m * 1e9,
+    }
+
+
+def _rheometer(path: str) -> dict:
+    trace = read_rheometer_csv(path)
+    return {"rows": len(trace.time_s)}
+
+
+def _absorbance(path: str) -> dict:
+    wavelengths, _ = read_absorbance_csv(path)
+    return {"rows": len(wavelengths)}
+
+
+def describe_file(path: str, read: Callable[[str], dict], sheet_pixel_nm: float | None) -> dict:
+    """One raw file: its format (suffix), what ``read`` finds in it, and its pixel size with
+    where it comes from (the file, else the sheet); a file that cannot be read is reported
+    with the reader's error, which names the file."""
+    record = {"path": path, "format": Path(path).suffix.lstrip(".").lower() or "folder"}
+    try:
+        record.update(read(path))
+    except (ValueError, OSError) as error:
+        record["error"] = str(error)
+        return record
+    if "pixel_nm" in record:
+        if record["pixel_nm"] is None and sheet_pixel_nm is not None:
+            record.update(pixel_nm=sheet_pixel_nm, pixel_from="sheet")
+        elif record["pixel_nm"] is not None:
+            record["pixel_from"] = "file"
+    return record
+
+
+def _afm_file(spheres: Spheres, sphere: str, stem: str) -> str | None:
+    folder = spheres.raw_dir(sphere)
+    found = [
+        f"{folder}/{stem}{ext}" for ext in AFM_SUFFIXES if Path(f"{folder}/{stem}{ext}").is_file()
+    ]
+    return found[0] if found else None
+
+
+def sphere_files(spheres: Spheres, sphere: str) -> tuple[list[dict], list[str]]:
+    """Every raw file of a measured sphere that is there, described, and the errors that
+    would stop the run before any job."""
+    files, errors = [], []
+    fluorescence_pixel = spheres.value(sphere, "fluorescence_pixel_nm")
+    afm_pixel = spheres.value(sphere, "afm_pixel_nm")
+    try:
+        images = spheres.per_load_inputs(sphere, "fluorescence")
+    except RawDataError as error:
+        errors.append(str(error))
+        images = []
+    files += [describe_file(path, _tiff, fluorescence_pixel) for path in images]
+    if spheres.has(sphere, RHEOMETER):
+        try:
+            files += [
+                describe_file(path, _rheometer, None)
+                for path in spheres.per_load_inputs(sphere, "rheometer")
+            ]
+        except RawDataError as error:
+            files.append({"path": f"{spheres.raw_dir(sphere)}/rheometer", "error": str(error)})
+    singles = [
+        (spheres.raw_file(sphere, REFLECTION_NAME), _tiff, fluorescence_pixel),
+        (spheres.bead_image(sphere), _tiff, fluorescence_pixel),
+        (spheres.absorbance_spectrum(sphere), _absorbance, None),
+        (spheres.raw_file(sphere, FLIM_NAME), _tiff, fluorescence_pixel),
+    ]
+    files += [describe_file(p, read, pixel) for p, read, pixel in singles if Path(p).is_file()]
+    for stem in (AFM_BEFORE, AFM_AFTER):
+        path = _afm_file(spheres, sphere, stem)
+        if path is not None:
+            files.append(describe_file(path, _height_map, afm_pixel))
+    return files, errors
+
+
+def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
+    """What the run makes of one sphere and what it cannot, and why."""
+    material = run.spheres.material_of(sphere)
+    folder = f"{run.paths.results}/{material}/{sphere}/"
+    outputs = [p for p in run.targets.material([material]) if p.startswith(folder)]
+    record = {
+        "sphere": sphere,
+        "material": material,
+        "data": "virtual experiment" if run.spheres.is_synthetic(sphere) else "measured",
+        "folder": run.spheres.raw_dir(sphere),
+        "loads_mn": run.spheres.loads_mn(sphere),
+        "outputs": outputs,
+        "left_out": run.spheres.left_out(sphere),
+        "files": [],
+        "errors": [],
+    }
+    if not run.spheres.is_synthetic(sphere):
+        record["files"], record["errors"] = sphere_files(run.spheres, sphere)
+    return record
+
+
+def check(configfiles: list[str], workflow_dir: Path = WORKFLOW_DIR) -> list[dict]:
+    """Every selected sphere's plan (:func:`sphere_plan`), from the config in the working
+    directory (config/config.yaml with ``configfiles`` merged over it)."""
+    base = "config/config.yaml"
+    config = read_config(base, *configfiles)
+    run = WorkflowRun.from_config(config, workflow_dir, ", ".join([base, *configfiles]))
+    return [sphere_plan(run, sphere) for sphere in run.spheres]
+
+
+def _file_line(record: dict) -> str:
+    if "error" in record:
+        return f"    {record['path']}: UNREADABLE: {record['error']}"
+    details = []
+    if "shape" in record:
+        details.append("×".join(map(str, record["shape"])) + " px")
+    if record.get("pixel_nm") is not None:
+        details.append(f"pixel {record['pixel_nm']:.4g} nm ({record['pixel_from']})")
+    elif "pixel_nm" in record:
+        details.append("NO PIXEL SIZE (neither the file nor the sheet gives one)")
+    if "rows" in record:
+        details.append(f"{record['rows']} rows")
+    return f"    {record['path']} [{record['format']}]: {', '.join(details)}"
+
+
+def report(plans: list[dict]) -> str:
+    """The plans as text, a block per sphere."""
+    lines = []
+    for plan in plans:
+        lines.append(f"{plan['sphere']} ({plan['material']}, {plan['data']}): {plan['folder']}")
+        lines.append(f"  loads (mN): {', '.join(f'{f:g}' for f in plan['loads_mn'])}")
+        if plan["files"]:
+            lines.append("  files:")
+            lines += [_file_line(record) for record in plan["files"]]
+        lines += [f"  STOPS THE RUN: {error}" for error in plan["errors"]]
+        lines.append(f"  will make {len(plan['outputs'])} files:")
+        lines += [f"    {path}" for path in plan["outputs"]]
+        lines += [f"  will not make: {line}" for line in plan["left_out"]]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--configfile", action="append", default=[], help="config overlay(s)")
+    parser.add_argument("--workflow-dir", type=Path, default=WORKFLOW_DIR)
+    parser.add_argument("--json", action="store_true", help="print the plans as JSON")
+    args = parser.parse_args(argv)
+    try:
+        plans = check(args.configfile, args.workflow_dir)
+    except (ConfigError, RawDataError) as error:
+        print(f"the run would stop before any job: {error}", file=sys.stderr)
+        return 1
+    print(json.dumps(plans, indent=1) if args.json else report(plans))
+    return 1 if any(plan["errors"] for plan in plans) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
