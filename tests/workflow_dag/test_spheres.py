@@ -3,7 +3,16 @@
 import pytest
 
 from amontons.workflow.paths import RunPaths
-from amontons.workflow.spheres import Spheres, names_pattern
+from amontons.workflow.spheres import (
+    ABSORBANCE,
+    AFM_AFTER,
+    AFM_BEFORE,
+    BEAD,
+    REFLECTION,
+    RHEOMETER,
+    Spheres,
+    names_pattern,
+)
 
 RECORD = {
     "material": "PS",
@@ -70,3 +79,66 @@ def test_data_label_says_synthetic_if_any_sphere_is(tmp_path):
 @pytest.mark.parametrize(("names", "matches"), [(["a.b", "c"], "a.b|c"), ([], "(?!)")])
 def test_names_pattern_escapes_and_never_matches_empty(names, matches):
     assert names_pattern(names) == matches.replace(".", r"\.")
+
+
+def _complete_folder(tmp_path) -> dict[str, str]:
+    """Every optional file of a measured sphere's folder, as relative path -> text."""
+    files = {f"fluorescence/{load}mN.tif": "" for load in (10, 20, 40)}
+    files.update({f"rheometer/{load}.csv": "" for load in (10, 20, 40)})
+    for name in ("reflection.tif", "bead.tif", "absorbance.csv", "afm_before.tif", "afm_after.npy"):
+        files[name] = ""
+    return files
+
+
+@pytest.mark.parametrize(
+    ("remove", "kind"),
+    [
+        ("reflection.tif", REFLECTION),
+        ("bead.tif", BEAD),
+        ("absorbance.csv", ABSORBANCE),
+        ("afm_before.tif", AFM_BEFORE),
+        ("afm_after.npy", AFM_AFTER),
+    ],
+)
+def test_a_missing_optional_file_is_found_and_named(tmp_path, remove, kind):
+    files = _complete_folder(tmp_path)
+    del files[remove]
+    spheres, folder = _spheres(tmp_path, **files)
+    assert list(spheres.missing("lab")) == [kind]
+    assert remove.split(".")[0] in spheres.missing("lab")[kind]
+    assert spheres.missing("syn") == {}  # the virtual experiment writes every file
+    (line,) = spheres.left_out("lab")
+    assert "will not be made" in line
+
+
+def test_a_sphere_without_rheometer_folder_has_no_friction(tmp_path):
+    files = {k: v for k, v in _complete_folder(tmp_path).items() if not k.startswith("rheometer")}
+    spheres, _ = _spheres(tmp_path, **files)
+    assert list(spheres.missing("lab")) == [RHEOMETER]
+    assert spheres.of("PS", having=RHEOMETER) == ["syn"]
+    assert spheres.materials_with(["PS"], RHEOMETER) == ["PS"]
+
+
+def test_a_shared_bead_image_stands_for_the_spheres_own(tmp_path):
+    files = _complete_folder(tmp_path)
+    del files["bead.tif"]
+    spheres, folder = _spheres(tmp_path, **files)
+    shared = tmp_path / "shared_bead.tif"
+    shared.write_text("")
+    spheres.records["lab"]["bead_file"] = str(shared)
+    spheres._missing.clear()
+    assert spheres.bead_image("lab") == str(shared)
+    assert spheres.missing("lab") == {}
+
+
+def test_without_a_bead_the_psf_is_the_stand_in_or_none(tmp_path):
+    files = _complete_folder(tmp_path)
+    del files["bead.tif"]
+    spheres, _ = _spheres(tmp_path, **files)
+    assert spheres.psf_source("lab") is None and not spheres.can_render("lab")
+    assert spheres.can_simulate("lab")
+    assert "no microscope scene" in spheres.left_out("lab")[0]
+    stand_in = Spheres(spheres.records, RunPaths("small"), psf_stand_in=True)
+    assert stand_in.psf_source("lab") == "stand_in" and stand_in.can_render("lab")
+    assert stand_in.psf_pattern("stand_in") == "lab"
+    assert "optics.psf.stand_in" in stand_in.left_out("lab")[0]
