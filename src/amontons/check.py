@@ -130,7 +130,7 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
         "folder": run.spheres.raw_dir(sphere),
         "loads_mn": run.spheres.loads_mn(sphere),
         "outputs": outputs,
-        "left_out": run.spheres.left_out(sphere),
+        "left_out": run.spheres.left_out(sphere) + run.scenes.left_out(sphere),
         "files": [],
         "errors": [],
     }

@@ -1,6 +1,7 @@
 """The expansion of scenes, scans and the study into the files the DAG schedules, on the
 shipped small config: only what a scene names, one job per scan value."""
 
+from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
@@ -104,3 +105,47 @@ def test_a_measurement_of_a_sphere_under_another_material_is_refused(small):
     others = [m for m in small.materials if m != small.spheres.material_of(sphere)]
     with pytest.raises(ValueError, match=f"sphere '{sphere}' is"):
         small.targets.measured(others[0], sphere, "psf.json")
+
+
+def test_a_scan_without_a_prior_runs_over_its_dimensionless_range(make_run, tmp_path):
+    sheet = tmp_path / "sheet.tsv"
+    lines = Path("config/materials.tsv").read_text().splitlines()
+    header = lines[0].split("\t")
+    rows = [line.split("\t") for line in lines[1:]]
+    for row in rows:
+        if row[0] == "PS":
+            row[header.index("hardening_k_mpa_per_nm")] = ""
+            row[header.index("hardness_mpa")] = ""
+            row[header.index("data_source")] = str(tmp_path)  # measured: no virtual truth needed
+    sheet.write_text("\n".join("\t".join(r) for r in [header, *rows]) + "\n")
+    for name in ("reflection.tif", "bead.tif", "absorbance.csv", "afm_before.tif", "afm_after.tif"):
+        (tmp_path / name).write_text("")  # found, never read: the DAG only looks for them
+    (tmp_path / "rheometer").mkdir()
+    run = make_run(edit=lambda config: config.update(materials_sheet=str(sheet)))
+    with_prior = make_run()
+    e_star_mpa = 3.7e3
+    for scan, spec in run.scenes.scans.items():
+        low, high = spec["prior_free_range"]
+        scale = run.scenes.prior_free_scale("PS", scan)
+        values = [float(v) for v in run.scenes.scan_value_labels("PS", scan)]
+        assert len(values) == spec["prior_free_steps"]
+        assert values[0] == pytest.approx(low * scale, rel=1e-3)
+        assert values[-1] == pytest.approx(high * scale, rel=1e-3)
+        prior = [float(v) for v in with_prior.scenes.scan_value_labels("PS", scan)]
+        # the prior-free range holds the range about the prior
+        assert values[0] < prior[0] and prior[-1] < values[-1]
+        params = run.scenes.scan_params("PS", scan)
+        assert "prior_free_range" in params and "range_factor" not in params
+        assert "prior_free_range" not in with_prior.scenes.scan_params("PS", scan)
+    assert run.scenes.prior_free_scale("PS", "p_y") == pytest.approx(e_star_mpa)
+    # k's scale is E*/Δx, Δx the hardening scene's solver pixel on PS
+    hardening = with_prior.resources.solve_size("hardening", "PS")[1]
+    assert hardening["side_px"] > 0
+    # the scans register on the elastic scene, the first microscope scene PS still runs
+    assert run.scenes.registration_scene("PS", "k") == "elastic"
+    assert with_prior.scenes.registration_scene("PS", "k") == "hardening"
+    lines = [line for line in run.left_out() if line.startswith("sphere PS ")]
+    assert any(
+        "scan k runs over its prior-free range (k·Δx/E* 0.01 to 100" in line for line in lines
+    )
+    assert any("scene hardening (k_mpa_per_nm null" in line for line in lines)

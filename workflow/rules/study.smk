@@ -26,7 +26,7 @@ rule scan_scene:
         mem_mb=solve_mem_mb(scan_solve(SCANS)),
         runtime=solve_runtime(scan_solve(SCANS)),
     params:
-        scan=lambda wc: sorted_keys(SCANS[wc.scan]),
+        scan=lambda wc: RUN.scenes.scan_params(wc.sphere, wc.scan),
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),

@@ -19,6 +19,8 @@ from amontons.config.geometry import (
 # The scan parameters: the model each belongs to, and the sheet column its prior is in.
 SCAN_MODELS = {"p_y_mpa": "penetration_hardness", "k_mpa_per_nm": "hardening"}
 SCAN_COLUMNS = {"p_y_mpa": "hardness_mpa", "k_mpa_per_nm": "hardening_k_mpa_per_nm"}
+# The model parameter a scene takes from the sheet where its own is null: model -> (key, column).
+SCENE_PRIORS = {model: (key, SCAN_COLUMNS[key]) for key, model in SCAN_MODELS.items()}
 
 
 def _check_scene_window(name: str, scene: Mapping, frames: Mapping[str, Frame], source: str):
@@ -38,23 +40,14 @@ def _check_scene_window(name: str, scene: Mapping, frames: Mapping[str, Frame], 
             )
 
 
-def _check_scene_parameters(name: str, scene: Mapping, spheres: Mapping[str, dict], source):
-    """Model parameters that are null must come from every sphere's sheet row."""
-    needs = {
-        "penetration_hardness": ("p_y_mpa", "hardness_mpa"),
-        "hardening": ("k_mpa_per_nm", "hardening_k_mpa_per_nm"),
-    }
-    if scene["model"] not in needs or scene["surface"] == "synthetic":
-        return
-    key, column = needs[scene["model"]]
-    if scene[key] is not None:
-        return
-    for sphere, record in spheres.items():
-        if record.get(column) is None:
-            raise ConfigError(
-                f"{source}: scene {name}: {key} is null, and sphere {sphere} has no {column} in "
-                f"the sheet; expected a value in one of them"
-            )
+def sheet_prior(scene: Mapping) -> tuple[str, str] | None:
+    """(key, sheet column) of the model parameter a scene on a sphere's map takes from the
+    sheet because its own value is null; None where it needs none. A sphere without that
+    column does not run the scene (amontons.workflow.scenes says so per sphere)."""
+    if scene["model"] not in SCENE_PRIORS or scene["surface"] == "synthetic":
+        return None
+    key, column = SCENE_PRIORS[scene["model"]]
+    return None if scene[key] is not None else (key, column)
 
 
 def _check_one_scene(name: str, scene: Mapping, spheres: Mapping[str, dict], source: str):
@@ -95,7 +88,6 @@ def _check_one_scene(name: str, scene: Mapping, spheres: Mapping[str, dict], sou
     if not synthetic:
         frames = {sphere: sphere_frame(scene, record) for sphere, record in spheres.items()}
         _check_scene_window(name, scene, frames, source)
-        _check_scene_parameters(name, scene, spheres, source)
 
 
 PRESET_KEYS = ("pixel_nm", "max_side_px", "window_factor", "tol")
@@ -132,7 +124,7 @@ def check_scenes(config: Mapping, spheres: Mapping[str, dict], source: str) -> N
         _check_one_scene(name, config["scenes"][name], spheres, source)
 
 
-def _check_one_scan(name: str, scan: Mapping, config: Mapping, spheres, source: str) -> None:
+def _check_one_scan(name: str, scan: Mapping, config: Mapping, source: str) -> None:
     where = f"{source}: scan {name}"
     base = scan["scene"]
     if base not in config["run_scenes"]:
@@ -155,19 +147,13 @@ def _check_one_scan(name: str, scan: Mapping, config: Mapping, spheres, source: 
             f"{where}: parameter {scan['parameter']} belongs to model {model}, but base scene "
             f"{base} has model {scene['model']}; expected a {model} scene"
         )
-    low, high = scan["range_factor"]
-    if not low < high:
-        raise ConfigError(f"{where}: range_factor = [{low:g}, {high:g}]; expected low < high")
-    column = SCAN_COLUMNS[scan["parameter"]]
-    for sphere, record in spheres.items():
-        if record.get(column) is None:
-            raise ConfigError(
-                f"{where}: sphere {sphere} has no {column} in the sheet; expected a value (the "
-                "scan's range is range_factor times it)"
-            )
+    for key in ("range_factor", "prior_free_range"):
+        low, high = scan[key]
+        if not low < high:
+            raise ConfigError(f"{where}: {key} = [{low:g}, {high:g}]; expected low < high")
 
 
-def check_scans(config: Mapping, spheres: Mapping[str, dict], source: str) -> None:
+def check_scans(config: Mapping, source: str) -> None:
     """Scans that cannot run stop the run before any job (docs/study.md)."""
     unknown = [name for name in config["run_scans"] if name not in config["scans"]]
     if unknown:
@@ -176,7 +162,7 @@ def check_scans(config: Mapping, spheres: Mapping[str, dict], source: str) -> No
             f"expected one of {', '.join(config['scans'])}"
         )
     for name in config["run_scans"]:
-        _check_one_scan(name, config["scans"][name], config, spheres, source)
+        _check_one_scan(name, config["scans"][name], config, source)
 
 
 def check_curvature_pairs(config: Mapping, source: str) -> None:

@@ -46,7 +46,7 @@ def load_workflow_config(
     selected = {s: r for s, r in sheet.items() if r["material"] in config["materials"]}
     check_reference_load(config["load_area"]["reference_load_mn"], selected, source)
     check_scenes(config, selected, source)
-    check_scans(config, selected, source)
+    check_scans(config, source)
     check_curvature_pairs(config, source)
     check_accuracy_study(config, sheet, source)
     return selected
@@ -74,7 +74,7 @@ class WorkflowRun:
         return [
             f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
             for sphere in self.spheres
-            for line in self.spheres.left_out(sphere)
+            for line in self.spheres.left_out(sphere) + self.scenes.left_out(sphere)
         ]
 
     @classmethod

@@ -7,12 +7,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from amontons.config.scenes import SCAN_COLUMNS
+from amontons.config import geometry
+from amontons.config.scenes import SCAN_COLUMNS, sheet_prior
 from amontons.simulate.scan_grid import scan_values, value_label
 from amontons.workflow import paths as files
 from amontons.workflow.params import sorted_keys
 from amontons.workflow.paths import RunPaths
 from amontons.workflow.spheres import Spheres
+
+# What a scan's prior-free range is a multiple of (config scans.<name>.prior_free_range).
+PRIOR_FREE_SCALES = {"p_y_mpa": "p_Y/E*", "k_mpa_per_nm": "k·Δx/E*"}
 
 
 class Scenes:
@@ -64,19 +68,58 @@ class Scenes:
         names = self.names(surface="afm_before", model=model, optics=optics)
         return names[0] if names else None
 
+    def missing_prior(self, sphere: str, scene: str) -> tuple[str, str] | None:
+        """(key, sheet column) where ``scene`` takes its model parameter from a sheet cell that
+        ``sphere`` leaves empty; None where it has what it needs."""
+        needs = sheet_prior(self.scenes[scene])
+        if needs is None or self.spheres.row(sphere).get(needs[1]) is not None:
+            return None
+        return needs
+
     def runnable(self, sphere: str) -> list[str]:
-        """The AFM scenes a sphere's data allow: its map before the loads for each, and a PSF
-        for those rendered like the microscope."""
+        """The AFM scenes a sphere's data allow: its map before the loads for each, a PSF for
+        those rendered like the microscope, and the sheet's value of the model parameter for
+        those that take it from there (never invented)."""
         return [
             scene
             for scene in self.afm_scenes()
             if self.spheres.can_simulate(sphere)
             and (not self.has_optics(scene) or self.spheres.can_render(sphere))
+            and self.missing_prior(sphere, scene) is None
         ]
+
+    def registration_scene(self, sphere: str, scan: str) -> str | None:
+        """The scene whose registration a sphere's scan is judged under: its base scene, or,
+        where the sphere does not run it (no prior), its first microscope scene; None where it
+        runs none."""
+        runs = [s for s in self.runnable(sphere) if self.has_optics(s)]
+        base = self.scans[scan]["scene"]
+        return base if base in runs else (runs[0] if runs else None)
 
     def runnable_scans(self, sphere: str) -> list[str]:
         """The scans a sphere's data allow: each registers on a microscope scene."""
-        return list(self.scans) if self.spheres.can_render(sphere) else []
+        return [scan for scan in self.scans if self.registration_scene(sphere, scan)]
+
+    def left_out(self, sphere: str) -> list[str]:
+        """What a sphere without a prior does not get (the scenes at the sheet's value), and
+        how its scans run instead."""
+        lines = []
+        for scene in self.afm_scenes():
+            needs = self.missing_prior(sphere, scene)
+            if needs is not None and self.spheres.can_simulate(sphere):
+                lines.append(
+                    f"no {needs[1]} in the sheet: scene {scene} ({needs[0]} null, at the "
+                    "sheet's value) will not be made"
+                )
+        for scan, spec in self.scans.items():
+            if self.prior(sphere, scan) is None and scan in self.runnable_scans(sphere):
+                low, high = spec["prior_free_range"]
+                lines.append(
+                    f"no {SCAN_COLUMNS[spec['parameter']]} in the sheet: scan {scan} runs over "
+                    f"its prior-free range ({PRIOR_FREE_SCALES[spec['parameter']]} {low:g} to "
+                    f"{high:g}, {spec['prior_free_steps']} values)"
+                )
+        return lines
 
     def sphere_scene_outputs(self, material: str, sphere: str, scene: str) -> list[str]:
         """What a scene of one sphere delivers: its fit and, with optics, its comparison."""
@@ -129,12 +172,45 @@ class Scenes:
         """The running scans of ``parameter`` (p_y_mpa or k_mpa_per_nm)."""
         return [name for name, spec in self.scans.items() if spec["parameter"] == parameter]
 
-    def scan_value_labels(self, sphere: str, scan: str) -> list[str]:
-        """The folder names of a scan's values for one sphere (range_factor × its sheet
-        value)."""
+    def prior(self, sphere: str, scan: str) -> float | None:
+        """The sheet's value a sphere's scan is centred on, or None (no prior)."""
+        return self.spheres.value(sphere, SCAN_COLUMNS[self.scans[scan]["parameter"]])
+
+    def prior_free_scale(self, sphere: str, scan: str) -> float:
+        """The scale (in the parameter's config unit) that makes a scan's prior-free range
+        dimensionless on a sphere: E* (MPa) for p_Y, E*/Δx (MPa/nm) for k, Δx the solver
+        pixel of the scan's base scene on that sphere (amontons.config.geometry)."""
         spec = self.scans[scan]
-        centre = self.spheres.row(sphere)[SCAN_COLUMNS[spec["parameter"]]]
-        values = scan_values(centre, spec["range_factor"], spec["steps"], spec["spacing"])
+        base = self.scenes[spec["scene"]]
+        frame = geometry.sphere_frame(base, self.spheres.row(sphere))
+        if spec["parameter"] == "p_y_mpa":
+            return frame.e_star_pa * 1e-6
+        window = geometry.window_m(spec["scene"], base, frame)
+        pixel = geometry.solver_pixel_m(base, window)
+        return frame.e_star_pa / pixel * 1e-15
+
+    def scan_params(self, sphere: str, scan: str) -> dict:
+        """A scan's config as a scan job's params: the keys of the range its sphere is scanned
+        over (about the prior, or prior-free), so that a changed range of the other kind
+        re-runs none of its jobs."""
+        unused = ("prior_free_range", "prior_free_steps")
+        if self.prior(sphere, scan) is None:
+            unused = ("range_factor", "steps")
+        return sorted_keys({k: v for k, v in self.scans[scan].items() if k not in unused})
+
+    def scan_value_labels(self, sphere: str, scan: str) -> list[str]:
+        """The folder names of a scan's values for one sphere: range_factor × its sheet
+        value, or, without one, prior_free_range × the sphere's scale
+        (:meth:`prior_free_scale`)."""
+        spec = self.scans[scan]
+        prior = self.prior(sphere, scan)
+        if prior is not None:
+            values = scan_values(prior, spec["range_factor"], spec["steps"], spec["spacing"])
+        else:
+            scale = self.prior_free_scale(sphere, scan)
+            values = scan_values(
+                scale, spec["prior_free_range"], spec["prior_free_steps"], spec["spacing"]
+            )
         return [value_label(v) for v in values]
 
     def scan_points(self, wildcards) -> list[str]:
@@ -146,9 +222,9 @@ class Scenes:
         ]
 
     def scan_base_registration(self, wildcards) -> str:
-        """The registration of a scan's base scene on the scan's sphere."""
-        base = self.scans[wildcards.scan]["scene"]
-        return self.paths.scene(files.REGISTRATION, wildcards.material, wildcards.sphere, base)
+        """The registration a scan is judged under on its sphere (:meth:`registration_scene`)."""
+        scene = self.registration_scene(wildcards.sphere, wildcards.scan)
+        return self.paths.scene(files.REGISTRATION, wildcards.material, wildcards.sphere, scene)
 
     def scan_outputs(self, materials) -> list[str]:
         """Every scan of every sphere of ``materials``: its table and best value."""
@@ -172,6 +248,6 @@ class Scenes:
                 for v in self.scan_value_labels(sphere, scan)
             ],
             "registration": self.paths.scene(
-                files.REGISTRATION, material, sphere, self.scans[scan]["scene"]
+                files.REGISTRATION, material, sphere, self.registration_scene(sphere, scan)
             ),
         }

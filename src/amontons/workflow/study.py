@@ -122,7 +122,10 @@ class Study:
         if self.scenes.scans_of(K) and self.scenes.runnable_scans(sphere):
             if self.spheres.has(sphere, AFM_AFTER):
                 names.append("B9_flattening")
-            if self.scenes.first("elastic", "microscope") and self.scenes.first("greenwood_tripp"):
+            runs = self.scenes.runnable(sphere)
+            elastic = self.scenes.first("elastic", "microscope")
+            gt = self.scenes.first("greenwood_tripp")
+            if elastic in runs and gt in runs:
                 names.append("B11_load_series")
         folder = self.paths.study(material, sphere)
         return [path for name in names for path in figure_files(folder, name)]
