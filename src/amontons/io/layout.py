@@ -8,7 +8,8 @@
                                          fluorescence image at the sheet's reflection_load_mn
 <folder>/bead.tif                        a 100 nm fluorescent bead, imaged like the contacts
 <folder>/absorbance.csv                  wavelength_nm, absorbance of the probe cover slip
-<folder>/flim.tif                        optional: mean photon arrival time map, ns (float)
+<folder>/flim.tif                        optional: mean photon arrival time map, ns (float),
+<folder>/flim.ptu                          or the time-tagged photons (PicoQuant PTU, T3 image)
 <folder>/afm_before.<tif|npy|txt>        AFM height map of the sphere before contact (m)
 <folder>/afm_after.<tif|npy|txt>         the same after the load series (m)
 <folder>/truth.json                      virtual experiment only; the analysis never reads it
@@ -27,6 +28,8 @@ REFLECTION_NAME = "reflection.tif"
 BEAD_NAME = "bead.tif"
 ABSORBANCE_NAME = "absorbance.csv"
 FLIM_NAME = "flim.tif"
+FLIM_PTU_NAME = "flim.ptu"
+FLIM_NAMES = (FLIM_NAME, FLIM_PTU_NAME)
 AFM_BEFORE_NAME = "afm_before.tif"
 AFM_AFTER_NAME = "afm_after.tif"
 FLUORESCENCE_DIR = "fluorescence"
@@ -132,6 +135,18 @@ def rheometer_files(folder: str | Path, loads_mn: Sequence[float]) -> list[Path]
     order of ``loads_mn``."""
     patterns = [f"*{suffix}" for suffix in RHEOMETER_SUFFIXES]
     return files_by_load(folder, loads_mn, patterns, "rheometer", "25.csv")
+
+
+def flim_file(folder: str | Path) -> Path | None:
+    """The sphere's FLIM file in ``folder`` (``flim.tif`` or ``flim.ptu``), None if it has
+    none; RawDataError naming the folder if it has both."""
+    folder = Path(folder)
+    found = [folder / name for name in FLIM_NAMES if (folder / name).is_file()]
+    if len(found) > 1:
+        raise RawDataError(
+            f"{folder}: both {' and '.join(FLIM_NAMES)}; expected one FLIM file per sphere"
+        )
+    return found[0] if found else None
 
 
 def per_load_files(

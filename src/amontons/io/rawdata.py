@@ -12,6 +12,7 @@ import numpy as np
 
 from amontons.io.absorbance import AbsorbanceError, read_absorbance_csv
 from amontons.io.layout import RawDataError
+from amontons.io.ptu import PhotonImage, PtuError, read_ptu_image
 from amontons.io.rheometer import RheometerError, RheometerTrace, read_rheometer_csv
 from amontons.io.rheometer_export import ExportMap, read_rheometer_export
 from amontons.io.tiff import Image, ImageError, read_image
@@ -108,6 +109,18 @@ def read_flim(path: str | Path, fallback_pixel_m: float | None = None) -> Image:
             "positive arrival times in ns"
         )
     return image
+
+
+def read_flim_photons(
+    path: str | Path, fallback_pixel_m: float | None = None, *, channel: int | None = None
+) -> PhotonImage:
+    """The time-tagged photons of ``flim.ptu`` (T3 image mode) per pixel: photon counts, mean
+    arrival time after the sync and the image's decay (amontons.io.ptu.read_ptu_image);
+    ``channel`` the detector channel (None: all summed)."""
+    try:
+        return read_ptu_image(path, fallback_pixel_m, channel=channel)
+    except PtuError as error:
+        raise RawDataError(f"FLIM photons: {error}") from error
 
 
 def read_absorbance(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
