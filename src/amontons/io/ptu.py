@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import logging
 import struct
+import uuid
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -211,10 +213,15 @@ def write_ptu_image(
     sync_period_s: float,
     pixel_m: float,
     comment: str = "",
+    guid: uuid.UUID | None = None,
+    created: datetime | None = None,
 ) -> None:
     """Write TCSPC histograms (rows × columns × bins, unsigned integers) as a T3 image-mode
     PTU with ptufile's writer, atomically: ``bin_s`` the TCSPC bin, ``sync_period_s`` the laser
-    period, ``pixel_m`` the pixel (written in µm, ``ImgHdr_PixResol``)."""
+    period, ``pixel_m`` the pixel (written in µm, ``ImgHdr_PixResol``). ``guid`` and
+    ``created`` (naive local time) go into the header; ptufile's defaults, a random GUID and
+    the time of writing, make every file's bytes differ, so a writer that must be
+    reproducible gives both."""
     data = np.asarray(histograms)
     if data.ndim != 3 or data.dtype.kind != "u":
         raise ValueError(
@@ -229,4 +236,6 @@ def write_ptu_image(
             tcspc_resolution=bin_s,
             pixel_resolution=pixel_m * 1e6,
             comment=comment,
+            guid=guid,
+            datetime=created,
         )
