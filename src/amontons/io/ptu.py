@@ -29,8 +29,9 @@ from amontons.io.files import atomic_path
 
 log = logging.getLogger(__name__)
 
-# Decode at most this many histogram values at a time (uint32): rows of a large image are
-# decoded in chunks, so a 512² image of 4096 bins needs ~64 MB, not 4 GB.
+# Decode at most this many histogram values at a time: rows of a large image are decoded in
+# chunks of 64 MB (uint32; 128 MB more while their first moment is taken in float64), so a
+# 512² image of 4096 bins needs ~200 MB, not the 4 GB of its whole histogram.
 _CHUNK_VALUES = 16 * 2**20
 # A file and a sheet whose pixels differ by more than this are reported (as for TIFFs).
 _PIXEL_AGREEMENT = 0.01
