@@ -193,7 +193,7 @@ def _natural(x: np.ndarray) -> np.ndarray:
     )
 
 
-def _start(decay: np.ndarray, centres: np.ndarray, bin_ns: float, period_ns: float) -> np.ndarray:
+def _start(decay: np.ndarray, centres: np.ndarray, bin_ns: float) -> np.ndarray:
     """Starting values from the decay's shape: σ from its rise (half maximum to peak, ≈1.18 σ
     for a Gaussian), μ half-way up the rise, lifetimes around the mean delay after μ."""
     smooth = np.convolve(decay, np.ones(5) / 5, mode="same")
@@ -255,7 +255,7 @@ def fit_time_origin(decay: np.ndarray, bin_ns: float, period_ns: float) -> TimeO
 
     result = minimize(
         negative_log_likelihood,
-        _start(counts, centres, bin_ns, period_ns),
+        _start(counts, centres, bin_ns),
         method="Nelder-Mead",
         options={"maxiter": 20000, "maxfev": 20000, "xatol": 1e-7, "fatol": 1e-7},
     )
