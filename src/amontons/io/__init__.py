@@ -5,7 +5,10 @@
   (standard library only, so that the workflow's DAG is built without the numerical stack);
 * :mod:`amontons.io.tiff`: microscope images with their pixel size;
 * :mod:`amontons.io.heightmap`: AFM height maps (TIFF, ``.npy``, Gwyddion text);
-* :mod:`amontons.io.rheometer`: rheometer torque logs;
+* :mod:`amontons.io.ptu`: FLIM photons in PicoQuant PTU files (T3 image mode);
+* :mod:`amontons.io.rheometer`: rheometer torque logs (our own CSV);
+* :mod:`amontons.io.rheometer_export`: the rheometer programs' exports, through a column map;
+* :mod:`amontons.io.units`: the one table of units an export may name;
 * :mod:`amontons.io.absorbance`: absorbance spectra;
 * :mod:`amontons.io.rawdata`: a sphere's raw files read with the checks the layout promises.
 

@@ -1,12 +1,15 @@
 """The raw-data layout a sphere's folder follows, whether real or virtual, and its file names.
 
 <folder>/fluorescence/<load in mN>.tif   one confocal image per load (e.g. 25.tif or 25mN.tif)
-<folder>/rheometer/<load in mN>.csv      one friction test per load (amontons.io.rheometer)
+<folder>/rheometer/<load in mN>.csv      one friction test per load: our CSV
+                                         (amontons.io.rheometer) or the program's export,
+                                         .csv or .txt (amontons.io.rheometer_export)
 <folder>/reflection.tif                  Newton rings, same field and pixel grid as the
                                          fluorescence image at the sheet's reflection_load_mn
 <folder>/bead.tif                        a 100 nm fluorescent bead, imaged like the contacts
 <folder>/absorbance.csv                  wavelength_nm, absorbance of the probe cover slip
-<folder>/flim.tif                        optional: mean photon arrival time map, ns (float)
+<folder>/flim.tif                        optional: mean photon arrival time map, ns (float),
+<folder>/flim.ptu                          or the time-tagged photons (PicoQuant PTU, T3 image)
 <folder>/afm_before.<tif|npy|txt>        AFM height map of the sphere before contact (m)
 <folder>/afm_after.<tif|npy|txt>         the same after the load series (m)
 <folder>/truth.json                      virtual experiment only; the analysis never reads it
@@ -25,10 +28,14 @@ REFLECTION_NAME = "reflection.tif"
 BEAD_NAME = "bead.tif"
 ABSORBANCE_NAME = "absorbance.csv"
 FLIM_NAME = "flim.tif"
+FLIM_PTU_NAME = "flim.ptu"
+FLIM_NAMES = (FLIM_NAME, FLIM_PTU_NAME)
 AFM_BEFORE_NAME = "afm_before.tif"
 AFM_AFTER_NAME = "afm_after.tif"
 FLUORESCENCE_DIR = "fluorescence"
 RHEOMETER_DIR = "rheometer"
+# Our own CSV, and the suffixes rheometer programs give their text exports.
+RHEOMETER_SUFFIXES = (".csv", ".txt")
 # Height-map formats amontons.io.heightmap reads: float TIFF, numpy, and the vendor formats
 # SurfaceTopography reads (its readers detect the format from the content).
 AFM_TIFF_SUFFIXES = (".tif", ".tiff")
@@ -52,9 +59,14 @@ def fluorescence_name(load_mn: float) -> str:
     return f"{load_mn:g}.tif"
 
 
-def rheometer_name(load_mn: float) -> str:
-    """File name of the rheometer record at ``load_mn`` (e.g. 25 → '25.csv')."""
-    return f"{load_mn:g}.csv"
+def rheometer_name(load_mn: float, suffix: str = ".csv") -> str:
+    """File name of the rheometer record at ``load_mn`` (e.g. 25 → '25.csv'; an export may
+    end in another of RHEOMETER_SUFFIXES)."""
+    if suffix not in RHEOMETER_SUFFIXES:
+        raise RawDataError(
+            f"rheometer file suffix '{suffix}'; expected one of {list(RHEOMETER_SUFFIXES)}"
+        )
+    return f"{load_mn:g}{suffix}"
 
 
 def same_load(a_mn: float, b_mn: float) -> bool:
@@ -72,23 +84,34 @@ def load_of(path: Path) -> float | None:
 
 
 def files_by_load(
-    folder: str | Path, loads_mn: Sequence[float], pattern: str, kind: str, example: str
+    folder: str | Path,
+    loads_mn: Sequence[float],
+    pattern: str | Sequence[str],
+    kind: str,
+    example: str,
 ) -> list[Path]:
-    """Paths of the files matching ``pattern`` in ``folder``, one per load, in the order of
-    ``loads_mn``.
+    """Paths of the files matching ``pattern`` (one glob, or several) in ``folder``, one per
+    load, in the order of ``loads_mn``.
 
     Files are named by their load in mN (``25.<ext>`` or ``25mN.<ext>``). Raises RawDataError
-    naming the folder when a load has no file, a file's load is not in the list, or a file
-    name is not a load.
+    naming the folder when a load has no file or two, a file's load is not in the list, or a
+    file name is not a load.
     """
     folder = Path(folder)
     if not folder.is_dir():
         raise RawDataError(f"{folder}: no {kind} folder (expected one {example} per load)")
+    patterns = [pattern] if isinstance(pattern, str) else list(pattern)
     found = {}
-    for path in sorted(folder.glob(pattern)):
+    for path in sorted({p for glob in patterns for p in folder.glob(glob)}):
         load = load_of(path)
         if load is None:
             raise RawDataError(f"{path}: file name is not a load in mN (expected e.g. {example})")
+        twin = next((found[f] for f in found if same_load(f, load)), None)
+        if twin is not None:
+            raise RawDataError(
+                f"{folder}: two {kind} files for {load:g} mN ({twin.name}, {path.name}); "
+                "expected one per load"
+            )
         found[load] = path
     missing = [load for load in loads_mn if not any(same_load(load, f) for f in found)]
     extra = [f for f in found if not any(same_load(load, f) for load in loads_mn)]
@@ -108,8 +131,22 @@ def fluorescence_images(folder: str | Path, loads_mn: Sequence[float]) -> list[P
 
 
 def rheometer_files(folder: str | Path, loads_mn: Sequence[float]) -> list[Path]:
-    """Paths of the rheometer records (``<load>.csv``), in the order of ``loads_mn``."""
-    return files_by_load(folder, loads_mn, "*.csv", "rheometer", "25.csv")
+    """Paths of the rheometer records (``<load>.csv`` or an export's ``<load>.txt``), in the
+    order of ``loads_mn``."""
+    patterns = [f"*{suffix}" for suffix in RHEOMETER_SUFFIXES]
+    return files_by_load(folder, loads_mn, patterns, "rheometer", "25.csv")
+
+
+def flim_file(folder: str | Path) -> Path | None:
+    """The sphere's FLIM file in ``folder`` (``flim.tif`` or ``flim.ptu``), None if it has
+    none; RawDataError naming the folder if it has both."""
+    folder = Path(folder)
+    found = [folder / name for name in FLIM_NAMES if (folder / name).is_file()]
+    if len(found) > 1:
+        raise RawDataError(
+            f"{folder}: both {' and '.join(FLIM_NAMES)}; expected one FLIM file per sphere"
+        )
+    return found[0] if found else None
 
 
 def per_load_files(

@@ -12,7 +12,9 @@ import numpy as np
 
 from amontons.io.absorbance import AbsorbanceError, read_absorbance_csv
 from amontons.io.layout import RawDataError
+from amontons.io.ptu import PhotonImage, PtuError, read_ptu_image
 from amontons.io.rheometer import RheometerError, RheometerTrace, read_rheometer_csv
+from amontons.io.rheometer_export import ExportMap, read_rheometer_export
 from amontons.io.tiff import Image, ImageError, read_image
 
 # A rheometer's set-point and its measured normal force differ by its force noise and drift;
@@ -21,18 +23,23 @@ NORMAL_FORCE_TOLERANCE = 0.1
 
 
 def read_rheometer_traces(
-    paths: Sequence[str | Path], loads_mn: Sequence[float]
+    paths: Sequence[str | Path], loads_mn: Sequence[float], export: ExportMap | None = None
 ) -> list[RheometerTrace]:
-    """Every load's rheometer record (``paths``, one per load, in the order of ``loads_mn``).
+    """Every load's rheometer record (``paths``, one per load, in the order of ``loads_mn``):
+    our own CSV, or with ``export`` the program's export read through that column map.
 
     Besides the file checks of amontons.io.rheometer.read_rheometer_csv (columns, rotation radius,
-    numbers), the mean normal force must be within NORMAL_FORCE_TOLERANCE of the file's load:
-    a file named 50.csv that recorded 100 mN is refused rather than mismatched.
+    numbers) or amontons.io.rheometer_export.read_rheometer_export (mapped columns, units), the
+    mean normal force must be within NORMAL_FORCE_TOLERANCE of the file's load: a file named
+    50.csv that recorded 100 mN is refused rather than mismatched.
     """
     traces = []
     for load, path in zip(loads_mn, paths, strict=True):
         try:
-            trace = read_rheometer_csv(path)
+            if export is None:
+                trace = read_rheometer_csv(path)
+            else:
+                trace = read_rheometer_export(path, export)
         except RheometerError as error:
             raise RawDataError(str(error)) from error
         measured_mn = float(np.mean(trace.normal_force_n)) * 1e3
@@ -102,6 +109,18 @@ def read_flim(path: str | Path, fallback_pixel_m: float | None = None) -> Image:
             "positive arrival times in ns"
         )
     return image
+
+
+def read_flim_photons(
+    path: str | Path, fallback_pixel_m: float | None = None, *, channel: int | None = None
+) -> PhotonImage:
+    """The time-tagged photons of ``flim.ptu`` (T3 image mode) per pixel: photon counts, mean
+    arrival time after the sync and the image's decay (amontons.io.ptu.read_ptu_image);
+    ``channel`` the detector channel (None: all summed)."""
+    try:
+        return read_ptu_image(path, fallback_pixel_m, channel=channel)
+    except PtuError as error:
+        raise RawDataError(f"FLIM photons: {error}") from error
 
 
 def read_absorbance(path: str | Path) -> tuple[np.ndarray, np.ndarray]:

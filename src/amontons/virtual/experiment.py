@@ -27,10 +27,12 @@ from amontons.io.layout import (
     ABSORBANCE_NAME,
     BEAD_NAME,
     FLIM_NAME,
+    FLIM_PTU_NAME,
     REFLECTION_NAME,
     fluorescence_name,
     rheometer_name,
 )
+from amontons.io.rheometer_export import EXPORT_SHAPES
 from amontons.physics import hertz
 from amontons.physics.newton_rings import ring_gap
 from amontons.virtual.instruments import (
@@ -41,6 +43,7 @@ from amontons.virtual.instruments import (
     write_afm_scans,
     write_bead,
     write_flim,
+    write_flim_ptu,
     write_fluorescence,
     write_reflection,
     write_rheometer,
@@ -53,7 +56,12 @@ from amontons.virtual.rough_contact import (
     simulate_rough_sphere,
 )
 from amontons.virtual.roughness import Roughness
-from amontons.virtual.settings import InstrumentSettings, SurfaceSettings
+from amontons.virtual.settings import (
+    TIFF_AND_CSV,
+    InstrumentSettings,
+    OutputFormats,
+    SurfaceSettings,
+)
 from amontons.virtual.state import ContactState, load_index
 
 log = logging.getLogger(__name__)
@@ -90,6 +98,7 @@ def generate_sphere(
     surface: SurfaceSettings,
     seed: int,
     threads: int = 1,
+    formats: OutputFormats = TIFF_AND_CSV,
 ) -> dict:
     """Write every raw file of one sphere into ``out_dir`` and ``truth.json``; return the truth.
 
@@ -98,7 +107,8 @@ def generate_sphere(
     ``contact_counts`` (settings) is the expected signal at the mean contact pressure of the
     smallest load; the signal scales as √max(p, p_c) in contact (p_c: the settings'
     ``confinement_floor_pa``). Static friction is ``shear_strength_pa`` × the true contact
-    area at each load (F_f = τ·A); dynamic friction is ``dynamic_fraction`` of it.
+    area at each load (F_f = τ·A); dynamic friction is ``dynamic_fraction`` of it. ``formats``
+    chooses the FLIM and rheometer file formats (default: TIFF and our CSV).
     """
     out_dir = Path(out_dir)
     radius_m = diameter_m / 2
@@ -149,6 +159,7 @@ def generate_sphere(
         shear_strength_pa=shear_strength_pa,
         settings=settings,
         seed=seed,
+        formats=formats,
     )
     afm_truth = write_afm_scans(
         out_dir,
@@ -225,9 +236,10 @@ def write_instruments(
     shear_strength_pa: float,
     settings: InstrumentSettings,
     seed: int,
+    formats: OutputFormats = TIFF_AND_CSV,
 ) -> dict:
-    """Write every instrument's file from the contact states (one per load, increasing) and
-    return the truth behind them (JSON-ready, units in the key names)."""
+    """Write every instrument's file from the contact states (one per load, increasing), in
+    ``formats``, and return the truth behind them (JSON-ready, units in the key names)."""
     smallest = states[0]
     mean_pressure_min = smallest.load_n / smallest.area_m2
     counts_per_sqrt_pa = settings.contact_counts / np.sqrt(mean_pressure_min)
@@ -253,35 +265,25 @@ def write_instruments(
         out_dir / ABSORBANCE_NAME, settings, instrument_rng(seed, sphere, "absorbance")
     )
     rheometer_rng = instrument_rng(seed, sphere, "rheometer")
+    suffix = ".csv" if formats.rheometer == "csv" else EXPORT_SHAPES[formats.rheometer].suffix
     static, dynamic = [], []
     for state in states:
         static.append(shear_strength_pa * state.area_m2)
         dynamic.append(
             write_rheometer(
-                out_dir / "rheometer" / rheometer_name(state.load_n * 1e3),
+                out_dir / "rheometer" / rheometer_name(state.load_n * 1e3, suffix),
                 state.load_n,
                 static[-1],
                 settings,
                 rheometer_rng,
+                formats.rheometer,
             )
         )
     flim_truth = None
     if flim_load_n is not None:
-        window = write_flim(
-            out_dir / FLIM_NAME,
-            _matching(states, flim_load_n),
-            pixel_m,
-            settings,
-            instrument_rng(seed, sphere, "flim"),
+        flim_truth = _write_flim(
+            out_dir, _matching(states, flim_load_n), pixel_m, settings, formats, seed, sphere
         )
-        flim_truth = {
-            "load_mn": flim_load_n * 1e3,
-            "contact_ns": settings.flim_contact_ns,
-            "outside_ns": settings.flim_outside_ns,
-            "noise_ns": settings.flim_noise_ns,
-            "contact_pixels": int(window.sum()),
-            "field_px": int(window.shape[0]),
-        }
 
     loads_mn = [s.load_n * 1e3 for s in states]
     return {
@@ -321,5 +323,47 @@ def write_instruments(
         "dynamic_friction_mn": [f * 1e3 for f in dynamic],
         "rotation_radius_mm": settings.rotation_radius_m * 1e3,
         "sliding_speed_um_s": settings.sliding_speed_m_s * 1e6,
+        "rheometer_format": formats.rheometer,
         "flim": flim_truth,
     }
+
+
+def _write_flim(
+    out_dir: Path,
+    state: ContactState,
+    pixel_m: float,
+    settings: InstrumentSettings,
+    formats: OutputFormats,
+    seed: int,
+    sphere: str,
+) -> dict:
+    """Write the FLIM file in its format; return its truth."""
+    rng = instrument_rng(seed, sphere, "flim")
+    truth = {
+        "load_mn": state.load_n * 1e3,
+        "contact_ns": settings.flim_contact_ns,
+        "outside_ns": settings.flim_outside_ns,
+    }
+    if formats.flim == "tif":
+        window = write_flim(out_dir / FLIM_NAME, state, pixel_m, settings, rng)
+        truth["noise_ns"] = settings.flim_noise_ns
+    else:
+        tcspc = formats.tcspc
+        window = write_flim_ptu(out_dir / FLIM_PTU_NAME, state, pixel_m, settings, tcspc, rng)
+        truth["photons"] = {
+            "per_pixel_mean": tcspc.photons_per_pixel,
+            "irf_peak_ns": tcspc.irf_peak_s * 1e9,
+            "irf_fwhm_ps": tcspc.irf_fwhm_s * 1e12,
+            "tcspc_bin_ps": tcspc.bin_s * 1e12,
+            "sync_period_ns": tcspc.sync_period_s * 1e9,
+            "definition": "mean arrival time after the instrument response's peak = the "
+            "lifetime; a pixel's standard error sqrt(tau^2 + sigma_irf^2 / N_photons)",
+        }
+    truth.update(
+        {
+            "contact_pixels": int(window.sum()),
+            "field_px": int(window.shape[0]),
+            "format": formats.flim,
+        }
+    )
+    return truth

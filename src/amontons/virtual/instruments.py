@@ -9,7 +9,9 @@ byte-identical.
 
 from __future__ import annotations
 
+import uuid
 import zlib
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +19,8 @@ import numpy as np
 from amontons.io.absorbance import write_absorbance_csv
 from amontons.io.heightmap import write_height_map
 from amontons.io.layout import AFM_AFTER_NAME, AFM_BEFORE_NAME
+from amontons.io.ptu import write_ptu_image
+from amontons.io.rheometer_export import write_rheometer_export
 from amontons.io.tiff import write_image
 from amontons.physics.beer_lambert import EPSILON_M2_PER_MOL, surface_density_per_m2
 from amontons.physics.roughness import flattening_depth, roughness_statistics
@@ -24,7 +28,7 @@ from amontons.simulate.grid import resample_points
 from amontons.virtual.absorbance import absorbance_spectrum
 from amontons.virtual.afm import MAX_APEX_OFFSET, AfmSettings, afm_to_microscope, scan_artefacts
 from amontons.virtual.bead import render_bead
-from amontons.virtual.flim import render_flim
+from amontons.virtual.flim import TcspcSettings, photon_histograms, render_flim
 from amontons.virtual.fluorescence import render_fluorescence
 from amontons.virtual.reflection import render_reflection
 from amontons.virtual.rheometer import rheometer_trace, write_rheometer_trace
@@ -40,6 +44,9 @@ ABSORBANCE_SCAN_NM = np.arange(400.0, 600.01, 0.5)
 ABSORBANCE_PEAK_NM = 488.0
 # Both faces of the cover slip carry a monolayer and the beam crosses both (docs/models.md §1.1).
 COATED_FACES = 2
+# A virtual acquisition has no time: its PTU header says the Unix epoch, as reproducible builds
+# do, so that the same seed writes the same bytes.
+VIRTUAL_ACQUISITION_TIME = datetime(1970, 1, 1)
 # Rheometer record: 20 s at 100 Hz (1 s rest, 4 s loading to the static peak, then sliding).
 RHEOMETER_DURATION_S = 20.0
 RHEOMETER_RATE_HZ = 100.0
@@ -141,9 +148,11 @@ def write_rheometer(
     static_friction_n: float,
     settings: InstrumentSettings,
     rng: np.random.Generator,
+    shape: str = "csv",
 ) -> float:
-    """One load's friction test (torque, angle, normal force); returns the true dynamic friction
-    (N)."""
+    """One load's friction test (torque, angle, normal force), as our CSV (``shape`` 'csv') or
+    as a program's export (a key of amontons.io.rheometer_export.EXPORT_SHAPES); returns the
+    true dynamic friction (N). The trace, and so its noise, is the same in every shape."""
     dynamic = settings.dynamic_fraction * static_friction_n
     trace = rheometer_trace(
         load_n,
@@ -155,8 +164,23 @@ def write_rheometer(
         RHEOMETER_RATE_HZ,
         rng=rng,
     )
-    write_rheometer_trace(path, trace)
+    if shape == "csv":
+        write_rheometer_trace(path, trace)
+    else:
+        write_rheometer_export(path, trace, shape)
     return dynamic
+
+
+def flim_window(state: ContactState, field_px: int) -> np.ndarray:
+    """The true contact mask of the FLIM microscope's window: ``field_px`` square, centred on
+    the contact's right-hand edge (appendix Fig. B.3)."""
+    half = field_px // 2
+    row = round(state.centre_px[0])
+    inside_cols = np.nonzero(state.contact[row])[0]
+    edge_col = int(inside_cols.max()) if inside_cols.size else round(state.centre_px[1])
+    # Pad with 'no contact' so a window reaching past the image is still defined.
+    padded = np.pad(state.contact, half, constant_values=False)
+    return padded[row : row + 2 * half, edge_col : edge_col + 2 * half]
 
 
 def write_flim(
@@ -168,13 +192,7 @@ def write_flim(
 ) -> np.ndarray:
     """Mean photon arrival time map (ns) of a window centred on the contact's right-hand edge
     (appendix Fig. B.3); returns the window's true contact mask."""
-    half = settings.flim_field_px // 2
-    row = round(state.centre_px[0])
-    inside_cols = np.nonzero(state.contact[row])[0]
-    edge_col = int(inside_cols.max()) if inside_cols.size else round(state.centre_px[1])
-    # Pad with 'no contact' so a window reaching past the image is still defined.
-    padded = np.pad(state.contact, half, constant_values=False)
-    window = padded[row : row + 2 * half, edge_col : edge_col + 2 * half]
+    window = flim_window(state, settings.flim_field_px)
     arrival = render_flim(
         window,
         settings.flim_contact_ns,
@@ -183,6 +201,34 @@ def write_flim(
         rng=rng,
     )
     write_image(path, arrival, pixel_m)
+    return window
+
+
+def write_flim_ptu(
+    path: Path,
+    state: ContactState,
+    pixel_m: float,
+    settings: InstrumentSettings,
+    tcspc: TcspcSettings,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """The time-tagged photons of the same window as :func:`write_flim` (a T3 image-mode PTU,
+    written by ptufile): each pixel a mono-exponential decay of the contact's or the free
+    molecules' lifetime through a Gaussian instrument response, Poisson photons; returns the
+    window's true contact mask."""
+    window = flim_window(state, settings.flim_field_px)
+    lifetime_s = np.where(window, settings.flim_contact_ns, settings.flim_outside_ns) * 1e-9
+    histograms = photon_histograms(lifetime_s, tcspc, rng=rng)
+    write_ptu_image(
+        path,
+        histograms,
+        bin_s=tcspc.bin_s,
+        sync_period_s=tcspc.sync_period_s,
+        pixel_m=pixel_m,
+        comment="amontons virtual experiment (synthetic data)",
+        guid=uuid.UUID(bytes=rng.bytes(16), version=4),
+        created=VIRTUAL_ACQUISITION_TIME,
+    )
     return window
 
 

@@ -6,8 +6,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from amontons.io.rheometer_export import EXPORT_SHAPES
 from amontons.virtual.afm import AfmSettings
+from amontons.virtual.flim import TcspcSettings
 from amontons.virtual.rough_contact import SolverSettings
+
+FLIM_FORMATS = ("tif", "ptu")
+RHEOMETER_FORMATS = ("csv", *EXPORT_SHAPES)
 
 
 @dataclass(frozen=True)
@@ -99,3 +104,46 @@ class SurfaceSettings:
                 mirrored=settings["afm_mirrored"],
             ),
         )
+
+
+@dataclass(frozen=True)
+class OutputFormats:
+    """The formats the virtual instruments write (config ``virtual_experiment.formats``).
+
+    ``flim``: 'tif' (the mean arrival time map) or 'ptu' (the time-tagged photons, which need
+    ``tcspc``); ``rheometer``: 'csv' (our own) or one of the export shapes of
+    amontons.io.rheometer_export.EXPORT_SHAPES. The default is the TIFF and CSV route.
+    """
+
+    flim: str = "tif"
+    rheometer: str = "csv"
+    tcspc: TcspcSettings | None = None
+
+    def __post_init__(self):
+        if self.flim not in FLIM_FORMATS:
+            raise ValueError(
+                f"virtual_experiment.formats.flim = {self.flim!r}; expected one of {FLIM_FORMATS}"
+            )
+        if self.rheometer not in RHEOMETER_FORMATS:
+            raise ValueError(
+                f"virtual_experiment.formats.rheometer = {self.rheometer!r}; expected one of "
+                f"{RHEOMETER_FORMATS}"
+            )
+        if self.flim == "ptu" and self.tcspc is None:
+            raise ValueError("a PTU FLIM file needs the photon-counting settings (tcspc)")
+
+    @classmethod
+    def from_config(cls, settings: Mapping) -> OutputFormats:
+        """From the ``virtual_experiment`` config slice: its ``formats`` (flim, rheometer) and,
+        for a PTU, the photon-counting keys (amontons.virtual.flim.TcspcSettings)."""
+        formats = settings["formats"]
+        flim = formats["flim"]
+        return cls(
+            flim=flim,
+            rheometer=formats["rheometer"],
+            tcspc=TcspcSettings.from_config(settings) if flim == "ptu" else None,
+        )
+
+
+# The formats of the small-data run and of every test that does not choose one.
+TIFF_AND_CSV = OutputFormats()
