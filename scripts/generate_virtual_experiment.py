@@ -9,7 +9,7 @@ if "snakemake" in globals():
 
 from amontons.runlog import run_logged
 from amontons.virtual.experiment import generate_sphere
-from amontons.virtual.settings import InstrumentSettings, SurfaceSettings
+from amontons.virtual.settings import InstrumentSettings, OutputFormats, SurfaceSettings
 
 
 def main(
@@ -45,6 +45,7 @@ def main(
         surface=SurfaceSettings.from_config(settings),
         seed=seed,
         threads=threads,
+        formats=OutputFormats.from_config(settings),
     )
 
 

@@ -4,6 +4,7 @@ import logging
 
 from amontons.io.files import write_table
 from amontons.io.layout import per_load_files, rheometer_name
+from amontons.io.rheometer_export import EXPORT_SHAPES, ExportMap
 from amontons.measure.friction import measure_friction
 from amontons.runlog import run_logged
 
@@ -16,12 +17,20 @@ def main(
     loads_mn: list[float],
     median_window_s: float,
     plateau_fraction: float,
+    export: dict | None,
+    virtual_format: str | None,
 ) -> None:
+    """``rheometer``: the per-load files, or the virtual experiment's folder of them, written
+    in ``virtual_format`` (config virtual_experiment.formats.rheometer; None for measured
+    data); ``export``: the column map of the rheometer program's export (config
+    rheometer_export), None for our own CSV."""
+    suffix = ".csv" if virtual_format in (None, "csv") else EXPORT_SHAPES[virtual_format].suffix
     table = measure_friction(
-        per_load_files(rheometer, loads_mn, rheometer_name),
+        per_load_files(rheometer, loads_mn, lambda load: rheometer_name(load, suffix)),
         loads_mn,
         median_window_s=median_window_s,
         plateau_fraction=plateau_fraction,
+        export=None if export is None else ExportMap.from_config(export),
     )
     for row in table.itertuples():
         log.info("%s: %g mN → static %.4g mN", row.file, row.load_mn, row.static_friction_mn)
@@ -38,4 +47,6 @@ if __name__ == "__main__":
         loads_mn=sm.params.loads_mn,
         median_window_s=sm.params.friction["median_window_s"],
         plateau_fraction=sm.params.friction["plateau_fraction"],
+        export=sm.params.export,
+        virtual_format=sm.params.virtual_format,
     )

@@ -16,12 +16,17 @@ def main(
     pixel_nm: float,
     otsu: dict,
     exclude_edge_px: int,
+    channel: int | None,
+    irf_peak_ns: float | None,
 ) -> None:
+    """``channel`` and ``irf_peak_ns`` apply to a PTU file only (config optics.lifetime)."""
     stats = measure_lifetime(
         flim_path,
         pixel_nm * 1e-9,
         otsu=OtsuSettings.from_config(otsu),
         exclude_edge_px=exclude_edge_px,
+        channel=channel,
+        irf_peak_ns=irf_peak_ns,
     )
     log.info(
         "%s: %.3f ns inside, %.3f ns outside",
@@ -42,4 +47,6 @@ if __name__ == "__main__":
         pixel_nm=sm.params.pixel_nm,
         otsu=sm.params.otsu,
         exclude_edge_px=sm.params.lifetime["exclude_edge_px"],
+        channel=sm.params.lifetime["channel"],
+        irf_peak_ns=sm.params.lifetime["irf_peak_ns"],
     )

@@ -19,6 +19,12 @@ rule measure_friction:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         friction=config_slice("friction"),
+        export=config.get("rheometer_export"),
+        virtual_format=lambda wc: (
+            config["virtual_experiment"]["formats"]["rheometer"]
+            if SPHERES.is_synthetic(wc.sphere)
+            else None
+        ),
     script:
         "../../scripts/measure_friction.py"
 

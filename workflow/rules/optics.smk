@@ -194,7 +194,7 @@ rule measure_intensity_pressure:
 
 rule measure_lifetime:
     input:
-        flim=lambda wc: raw_file(wc.sphere, "flim.tif"),
+        flim=lambda wc: SPHERES.flim_path(wc.sphere),
     output:
         lifetime=f"{MEASURED}/{LIFETIME}",
     log:

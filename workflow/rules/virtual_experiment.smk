@@ -54,7 +54,7 @@ use rule generate_virtual_experiment as generate_virtual_experiment_with_flim wi
         absorbance=f"{SYNTHETIC_SPHERE}/absorbance.csv",
         afm_before=f"{SYNTHETIC_SPHERE}/afm_before.tif",
         afm_after=f"{SYNTHETIC_SPHERE}/afm_after.tif",
-        flim=f"{SYNTHETIC_SPHERE}/flim.tif",
+        flim=f"{SYNTHETIC_SPHERE}/flim.{config['virtual_experiment']['formats']['flim']}",
         truth=f"{SYNTHETIC_SPHERE}/{TRUTH}",
     wildcard_constraints:
         sphere=SPHERES.synthetic_pattern(with_flim=True),

@@ -21,6 +21,7 @@ from scipy.ndimage import median_filter
 from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_rheometer_traces
 from amontons.io.rheometer import RheometerError, RheometerTrace
+from amontons.io.rheometer_export import ExportMap
 
 
 @dataclass(frozen=True)
@@ -227,11 +228,14 @@ def measure_friction(
     *,
     median_window_s: float,
     plateau_fraction: float,
+    export: ExportMap | None = None,
 ) -> pd.DataFrame:
     """Friction per load from the rheometer records ``rheometer_paths`` (one per load of
-    ``loads_mn``); units in the column names."""
+    ``loads_mn``; our CSV, or with ``export`` the program's export read through that column
+    map); units in the column names."""
     rows = []
-    for load, trace in zip(loads_mn, read_rheometer_traces(rheometer_paths, loads_mn), strict=True):
+    traces = read_rheometer_traces(rheometer_paths, loads_mn, export)
+    for load, trace in zip(loads_mn, traces, strict=True):
         try:
             result = static_friction(
                 trace, median_window_s=median_window_s, plateau_fraction=plateau_fraction

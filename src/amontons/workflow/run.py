@@ -91,7 +91,10 @@ class WorkflowRun:
         )
         paths = RunPaths(config["run"])
         spheres = Spheres(
-            records, paths, psf_stand_in=config["optics"]["psf"].get("stand_in") is not None
+            records,
+            paths,
+            psf_stand_in=config["optics"]["psf"].get("stand_in") is not None,
+            synthetic_flim=config["virtual_experiment"]["formats"]["flim"],
         )
         scenes = Scenes(config, spheres, paths)
         study = Study(config, spheres, scenes, paths)

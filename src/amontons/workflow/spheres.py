@@ -20,6 +20,7 @@ from amontons.io.layout import (
     REFLECTION_NAME,
     RHEOMETER_DIR,
     afm_file,
+    flim_file,
     fluorescence_images,
     rheometer_files,
 )
@@ -60,12 +61,20 @@ class Spheres:
     """The sheet records (sphere id → record, amontons.config.sheet) of the selected
     materials, in the sheet's order, with the run's paths."""
 
-    def __init__(self, records: Mapping[str, dict], paths: RunPaths, psf_stand_in: bool = False):
+    def __init__(
+        self,
+        records: Mapping[str, dict],
+        paths: RunPaths,
+        psf_stand_in: bool = False,
+        synthetic_flim: str = "tif",
+    ):
         """``psf_stand_in``: whether the config gives a PSF (optics.psf.stand_in) for the
-        spheres with no bead image."""
+        spheres with no bead image; ``synthetic_flim``: the format of the virtual experiment's
+        FLIM file ('tif' or 'ptu', config virtual_experiment.formats.flim)."""
         self.records = dict(records)
         self.paths = paths
         self.psf_stand_in = psf_stand_in
+        self.synthetic_flim = synthetic_flim
         self._missing: dict[str, dict[str, str]] = {}
 
     def __iter__(self):
@@ -226,12 +235,19 @@ class Spheres:
         """Regex matching the spheres whose PSF comes from ``source`` ('bead', 'stand_in')."""
         return names_pattern([s for s in self.records if self.psf_source(s) == source])
 
-    def has_flim(self, sphere: str) -> bool:
-        """Synthetic spheres get a FLIM map where the sheet gives flim_load_mn; measured
-        spheres have one where their folder holds flim.tif."""
+    def flim_path(self, sphere: str) -> str | None:
+        """A sphere's FLIM file: the virtual experiment's flim.<format> where the sheet gives
+        flim_load_mn; a measured sphere's flim.tif or flim.ptu (amontons.io.layout.flim_file;
+        both stop the run, naming them); None where it has none."""
         if self.is_synthetic(sphere):
-            return self.value(sphere, "flim_load_mn") is not None
-        return os.path.isfile(self.raw_file(sphere, "flim.tif"))
+            if self.value(sphere, "flim_load_mn") is None:
+                return None
+            return self.raw_file(sphere, f"flim.{self.synthetic_flim}")
+        found = flim_file(self.raw_dir(sphere))
+        return None if found is None else str(found)
+
+    def has_flim(self, sphere: str) -> bool:
+        return self.flim_path(sphere) is not None
 
     def synthetic_pattern(self, with_flim: bool) -> str:
         """Regex matching the synthetic spheres with (or without) a FLIM map; never
