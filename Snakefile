@@ -1,5 +1,7 @@
 # amontons: multi-asperity contact experiments, from raw images to deviations from Amontons' law.
-# Entry point; README.md says how to run it, config/README.md what every key means.
+# Entry point; README.md says how to run it, config/README.md what every key means. It also runs
+# as a Snakemake module from a folder of one's own, whose config then stands in for the
+# configfile below (docs/deploy.md).
 from snakemake.utils import min_version
 
 min_version("9.0")

@@ -506,24 +506,6 @@ def check_measurements_against_truth(project, material, sphere):
     )
 
 
-def test_readme_shows_the_current_rule_graph():
-    graph = run(
-        [sys.executable, "-m", "snakemake", "--rulegraph", "mermaid-js", "--quiet", "all"],
-        cwd=REPO,
-    )
-    assert graph.returncode == 0, graph.stderr
-    readme = (REPO / "README.md").read_text()
-    shown = readme.split("```mermaid\n", 1)[1].split("```", 1)[0]
-
-    def named_edges(text):
-        # Node ids, colours and edge order vary between runs; the named edges do not.
-        names = dict(re.findall(r"(id\d+)\[(\w+)\]", text))
-        return {(names[a], names[b]) for a, b in re.findall(r"(id\d+) --> (id\d+)", text)}
-
-    assert named_edges(shown) == named_edges(graph.stdout)
-    assert named_edges(shown)
-
-
 def test_own_afm_maps_in_vendor_formats_are_measured(small_run, tmp_path):
     """A measured sphere whose AFM scans come as an ISO 25178 x3p file (before) and a
     Gwyddion file (after), written from the virtual PS sphere's float TIFF scans: the topography
