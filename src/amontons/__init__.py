@@ -1,3 +1,6 @@
 """amontons: multi-asperity contact experiments, from raw images to Amontons-deviation plots."""
 
-__version__ = "0.1.0"
+from importlib.metadata import version
+
+# pyproject.toml's project.version, the one place it is set (docs/deploy.md, "Cutting a release")
+__version__ = version("amontons")

@@ -1,4 +1,4 @@
-"""What a job of the workflow needs on a cluster, from measured runs (README, "On a cluster").
+"""What a job of the workflow needs on a cluster, from measured runs (docs/cluster.md).
 
 `benchmarks/fit_job_resources.py` reads the benchmark files Snakemake writes for every job of
 a run (`logs/<run>/**/*.benchmark.tsv`: wall time and peak resident memory) and writes

@@ -1,7 +1,6 @@
 # Wiring only: the run is checked and built once by amontons.workflow (importable, tested
 # without Snakemake in tests/workflow_dag/), and the names the rules use are bound to it here.
 # amontons.workflow loads no numerical stack, so that building the DAG stays fast.
-import os
 from functools import partial
 
 from snakemake.logging import logger
@@ -43,8 +42,11 @@ from amontons.workflow.spheres import RHEOMETER, names_pattern
 CONFIG_SOURCE = ", ".join(
     str(f) for f in (workflow.overwrite_configfiles or ["config/config.yaml"])
 )
+# The workflow's own files (schemas, measured resources, timing model) are located from this
+# file, not from workflow.basedir: that is the folder of the Snakefile Snakemake runs, a user's
+# own one when this workflow is a module there (docs/deploy.md).
 RUN = WorkflowRun.from_config(
-    config, os.path.join(workflow.basedir, "workflow"), CONFIG_SOURCE
+    config, lambda name: workflow.source_path(f"../{name}"), CONFIG_SOURCE
 )
 MATERIALS = RUN.materials
 # A sphere's missing optional file removes only what needs it: say so before any job.

@@ -35,13 +35,15 @@ class SolveResources:
         self.timing_model = timing_model
 
     @classmethod
-    def from_workflow_dir(cls, config: Mapping, spheres: Spheres, folder: str | Path):
-        """Read resources.json and timing_model.json from the workflow folder ``folder``."""
-        folder = Path(folder)
-        with open(folder / "timing_model.json", encoding="utf-8") as stream:
-            timing_model = json.load(stream)
-        measured = JobResources.from_file(folder / "resources.json")
-        return cls(config, spheres, measured, timing_model)
+    def from_files(
+        cls, config: Mapping, spheres: Spheres, resources: str | Path, timing_model: str | Path
+    ) -> SolveResources:
+        """From the measured resources (workflow/resources.json) and the timing model
+        (workflow/timing_model.json) at the paths given."""
+        with open(timing_model, encoding="utf-8") as stream:
+            model = json.load(stream)
+        measured = JobResources(JobResources.from_file(resources).record, "workflow/resources.json")
+        return cls(config, spheres, measured, model)
 
     def runtime(self, rule: str) -> int:
         """Measured runtime (min) of a job of ``rule``."""

@@ -4,7 +4,7 @@ built from it. workflow/rules/common.smk only binds these to the names the rules
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,6 +29,13 @@ from amontons.workflow.scenes import Scenes
 from amontons.workflow.spheres import Spheres
 from amontons.workflow.study import Study
 from amontons.workflow.targets import Targets
+
+# Locates a file of the workflow folder by its path there (e.g. "schemas/config.schema.yaml").
+Locate = Callable[[str], str | Path]
+
+
+def _in_folder(folder: Path) -> Locate:
+    return lambda name: folder / name
 
 
 def load_workflow_config(
@@ -78,15 +85,18 @@ class WorkflowRun:
         ]
 
     @classmethod
-    def from_config(cls, config: Mapping, workflow_dir: str | Path, source: str) -> WorkflowRun:
-        """Check ``config`` (resolved in place) against the schemas in
-        ``workflow_dir``/schemas and build the run; ``workflow_dir`` also holds the measured
-        resources and the timing model."""
-        schemas = Path(workflow_dir) / "schemas"
+    def from_config(
+        cls, config: Mapping, workflow_dir: str | Path | Locate, source: str
+    ) -> WorkflowRun:
+        """Check ``config`` (resolved in place) against the workflow's schemas and build the
+        run. ``workflow_dir``: the workflow folder (schemas/, resources.json,
+        timing_model.json), or a function that locates one of its files by its path in that
+        folder (Snakemake's ``workflow.source_path``, which also serves a deployed module)."""
+        locate = workflow_dir if callable(workflow_dir) else _in_folder(Path(workflow_dir))
         records = load_workflow_config(
             config,
-            load_schema(schemas / "config.schema.yaml"),
-            load_schema(schemas / "materials.schema.yaml"),
+            load_schema(locate("schemas/config.schema.yaml")),
+            load_schema(locate("schemas/materials.schema.yaml")),
             source,
         )
         paths = RunPaths(config["run"])
@@ -106,5 +116,7 @@ class WorkflowRun:
             study=study,
             targets=Targets(spheres, scenes, study, paths),
             accuracy=AccuracyStudy(config, spheres, paths),
-            resources=SolveResources.from_workflow_dir(config, spheres, workflow_dir),
+            resources=SolveResources.from_files(
+                config, spheres, locate("resources.json"), locate("timing_model.json")
+            ),
         )
