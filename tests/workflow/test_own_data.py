@@ -1,0 +1,228 @@
+"""Own data as a lab has it (issue 36): spheres with a file missing, and one bad sphere among
+good ones. Each sphere is a copy of the small run's virtual PS sphere in a measured folder,
+less the file the case is about, so that every output it still makes can be compared with
+the complete copy's, made in the same run."""
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+pytestmark = pytest.mark.workflow
+
+REPO = Path(__file__).resolve().parents[2]
+SMALL = "small"
+COMPLETE = "PS-complete"
+# case -> (files removed from the sphere's folder, results it then lacks, relative to its
+# results folder; "scenes/" stands for every scene's files)
+CASES = {
+    "PS-noreflection": (["reflection.tif"], ["measure/edge_gap.json", "measure/edge_gap.png",
+                                            "measure/edge_gap.pdf"]),
+    "PS-nobead": (["bead.tif"], ["measure/psf.png", "measure/psf.pdf"]),
+    "PS-noabsorbance": (["absorbance.csv"], ["measure/grafting_density.json",
+                                             "measure/absorbance.png", "measure/absorbance.pdf"]),
+    "PS-noafmafter": (["afm_after.tif"], ["measure/topography.json", "measure/topography.png",
+                                          "measure/topography.pdf"]),
+    "PS-noafm": (["afm_before.tif", "afm_after.tif"], ["measure/topography.json",
+                                                       "measure/topography.png",
+                                                       "measure/topography.pdf",
+                                                       "measure/afm_before_levelled.h5",
+                                                       "scenes/"]),
+    "PS-norheometer": (["rheometer"], ["measure/friction.csv"]),
+}  # fmt: skip
+# The stand-in PSF of the sphere without a bead image: another FWHM than the bead gives, so
+# that its renderings differ from the complete sphere's and show where the PSF came from.
+STAND_IN = {"fwhm_nm": 500.0, "fwhm_se_nm": 25.0}
+
+
+def _lab_sphere(small_run, lab: Path, name: str, remove: list[str]) -> Path:
+    """A copy of the virtual PS sphere as measured data, less ``remove``."""
+    folder = lab / name
+    shutil.copytree(small_run / "resources" / "synthetic" / SMALL / "PS", folder)
+    (folder / "truth.json").unlink()
+    for entry in remove:
+        path = folder / entry
+        shutil.rmtree(path) if path.is_dir() else path.unlink()
+    return folder
+
+
+def _project(tmp_path, small_run, spheres: dict[str, list[str]]) -> Path:
+    """A project folder whose sheet lists ``spheres`` (name -> files removed), the PS row's
+    values each, with two scenes (one rendered, one not) and no scans to keep the run short."""
+    project = tmp_path / "project"
+    shutil.copytree(REPO / "config", project / "config")
+    sheet = pd.read_csv(project / "config" / "materials.tsv", sep="\t", dtype=str)
+    ps = sheet[sheet["sphere"] == "PS"]
+    rows = [
+        ps.assign(sphere=name, data_source=str(_lab_sphere(small_run, tmp_path / "lab", name, rm)))
+        for name, rm in spheres.items()
+    ]
+    pd.concat(rows).to_csv(project / "config" / "own.tsv", sep="\t", index=False)
+    path = project / "config" / "test.yaml"
+    config = yaml.safe_load(path.read_text())
+    config.update(
+        materials=["PS"],
+        materials_sheet="config/own.tsv",
+        run_scenes=["elastic", "greenwood_tripp"],
+        run_scans=[],
+        study={"run_curvature_pairs": []},
+        optics={"psf": {"stand_in": STAND_IN}},
+    )
+    path.write_text(yaml.safe_dump(config))
+    return project
+
+
+def _snakemake(project, *args):
+    command = [sys.executable, "-m", "snakemake", "-s", str(REPO / "Snakefile")]
+    return subprocess.run(
+        [*command, "-d", str(project), "--configfile", "config/test.yaml", *args],
+        cwd=project,
+        capture_output=True,
+        text=True,
+        timeout=1800,
+    )
+
+
+def _made(project, sphere) -> set[str]:
+    folder = project / "results" / SMALL / "PS" / sphere
+    return {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def lab_run(small_run, tmp_path_factory):
+    """The run of the complete copy and of one copy per case, with its dry run and the check
+    command's plan made before it."""
+    tmp_path = tmp_path_factory.mktemp("own_data")
+    project = _project(tmp_path, small_run, {COMPLETE: []} | {n: c[0] for n, c in CASES.items()})
+    dry = _snakemake(project, "-n")
+    check = subprocess.run(
+        [sys.executable, "-m", "amontons.check", "--configfile", "config/test.yaml", "--json"],
+        cwd=project,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    run = _snakemake(project, "--cores", "2")
+    return project, dry, check, run
+
+
+def test_a_missing_file_stops_nothing_else(lab_run):
+    _, dry, _, run = lab_run
+    assert dry.returncode == 0, dry.stderr[-3000:]
+    assert run.returncode == 0, run.stderr[-3000:]
+
+
+@pytest.mark.parametrize("sphere", sorted(CASES))
+def test_a_sphere_lacks_exactly_what_needed_its_missing_file(lab_run, sphere):
+    project = lab_run[0]
+    lacking = CASES[sphere][1]
+    expected = {
+        name
+        for name in _made(project, COMPLETE)
+        if name not in lacking and not any(name.startswith(p) for p in lacking if p[-1] == "/")
+    }
+    assert _made(project, sphere) == expected
+
+
+# A solve's record holds its wall time, which no two runs share: compared without it.
+TIMINGS = ("wall_time_s",)
+
+
+def _without_timings(value):
+    if isinstance(value, dict):
+        return {k: _without_timings(v) for k, v in value.items() if k not in TIMINGS}
+    if isinstance(value, list):
+        return [_without_timings(v) for v in value]
+    return value
+
+
+def _same_bytes(project, sphere, name) -> bool:
+    """A record of ``sphere`` against the complete sphere's: the same bytes, once the sphere's
+    name and its folder's (which records cite) are the complete sphere's; a JSON record with
+    a wall time, the same values but that."""
+    root = project / "results" / SMALL / "PS"
+    text = (root / sphere / name).read_text().replace(sphere, COMPLETE)
+    complete = (root / COMPLETE / name).read_text()
+    if name.endswith(".json") and any(f'"{key}"' in complete for key in TIMINGS):
+        return _without_timings(json.loads(text)) == _without_timings(json.loads(complete))
+    return text == complete
+
+
+@pytest.mark.parametrize("sphere", sorted(CASES))
+def test_every_other_record_is_the_complete_spheres(lab_run, sphere):
+    """Tables and records (CSV, JSON) byte for byte; figures carry the sphere's name in their
+    titles, and the stand-in PSF changes the renderings of the sphere without a bead (they are
+    checked to differ, which shows the stand-in was used)."""
+    project = lab_run[0]
+    records = sorted(n for n in _made(project, sphere) if n.endswith((".csv", ".json")))
+    rendered = [n for n in records if n.startswith("scenes/elastic/") or n == "measure/psf.json"]
+    same = [n for n in records if n not in rendered or sphere != "PS-nobead"]
+    assert records and [n for n in same if not _same_bytes(project, sphere, n)] == []
+    if sphere == "PS-nobead":
+        assert rendered and not any(_same_bytes(project, sphere, n) for n in rendered)
+        psf = json.loads(
+            (project / "results" / SMALL / "PS" / sphere / "measure/psf.json").read_text()
+        )
+        assert psf["fwhm_nm"] == {"estimate": 500.0, "standard_error": 25.0}
+        assert psf["source"] == "config optics.psf.stand_in"
+
+
+def test_the_dry_run_says_what_each_sphere_will_not_get_and_why(lab_run):
+    stderr = lab_run[1].stderr
+    for sphere, (removed, _) in CASES.items():
+        line = next(line for line in stderr.splitlines() if f"sphere {sphere} (PS):" in line)
+        assert "will not be made" in line
+        assert removed[0].split(".")[0] in line  # names what it looked for
+    assert f"sphere {COMPLETE} " not in stderr
+
+
+def test_the_check_lists_what_the_run_then_makes(lab_run):
+    project, _, check, _ = lab_run
+    assert check.returncode == 0, check.stderr
+    for plan in json.loads(check.stdout):
+        folder = f"results/{SMALL}/PS/{plan['sphere']}/"
+        planned = {path.removeprefix(folder) for path in plan["outputs"]}
+        # the plan names what the targets ask for; intermediate files (fields, renders) are
+        # the run's own business
+        assert planned and planned <= _made(project, plan["sphere"])
+        lacking = CASES.get(plan["sphere"], ([], []))[1]
+        assert not planned & set(lacking)
+        assert bool(plan["left_out"]) == (plan["sphere"] in CASES)
+        assert all("pixel_nm" not in f or f["pixel_nm"] for f in plan["files"])
+
+
+def test_the_material_tables_hold_the_spheres_that_have_their_inputs(lab_run):
+    project = lab_run[0]
+    material = project / "results" / SMALL / "PS"
+    amontons = pd.read_csv(material / "amontons.csv")
+    assert set(amontons["sphere"]) == {COMPLETE, *CASES} - {"PS-norheometer"}
+    scenes = pd.read_csv(material / "scenes.csv")
+    assert set(scenes["sphere"]) == {COMPLETE, *CASES} - {"PS-noafm"}
+
+
+def test_one_corrupt_file_stops_only_its_sphere(small_run, tmp_path):
+    """Two spheres, one with a truncated fluorescence image: every output of the other is
+    made, and the run exits non-zero naming the file."""
+    project = _project(tmp_path, small_run, {COMPLETE: [], "PS-corrupt": []})
+    image = tmp_path / "lab" / "PS-corrupt" / "fluorescence" / "100.tif"
+    image.write_bytes(image.read_bytes()[:2000])
+    run = _snakemake(project, "--cores", "2")
+    assert run.returncode != 0
+    assert str(image) in run.stderr
+    check = subprocess.run(
+        [sys.executable, "-m", "amontons.check", "--configfile", "config/test.yaml", "--json"],
+        cwd=project,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
+    for path in plans[COMPLETE]["outputs"]:
+        assert (project / path).is_file(), path
+    errors = [f["error"] for f in plans["PS-corrupt"]["files"] if "error" in f]
+    assert errors and str(image) in errors[0]
