@@ -1,7 +1,8 @@
 """Rule plot_model_curves: appendix Fig. B.12 for one sphere. The measured contact area
 against load (symbols) with every model's curve: each scene (rendered Otsu area where it has
 optics, else the solver's real area: Greenwood-Tripp) and each scan's best value, with the
-power-law fit's exponent and its interval in the legend and the fit's 95 % band."""
+power-law fit's exponent and its interval in the legend and the fit's 95 % band. A scan's
+curve is the model at the grid's best value, named as such beside the scan's estimate."""
 
 import logging
 
@@ -11,6 +12,7 @@ import pandas as pd
 from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
+from amontons.simulate.scan import grid_best_text
 from amontons.study_figures import Curve, plot_area_curves
 
 log = logging.getLogger(__name__)
@@ -85,9 +87,10 @@ def main(
     for path in scans.values():
         best = read_json(path)
         rows = best["best_loads"]
-        series = f"{best['scene']}, best {best['parameter']} = {best['best']:g}"
+        # the CSV's series keeps its name; the legend names the grid's best as such
+        series = f"{best['scene']}, best {best['parameter']} = {best['grid_best']:g}"
         curve, summary = fitted_curve(
-            series,
+            f"{best['scene']} at {grid_best_text(best)}",
             [r["load_mn"] for r in rows],
             [r["simulated_area_um2"] for r in rows],
             confidence,
