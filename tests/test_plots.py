@@ -34,19 +34,29 @@ LONG_TITLE = " ".join([B11_TITLE] * 2)
 
 
 def overflowing_titles(fig) -> list[str]:
-    """The titles of ``fig`` that run past the figure (its title) or past their panel (an
-    axes' title), as the figure's renderer draws them now; 0.5 px: the renderer's rounding of
-    a glyph's extent."""
+    """The titles of ``fig`` that run past an edge of the figure, or over another panel's
+    title, as the figure's renderer draws them now; 0.5 px: the renderer's rounding of a
+    glyph's extent."""
     if not isinstance(fig.canvas, FigureCanvasAgg):  # a closed figure lost its canvas
         FigureCanvasAgg(fig)
     fig.draw_without_rendering()
     renderer = fig.canvas.get_renderer()
-    checks = [(fig._suptitle, fig.bbox)] if fig._suptitle is not None else []
-    checks += [(ax.title, ax.bbox) for ax in fig.axes if ax.title.get_text()]
+    frame = fig.bbox
+    titles = [fig._suptitle] if fig._suptitle is not None else []
+    titles += [ax.title for ax in fig.axes if ax.title.get_text()]
+    boxes = [title.get_window_extent(renderer) for title in titles]
     out = []
-    for title, frame in checks:
-        box = title.get_window_extent(renderer)
-        if box.x0 < frame.x0 - 0.5 or box.x1 > frame.x1 + 0.5 or box.y1 > fig.bbox.y1 + 0.5:
+    for i, (title, box) in enumerate(zip(titles, boxes, strict=True)):
+        outside = (
+            box.x0 < frame.x0 - 0.5
+            or box.x1 > frame.x1 + 0.5
+            or box.y0 < frame.y0 - 0.5
+            or box.y1 > frame.y1 + 0.5
+        )
+        overlapping = any(
+            box.overlaps(other) for j, other in enumerate(boxes) if j != i and i and j
+        )
+        if outside or overlapping:
             out.append(title.get_text())
     return out
 
@@ -104,9 +114,12 @@ def _height_maps(path):
 
 
 def _area_curves(path):
+    """Fig. B.12 as PS's full run draws it: seven fits in the legend, the scans' estimates in
+    the title."""
     loads = np.array([25.0, 50, 100, 200, 300])
-    curve = Curve("hardening at the grid's best k = 4.47 MPa/nm", loads, loads**0.86)
-    plot_area_curves(Curve("measured", loads, loads**0.87), [curve], LONG_TITLE, [path])
+    label = "penetration_hardness, grid's best p_Y = 179 MPa: α = 0.914 [0.898, 0.930]"
+    curves = [Curve(label, loads, loads ** (0.8 + i / 50)) for i in range(7)]
+    plot_area_curves(Curve("measured", loads, loads**0.87), curves, LONG_TITLE, [path])
 
 
 def _normalised_study(path):
