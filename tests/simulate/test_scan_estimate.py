@@ -94,5 +94,5 @@ def test_texts_give_the_estimate_its_interval_and_the_grid_best_by_name():
     assert estimate_text(glass) == (
         "k = 40000 MPa/nm (95% interval 2170 to open; grid's best 40000)"
     )
-    assert interval_text(None, None) == "open to open"
+    assert interval_text(None, None) == "open both ways"
     assert [significant(v) for v in (0.44721, 178.94, 2170.4)] == ["0.447", "179", "2170"]

@@ -54,6 +54,7 @@ __all__ = [
     "best_scan_value",
     "estimate_columns",
     "estimate_text",
+    "grid_best_label",
     "grid_best_text",
     "interval_text",
     "log_area_distance",
@@ -280,7 +281,10 @@ def significant(value: float, digits: int = 3) -> str:
 
 
 def interval_text(low: float | None, high: float | None) -> str:
-    """A scan's interval as '4.61–6.13'; with an end the scan does not bound, '2170 to open'."""
+    """A scan's interval as '4.61–6.13'; with an end the scan does not bound, '2170 to open',
+    and with neither, 'open both ways'."""
+    if low is None and high is None:
+        return "open both ways"
     ends = ["open" if end is None else significant(end) for end in (low, high)]
     return (" to " if None in (low, high) else "–").join(ends)
 
@@ -308,3 +312,10 @@ def grid_best_text(best: Mapping) -> str:
         f"{significant(best['estimate'])}, {best['confidence']:.0%} interval "
         f"{interval_text(low, high)})"
     )
+
+
+def grid_best_label(best: Mapping) -> str:
+    """The grid's best value of a best.json record, short, for a legend or a panel
+    ("grid's best k = 4.47 MPa/nm")."""
+    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    return f"grid's best {symbol} = {significant(best['grid_best'])} {unit}"
