@@ -29,13 +29,14 @@ include: "workflow/rules/surface.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/study.smk"
 include: "workflow/rules/accuracy.smk"
+include: "workflow/rules/summary.smk"
 
 
 # Default target: every output of every selected material.
 rule all:
     default_target: True
     input:
-        material_outputs(MATERIALS) + study_overview_outputs(),
+        material_outputs(MATERIALS) + study_overview_outputs() + SUMMARY_OUTPUTS,
     localrule: True
 
 
