@@ -24,7 +24,7 @@ from amontons.simulate.flattening import (
     offset_from_centre_m,
     window_slices,
 )
-from amontons.simulate.scan import grid_best_text
+from amontons.simulate.scan import grid_best_label, grid_best_text
 from amontons.study_figures import MapPanel, plot_height_maps
 
 log = logging.getLogger(__name__)
@@ -98,7 +98,7 @@ def main(
         MapPanel(after * 1e9, _title("b) AFM after", depth), core, centre, pixel_um=afm_um),
         MapPanel(
             deformed * 1e9,
-            _title(f"c) hardening, grid's best k = {best['grid_best']:g} MPa/nm", sim_depth),
+            _title(f"c) hardening, {grid_best_label(best)}", sim_depth),
             sim_core,
             sim_centre,
             pixel_um=solver_pixel * 1e6,

@@ -19,7 +19,7 @@ from amontons.runlog import run_logged
 from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.register import Registration, warp_to_measured
 from amontons.simulate.render import area_fraction_map
-from amontons.simulate.scan import grid_best_text
+from amontons.simulate.scan import grid_best_text, significant
 from amontons.study_figures import MapPanel, crop_box, plot_map_grid
 
 log = logging.getLogger(__name__)
@@ -118,7 +118,7 @@ def main(
             "experiment",
             "Greenwood-Tripp\n(area fraction)",
             "elastic",
-            f"hardening\ngrid's best\nk = {best['grid_best']:g} MPa/nm",
+            f"hardening\ngrid's best\nk = {significant(best['grid_best'])} MPa/nm",
         ],
         pixel_nm * 1e-3,
         f"{label}: measured and simulated contact at increasing loads; hardening at "
