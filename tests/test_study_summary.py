@@ -19,6 +19,7 @@ from amontons.study_summary import (  # noqa: E402
     markdown_table,
     matching_models,
     report_page,
+    scan_headline,
     verdict_rows,
     verdict_text,
 )
@@ -105,8 +106,13 @@ def test_models_inside_the_measured_interval_are_all_named_and_none_singled_out(
     assert verdict_text({"matching": ""}) == "no model"
 
 
+def test_a_best_json_without_the_estimate_is_named():
+    with pytest.raises(SummaryError, match=r"scans/k/best\.json: no 'estimate'.*--forcerun"):
+        scan_headline("PS", {"best": 4.472, "scatter_interval": [4.6, 6.0]}, "PS/scans/k/best.json")
+
+
 def test_a_table_that_is_not_a_model_table_is_named():
-    with pytest.raises(SummaryError, match=r"results/x/PS/models\.csv: no column .*exponent"):
+    with pytest.raises(SummaryError, match=r"results/x/PS/models\.csv: no column .*'estimate'"):
         verdict_rows(
             pd.DataFrame({"sphere": ["PS"], "model": ["elastic"]}), "PS", "results/x/PS/models.csv"
         )

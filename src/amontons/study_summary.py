@@ -32,6 +32,22 @@ MODELS = {
 }
 # The scanned parameter of each plastic model.
 MODEL_PARAMETERS = {"hardening": "k_mpa_per_nm", "penetration_hardness": "p_y_mpa"}
+# The model-table columns the verdict reads.
+MODEL_TABLE_COLUMNS = (
+    "sphere",
+    "model",
+    "source",
+    "value",
+    "estimate",
+    "estimate_low",
+    "estimate_high",
+    "exponent",
+    "exponent_difference",
+    "measured_exponent",
+    "measured_ci_low",
+    "measured_ci_high",
+    "area_ratio_largest",
+)
 # verdict.csv's column stem of a scanned parameter.
 PARAMETER_STEMS = {"k_mpa_per_nm": "k", "p_y_mpa": "p_y"}
 
@@ -76,9 +92,13 @@ def verdict_rows(table: pd.DataFrame, material: str, source: str) -> list[dict]:
     it comes from; per scanned parameter, the estimate, its interval (None: open) and the
     grid's best; and ``matching``: the models whose exponent lies inside the measured
     interval, ';'-separated."""
-    missing = {"sphere", "model", "source", "exponent", "measured_exponent"} - set(table)
+    missing = set(MODEL_TABLE_COLUMNS) - set(table)
     if missing:
-        raise SummaryError(f"{source}: no column {sorted(missing)}; expected a models.csv")
+        raise SummaryError(
+            f"{source}: no column {sorted(missing)}; expected a models.csv of rule "
+            "tabulate_models with the scans' estimates (one written before them: rerun it, "
+            "snakemake --forcerun best_scan_value)"
+        )
     rows = []
     for sphere, own in table.groupby("sphere", sort=False):
         first = own.iloc[0]
@@ -307,6 +327,12 @@ def measured_headline(sphere: str, fit: Mapping, path: str) -> Headline:
 
 def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
     """A scan's estimate with its interval and the grid's best (best.json)."""
+    if "estimate" not in best or "grid_best" not in best:
+        raise SummaryError(
+            f"{path}: no 'estimate' or 'grid_best'; expected a best.json of rule "
+            "best_scan_value that states the scan's estimate (rerun it, snakemake "
+            "--forcerun best_scan_value)"
+        )
     symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
     low, high = best["scatter_interval"]
     edge = "; the grid's best is at the scan's end" if best["at_scan_edge"] else ""
