@@ -31,13 +31,16 @@ include: "workflow/rules/surface.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/study.smk"
 include: "workflow/rules/accuracy.smk"
+include: "workflow/rules/summary.smk"
 
 
 # Default target: every output of every selected material.
 rule all:
     default_target: True
     input:
-        TARGETS.material(MATERIALS) + RUN.study.overview_outputs(),
+        TARGETS.material(MATERIALS)
+        + RUN.study.overview_outputs()
+        + RUN.summary.outputs(),
     localrule: True
 
 

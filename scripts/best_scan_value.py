@@ -1,5 +1,6 @@
 """Rule best_scan_value: a sphere's scan judged (docs/study.md): every value's distance from
-the measured areas, the best value and its brackets."""
+the measured areas, the scan's estimate with its interval, and the grid's best value with its
+brackets."""
 
 import logging
 
@@ -34,13 +35,14 @@ def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str
     ]
     best = best_scan_value(points, scatter, len(measured), confidence)
     log.info(
-        "%s: best %s = %g (D = %.4f; scan bracket %s, scatter interval %s)",
+        "%s: %s = %g, interval %s; grid's best %g (D = %.4f; scan bracket %s)",
         scan_name,
         records[0]["parameter"],
+        best.refined,
+        [best.scatter_low, best.scatter_high],
         best.value,
         best.distance,
         [best.resolution_low, best.resolution_high],
-        [best.scatter_low, best.scatter_high],
     )
     rows = []
     for record in records:

@@ -1,6 +1,7 @@
 """Rule plot_amontons_study: appendix Fig. B.13 across materials. Contact area and static
 friction over their values at the reference load, against load, for every sphere of every
-selected material, with each sphere's hardening model at the k scan's best k."""
+selected material, with each sphere's hardening model at the k scan's grid's best k (the
+scanned value of least distance, docs/study.md §1)."""
 
 import logging
 
@@ -52,7 +53,7 @@ def main(amontons_paths, best_paths: dict, table_path, figure_paths, reference_l
                 "load_over_ref": xi,
                 "area_over_ref": a,
                 "friction_over_ref": None,
-                "best_k_mpa_per_nm": best["best"],
+                "best_k_mpa_per_nm": best["grid_best"],
             }
             for xi, a in zip(*models[sphere], strict=True)
         ]
@@ -62,7 +63,7 @@ def main(amontons_paths, best_paths: dict, table_path, figure_paths, reference_l
         models,
         reference_load_mn,
         f"Deviation from Amontons' law, normalised at {reference_load_mn:g} mN ({label}); "
-        "lines: hardening model at each sphere's best k",
+        "lines: hardening model at each sphere's grid's best k",
         figure_paths,
     )
 

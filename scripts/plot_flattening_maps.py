@@ -1,10 +1,11 @@
 """Rule plot_flattening_maps: appendix Fig. B.9 for one sphere. The AFM map before and after
 the load series, and the deformed surface h + h_pl of the hardening model at the k scan's
-best k after the largest load; sphere curvature subtracted from all three, all in the AFM
-frame cut to the solver window about the fitted apex. Each shows the flattening: measured,
-where after − before drops (amontons.measure.flattening); simulated, where h_pl < 0; its
-depth (the median drop over the pixels that went down by more than half of it, the same
-definition for both) and the centre of the flattened region."""
+grid's best k (the scanned value of least distance, docs/study.md §1) after the largest
+load; sphere curvature subtracted from all three, all in the AFM frame cut to the solver
+window about the fitted apex. Each shows the flattening: measured, where after − before drops
+(amontons.measure.flattening); simulated, where h_pl < 0; its depth (the median drop over the
+pixels that went down by more than half of it, the same definition for both) and the centre
+of the flattened region."""
 
 import logging
 
@@ -23,6 +24,7 @@ from amontons.simulate.flattening import (
     offset_from_centre_m,
     window_slices,
 )
+from amontons.simulate.scan import grid_best_label, grid_best_text
 from amontons.study_figures import MapPanel, plot_height_maps
 
 log = logging.getLogger(__name__)
@@ -62,7 +64,9 @@ def main(
         line_levelling=line_levelling_mode(afm["line_levelling"]),
     )
     best = read_json(k_scan["best"])
-    path = next(p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["best"])
+    path = next(
+        p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["grid_best"]
+    )
     fields, _, attrs = read_load_series(path)
     last = fields[-1]
     solver_pixel = attrs["pixel_nm"] * 1e-9
@@ -94,7 +98,7 @@ def main(
         MapPanel(after * 1e9, _title("b) AFM after", depth), core, centre, pixel_um=afm_um),
         MapPanel(
             deformed * 1e9,
-            _title(f"c) hardening, k = {best['best']:g} MPa/nm", sim_depth),
+            _title(f"c) hardening, {grid_best_label(best)}", sim_depth),
             sim_core,
             sim_centre,
             pixel_um=solver_pixel * 1e6,
@@ -114,15 +118,15 @@ def main(
         ),
     ]
     table = pd.DataFrame(rows)
-    table["best_k_mpa_per_nm"] = best["best"]
+    table["best_k_mpa_per_nm"] = best["grid_best"]
     table["load_mn"] = read_load_series(path)[1][-1]["load_mn"]
     write_table(table_path, table)
     log.info("\n%s", table.to_string(index=False))
     plot_height_maps(
         panels,
         f"{label}: AFM before and after the load series, and the hardening model's deformed "
-        f"surface (best k = {best['best']:g} MPa/nm); sphere subtracted; outlines: flattened "
-        "regions, +: their centres",
+        f"surface at {grid_best_text(best)}; sphere subtracted; outlines: flattened regions, "
+        "+: their centres",
         figure_paths,
     )
 

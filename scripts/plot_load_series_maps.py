@@ -1,7 +1,8 @@
 """Rule plot_load_series_maps: appendix Figs. 5.2 and B.11 for one sphere. Measured and
 simulated contact at increasing loads: the experiment, Greenwood-Tripp (its mean-field
 real-area fraction: the model has no asperity map), the elastic scene and the hardening
-model at the best k of the k scan, each simulation warped onto the measured image by its
+model at the k scan's grid's best k (the scanned value of least distance, docs/study.md
+§1), each simulation warped onto the measured image by its
 scene's registration."""
 
 import logging
@@ -18,6 +19,7 @@ from amontons.runlog import run_logged
 from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.register import Registration, warp_to_measured
 from amontons.simulate.render import area_fraction_map
+from amontons.simulate.scan import grid_best_text, significant
 from amontons.study_figures import MapPanel, crop_box, plot_map_grid
 
 log = logging.getLogger(__name__)
@@ -55,7 +57,7 @@ def main(
     box = crop_box(measured[-1].mask)
     best = read_json(k_scan["best"])
     best_path = next(
-        p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["best"]
+        p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["grid_best"]
     )
     hardening_registration = Registration.from_record(read_json(k_scan["registration"]))
     elastic_registration = Registration.from_record(read_json(elastic["registration"]))
@@ -108,7 +110,7 @@ def main(
                 }
             )
     table = pd.DataFrame(records)
-    table["best_k_mpa_per_nm"] = best["best"]
+    table["best_k_mpa_per_nm"] = best["grid_best"]
     write_table(table_path, table)
     plot_map_grid(
         list(rows.values()),
@@ -116,11 +118,11 @@ def main(
             "experiment",
             "Greenwood-Tripp\n(area fraction)",
             "elastic",
-            f"hardening\nk = {best['best']:g} MPa/nm",
+            f"hardening\ngrid's best\nk = {significant(best['grid_best'])} MPa/nm",
         ],
         pixel_nm * 1e-3,
-        f"{label}: measured and simulated contact at increasing loads (hardening at the k "
-        f"scan's best k = {best['best']:g} MPa/nm); outlines: Otsu masks",
+        f"{label}: measured and simulated contact at increasing loads; hardening at "
+        f"{grid_best_text(best)}; outlines: Otsu masks",
         figure_paths,
     )
 

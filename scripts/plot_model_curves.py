@@ -1,7 +1,9 @@
 """Rule plot_model_curves: appendix Fig. B.12 for one sphere. The measured contact area
 against load (symbols) with every model's curve: each scene (rendered Otsu area where it has
 optics, else the solver's real area: Greenwood-Tripp) and each scan's best value, with the
-power-law fit's exponent and its interval in the legend and the fit's 95 % band."""
+power-law fit's exponent and its interval in the legend and the fit's 95 % band. A scan's
+curve is the model at the grid's best value, named as such; the title gives the scans'
+estimates with their intervals."""
 
 import logging
 
@@ -11,6 +13,7 @@ import pandas as pd
 from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
+from amontons.simulate.scan import estimate_text, grid_best_label
 from amontons.study_figures import Curve, plot_area_curves
 
 log = logging.getLogger(__name__)
@@ -82,12 +85,15 @@ def main(
             {"series": f"scene {name}", "area": kind, "load_mn": f, "area_um2": a, **summary}
             for f, a in zip(curve.loads_mn, curve.areas_um2, strict=True)
         ]
+    estimates = []
     for path in scans.values():
         best = read_json(path)
+        estimates.append(estimate_text(best))
         rows = best["best_loads"]
-        series = f"{best['scene']}, best {best['parameter']} = {best['best']:g}"
+        # the CSV's series keeps its name; the legend names the grid's best as such
+        series = f"{best['scene']}, best {best['parameter']} = {best['grid_best']:g}"
         curve, summary = fitted_curve(
-            series,
+            f"{best['scene']}, {grid_best_label(best)}",
             [r["load_mn"] for r in rows],
             [r["simulated_area_um2"] for r in rows],
             confidence,
@@ -102,7 +108,8 @@ def main(
     plot_area_curves(
         points,
         curves,
-        f"{label}: measured contact area and every model's ({confidence:.0%} bands)",
+        f"{label}: measured contact area and every model's ({confidence:.0%} bands); scans' "
+        f"estimates: {'; '.join(estimates)}",
         figure_paths,
     )
 

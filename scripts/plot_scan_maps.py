@@ -14,6 +14,7 @@ from amontons.io.rawdata import read_fluorescence_series
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
 from amontons.simulate.register import Registration, warp_to_measured
+from amontons.simulate.scan import estimate_text
 from amontons.study_figures import MapPanel, crop_box, plot_map_grid
 
 log = logging.getLogger(__name__)
@@ -37,7 +38,7 @@ def main(
     box = crop_box(contact.mask)
     rows = [[MapPanel(measured.data[box], f"measured, {loads_mn[-1]:g} mN", contact.mask[box])]]
     labels = ["experiment"]
-    records = []
+    records, estimates = [], []
     for name, scan in scans.items():
         best = read_json(scan["best"])
         table = pd.read_csv(scan["table"]).set_index("value")
@@ -54,7 +55,7 @@ def main(
                 "log_area_distance": row["log_area_distance"],
                 "iou_largest": row["iou_largest"],
                 "area_ratio_largest": row["area_ratio_largest"],
-                "best": value == best["best"],
+                "best": value == best["grid_best"],
                 "contact_leaves_window": not fields,
                 "load_mn": loads_mn[-1],
             }
@@ -78,15 +79,16 @@ def main(
         rows.append(panels)
         symbol = {"p_y_mpa": "p_Y (MPa)", "k_mpa_per_nm": "k (MPa/nm)"}[best["parameter"]]
         labels.append(f"{best['scene']}\n{symbol}")
-        log.info("%s: best %s = %g", name, best["parameter"], best["best"])
+        log.info("%s: %s", name, estimate_text(best))
+        estimates.append(estimate_text(best))
     write_table(table_path, pd.DataFrame(records))
-    bests = ", ".join(f"{r['parameter']} = {r['value']:g}" for r in records if r["best"])
     plot_map_grid(
         rows,
         labels,
         pixel_nm * 1e-3,
         f"{label}: contact at {loads_mn[-1]:g} mN, measured and simulated over the scans; "
-        f"best (framed): {bests}; D: rms log-area distance over all loads",
+        f"framed: the grid's best value; estimates: {'; '.join(estimates)}; D: rms log-area "
+        "distance over all loads",
         figure_paths,
     )
 

@@ -1,5 +1,10 @@
 """Rule tabulate_models: the model-comparison table of one material (docs/study.md): every
-scene and every scan's best value against the measured load-area exponent, per sphere."""
+scene and every scan's best value against the measured load-area exponent, per sphere.
+
+A scan's row is the model at the grid's best value (``value``: what was solved, so the
+exponent, area ratio and IoU are its), with the scan's estimate and the interval that belongs
+to it (``estimate``, ``estimate_low``, ``estimate_high``); the grid's best may lie outside
+that interval (docs/study.md §1)."""
 
 import logging
 
@@ -8,29 +13,57 @@ import pandas as pd
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
 from amontons.simulate.fits import model_table_rows
+from amontons.simulate.scan import estimate_columns
 
 log = logging.getLogger(__name__)
+
+# model_table_rows gives a scan row the interval as value_low/value_high, beside the grid's
+# best in `value`, which it need not hold; the table gives it beside the estimate instead.
+_VALUE_INTERVAL = ("value_low", "value_high")
 
 
 def _largest_row(path: str | None) -> dict | None:
     return None if path is None else pd.read_csv(path).iloc[-1].to_dict()
 
 
-def main(inputs: dict, table_path: str, spheres: list[str], models: dict) -> None:
-    rows = []
-    for sphere in spheres:
-        own = inputs[sphere]
-        scenes = {
-            name: {
-                "fit": read_json(files["fit"]),
-                "solve": read_json(files["solve"]),
-                "largest": _largest_row(files.get("comparison")),
-            }
-            for name, files in own["scenes"].items()
+def with_estimate(row: dict, best: dict | None) -> dict:
+    """``row`` with the scan's estimate and its interval after ``value`` (empty for a scene)
+    in place of the interval beside the grid's best."""
+    out = {}
+    for key, cell in row.items():
+        if key in _VALUE_INTERVAL:
+            continue
+        out[key] = cell
+        if key == "value":
+            out.update(estimate_columns(best))
+    return out
+
+
+def sphere_rows(sphere: str, files: dict, models: dict) -> list[dict]:
+    """The model-table rows of one sphere: its scenes, then its scans' best values."""
+    measured = read_json(files["measured"])
+    scenes = {
+        name: {
+            "fit": read_json(own["fit"]),
+            "solve": read_json(own["solve"]),
+            "largest": _largest_row(own.get("comparison")),
         }
-        bests = {name: read_json(path) for name, path in own["scans"].items()}
-        rows += model_table_rows(sphere, read_json(own["measured"]), scenes, bests, models)
-    table = pd.DataFrame(rows)
+        for name, own in files["scenes"].items()
+    }
+    rows = [
+        with_estimate(row, None) for row in model_table_rows(sphere, measured, scenes, {}, models)
+    ]
+    for name, path in files["scans"].items():
+        best = read_json(path)
+        (row,) = model_table_rows(sphere, measured, {}, {name: best}, models)
+        rows.append(with_estimate(row, best))
+    return rows
+
+
+def main(inputs: dict, table_path: str, spheres: list[str], models: dict) -> None:
+    table = pd.DataFrame(
+        [row for sphere in spheres for row in sphere_rows(sphere, inputs[sphere], models)]
+    )
     log.info("\n%s", table.to_string(index=False))
     write_table(table_path, table)
 

@@ -42,8 +42,88 @@ def plot_normalised_load_area(
     _save(fig, paths)
 
 
+# Rounds of wrapping and layout fit_titles runs at most: a wrap makes a title taller and the
+# layout moves the axes, which may call for one more wrap.
+TITLE_ROUNDS = 4
+# The share of the figure's width a title may take (the rest: a margin at either edge).
+TITLE_WIDTH = 0.98
+
+
+def _text_width_px(renderer, text: str, properties) -> float:
+    return renderer.get_text_width_height_descent(text, properties, ismath=False)[0]
+
+
+def wrap_to_width(text: str, width_px: float, renderer, properties) -> str:
+    """``text`` with each of its lines broken between words so that every line is at most
+    ``width_px`` wide as ``renderer`` draws it in ``properties`` (display pixels). A single
+    word wider than that stays on a line of its own."""
+    lines = []
+    for paragraph in text.split("\n"):
+        line = ""
+        for word in paragraph.split(" "):
+            candidate = f"{line} {word}" if line else word
+            if line and _text_width_px(renderer, candidate, properties) > width_px:
+                lines.append(line)
+                line = word
+            else:
+                line = candidate
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def _room_px(fig, ax) -> float:
+    """The width an axes' title may take, centred over its axes as matplotlib draws it: to
+    the nearer edge of the figure (less the margin) on either side, and no more than the
+    distance to the centre of the nearest panel beside it, so that two neighbours' titles
+    cannot meet."""
+    frame = fig.bbox
+    margin = frame.width * (1 - TITLE_WIDTH) / 2
+    centre = (ax.bbox.x0 + ax.bbox.x1) / 2
+    room = 2 * min(centre - frame.x0 - margin, frame.x1 - margin - centre)
+    for other in fig.axes:
+        beside = other.bbox.y0 < ax.bbox.y1 and ax.bbox.y0 < other.bbox.y1
+        if other is not ax and other.title.get_text() and beside:
+            room = min(room, abs((other.bbox.x0 + other.bbox.x1) / 2 - centre))
+    return room
+
+
+def _titles(fig):
+    """(title, the width in display pixels it must fit) for the figure's title (the figure's
+    width less the margin) and each axes' title (_room_px)."""
+    # Figure.get_suptitle gives the string only; the Text artist is the figure's _suptitle.
+    suptitle = getattr(fig, "_suptitle", None)
+    if suptitle is not None and suptitle.get_text():
+        yield suptitle, fig.bbox.width * TITLE_WIDTH
+    for ax in fig.axes:
+        if ax.get_visible() and ax.title.get_text():
+            yield ax.title, _room_px(fig, ax)
+
+
+def fit_titles(fig) -> None:
+    """Wrap the figure's title to the figure's width and each axes' title to the room it has
+    (_room_px), between words, keeping the line breaks they have, then lay the figure out
+    again: a title never runs past the edge of the figure, nor over the next panel's.
+    Measured with the figure's own renderer, so the font and its size decide, not a count of
+    characters."""
+    for _ in range(TITLE_ROUNDS):
+        fig.draw_without_rendering()
+        renderer = fig.canvas.get_renderer()
+        changed = False
+        for title, width_px in _titles(fig):
+            wrapped = wrap_to_width(
+                title.get_text(), width_px, renderer, title.get_fontproperties()
+            )
+            if wrapped != title.get_text():
+                title.set_text(wrapped)
+                changed = True
+        if not changed:
+            return
+
+
 def _save(fig, paths: list[str]) -> None:
-    """Write ``fig`` to each path (format from the extension), atomically, and close it."""
+    """Fit the titles (fit_titles), then write ``fig`` to each path (format from the
+    extension), atomically, and close it."""
+    fit_titles(fig)
     for path in paths:
         with atomic_path(path) as tmp:
             fig.savefig(tmp, dpi=150, format=str(path).rsplit(".", 1)[-1])

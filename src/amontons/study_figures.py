@@ -10,8 +10,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import textwrap  # noqa: E402
-
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
@@ -43,10 +41,6 @@ def crop_box(mask: np.ndarray, margin: float = 0.35) -> tuple[slice, slice]:
     half = (1 + 2 * margin) * max(rows.max() - rows.min(), cols.max() - cols.min()) / 2 + 2
     r0, c0 = (int(max(0, c - half)) for c in centre)
     return slice(r0, int(centre[0] + half) + 1), slice(c0, int(centre[1] + half) + 1)
-
-
-def _wrapped(title: str, width: int) -> str:
-    return "\n".join(textwrap.wrap(title, width))
 
 
 def _plain_log_ticks(ax) -> None:
@@ -103,7 +97,11 @@ def plot_map_grid(
     in the caption line. Figs. B.8 and B.11 (5.2)."""
     n_rows, n_cols = len(rows), max(len(r) for r in rows)
     fig, axes = plt.subplots(
-        n_rows, n_cols, figsize=(1.6 * n_cols + 0.8, 1.7 * n_rows + 0.6), squeeze=False
+        n_rows,
+        n_cols,
+        figsize=(1.6 * n_cols + 0.8, 1.7 * n_rows + 0.6),
+        squeeze=False,
+        constrained_layout=True,
     )
     limits = None
     if shared_limits:
@@ -120,15 +118,16 @@ def plot_map_grid(
             if c == 0:
                 ax.set_ylabel(label, fontsize=7)
     side = rows[0][0].image.shape[1] * pixel_um if rows[0][0] is not None else 0
-    fig.suptitle(_wrapped(f"{title} (each panel {side:.0f} µm wide)", 40 + 25 * n_cols), fontsize=8)
-    fig.tight_layout()
+    fig.suptitle(f"{title} (each panel {side:.0f} µm wide)", fontsize=8)
     _save(fig, paths)
 
 
 def plot_height_maps(panels: Sequence[MapPanel], title: str, paths: list[str]) -> None:
     """Fig. B.9: height maps (nm; each panel with its own ``pixel_um``) side by side on one
     colour scale, each with the flattened region outlined and its centre marked."""
-    fig, axes = plt.subplots(1, len(panels), figsize=(3.2 * len(panels), 3.6), squeeze=False)
+    fig, axes = plt.subplots(
+        1, len(panels), figsize=(3.2 * len(panels), 3.6), squeeze=False, constrained_layout=True
+    )
     values = np.concatenate([p.image.ravel() for p in panels])
     limits = tuple(np.percentile(values, [1, 99]))
     for ax, panel in zip(axes[0], panels, strict=True):
@@ -136,7 +135,7 @@ def plot_height_maps(panels: Sequence[MapPanel], title: str, paths: list[str]) -
     side = panels[0].image.shape[1] * panels[0].pixel_um
     mappable = plt.cm.ScalarMappable(norm=matplotlib.colors.Normalize(*limits), cmap="viridis")
     fig.colorbar(mappable, ax=list(axes[0]), shrink=0.8, label="height (nm)")
-    fig.suptitle(_wrapped(f"{title} (each panel {side:.1f} µm wide)", 110), fontsize=8)
+    fig.suptitle(f"{title} (each panel {side:.1f} µm wide)", fontsize=8)
     _save(fig, paths)
 
 
@@ -182,7 +181,7 @@ def plot_area_curves(
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     _plain_log_ticks(ax)
-    ax.set_title(_wrapped(title, 70), fontsize=8)
+    ax.set_title(title, fontsize=8)
     ax.legend(fontsize=6)
     _save(fig, paths)
 
@@ -214,5 +213,5 @@ def plot_normalised_study(
         amontons_axes(ax, span, reference_load_mn, label, name, legend_size=6)
     for ax in axes:
         _plain_log_ticks(ax)
-    fig.suptitle(_wrapped(title, 110), fontsize=9)
+    fig.suptitle(title, fontsize=9)
     _save(fig, paths)

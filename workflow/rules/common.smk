@@ -13,6 +13,11 @@ from amontons.workflow.params import (
     sorted_keys,
 )
 from amontons.workflow.paths import (
+    AMONTONS_FIGURE,
+    B10_FIGURE,
+    B12_FIGURE,
+    B13_FIGURE,
+    MODELS_TABLE,
     BEST,
     COMPARISON,
     COMPARISON_FIGURE,
@@ -109,6 +114,9 @@ measured_runtime = RUN.resources.runtime
 measured_mem_mb = RUN.resources.mem_mb
 solve_runtime = RUN.resources.solve_runtime
 solve_mem_mb = RUN.resources.solve_mem_mb
+
+# The run's answer (amontons.workflow.summary, docs/study.md §6).
+SUMMARY = RUN.summary
 
 # The accuracy study (docs/accuracy.md).
 ACCURACY_SPHERE = RUN.accuracy.sphere

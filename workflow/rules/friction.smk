@@ -35,18 +35,18 @@ rule plot_amontons_deviation:
         friction=lambda wc: TARGETS.per_sphere(wc.material, FRICTION, having=RHEOMETER),
     output:
         table=report(
-            f"{MATERIAL}/amontons.csv",
+            f"{MATERIAL}/{AMONTONS_FIGURE}.csv",
             caption="../report/amontons.rst",
             category="Amontons deviation",
             subcategory="{material}",
         ),
         png=report(
-            f"{MATERIAL}/amontons.png",
+            f"{MATERIAL}/{AMONTONS_FIGURE}.png",
             caption="../report/amontons.rst",
             category="Amontons deviation",
             subcategory="{material}",
         ),
-        pdf=f"{MATERIAL}/amontons.pdf",
+        pdf=f"{MATERIAL}/{AMONTONS_FIGURE}.pdf",
     log:
         f"{MATERIAL_LOGS}/plot_amontons_deviation.log",
     benchmark:

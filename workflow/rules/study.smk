@@ -69,7 +69,7 @@ rule tabulate_models:
         lambda wc: flat_files(RUN.study.model_table_layout(wc.material)),
     output:
         table=report(
-            f"{MATERIAL}/models.csv",
+            f"{MATERIAL}/{MODELS_TABLE}",
             caption="../report/models_table.rst",
             category="Study",
             subcategory="{material}",
@@ -202,14 +202,14 @@ rule plot_model_curves:
         measured=rules.measure_contact_area.output.table,
         measured_fit=rules.fit_load_area.output.fit,
     output:
-        table=f"{STUDY}/B12_models.csv",
+        table=f"{STUDY}/{B12_FIGURE}.csv",
         png=report(
-            f"{STUDY}/B12_models.png",
+            f"{STUDY}/{B12_FIGURE}.png",
             caption="../report/study_b12.rst",
             category="Study",
             subcategory="{material}",
         ),
-        pdf=f"{STUDY}/B12_models.pdf",
+        pdf=f"{STUDY}/{B12_FIGURE}.pdf",
     log:
         f"{STUDY_LOGS}/plot_model_curves.log",
     benchmark:
@@ -234,14 +234,14 @@ rule plot_curvature_study:
         solves=list(RUN.study.curvature_files(SOLVE).values()),
         fits=list(RUN.study.curvature_files(SCENE_FIT).values()),
     output:
-        table=f"{STUDY_RESULTS}/B10_curvature.csv",
+        table=f"{STUDY_RESULTS}/{B10_FIGURE}.csv",
         png=report(
-            f"{STUDY_RESULTS}/B10_curvature.png",
+            f"{STUDY_RESULTS}/{B10_FIGURE}.png",
             caption="../report/study_b10.rst",
             category="Study",
             subcategory="synthetic surfaces",
         ),
-        pdf=f"{STUDY_RESULTS}/B10_curvature.pdf",
+        pdf=f"{STUDY_RESULTS}/{B10_FIGURE}.pdf",
     log:
         f"{LOGS}/study/plot_curvature_study.log",
     benchmark:
@@ -268,14 +268,14 @@ rule plot_amontons_study:
         ),
         bests=list(RUN.study.k_bests(MATERIALS).values()),
     output:
-        table=f"{STUDY_RESULTS}/B13_amontons.csv",
+        table=f"{STUDY_RESULTS}/{B13_FIGURE}.csv",
         png=report(
-            f"{STUDY_RESULTS}/B13_amontons.png",
+            f"{STUDY_RESULTS}/{B13_FIGURE}.png",
             caption="../report/study_b13.rst",
             category="Study",
             subcategory="all materials",
         ),
-        pdf=f"{STUDY_RESULTS}/B13_amontons.pdf",
+        pdf=f"{STUDY_RESULTS}/{B13_FIGURE}.pdf",
     log:
         f"{LOGS}/study/plot_amontons_study.log",
     benchmark:

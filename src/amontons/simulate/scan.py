@@ -30,6 +30,12 @@ Brackets, two of them:
   points. Where the interval reaches the end of the scan, that side is open (``None``): the
   data do not bound the parameter there (glass: no value of k within the scan changes its
   contact).
+
+The scan's **estimate** is the refined value: the interval is the one about the parabola's
+vertex, so it always holds the estimate. The grid's best value need not lie inside it: χ² at
+the grid point lies above the vertex's by the parabola's rise over the grid step, which can
+exceed the χ² quantile (docs/study.md §4: PS's k). The grid's best is what was solved and
+rendered, so the figures and the model table show the model at it, named as the grid's best.
 """
 
 from __future__ import annotations
@@ -46,10 +52,16 @@ __all__ = [
     "ScanError",
     "ScanPoint",
     "best_scan_value",
+    "estimate_columns",
+    "estimate_text",
+    "grid_best_label",
+    "grid_best_text",
+    "interval_text",
     "log_area_distance",
     "log_area_scatter",
     "scan_values",
     "scene_config_at",
+    "significant",
     "value_label",
 ]
 
@@ -57,6 +69,8 @@ PARAMETERS = {
     "p_y_mpa": "penetration_hardness",
     "k_mpa_per_nm": "hardening",
 }
+# How a parameter is written in figures and tables: symbol and unit.
+PARAMETER_SYMBOLS = {"p_y_mpa": ("p_Y", "MPa"), "k_mpa_per_nm": ("k", "MPa/nm")}
 # The sheet column a parameter's scan range is centred on.
 SHEET_COLUMNS = {"p_y_mpa": "hardness_mpa", "k_mpa_per_nm": "hardening_k_mpa_per_nm"}
 # Relative difference in D below which two values count as equally good (tie-break: IoU).
@@ -127,12 +141,16 @@ class ScanBest:
     at_scan_edge: bool
 
     def to_record(self) -> dict:
+        """best.json's judgement: the scan's estimate inside its own interval first, then the
+        grid's best (the scanned value the figures and the model table show), under the name
+        ``grid_best`` and under its former name ``best``."""
         return {
-            "best": self.value,
-            "refined": self.refined,
-            "distance": self.distance,
-            "resolution_bracket": [self.resolution_low, self.resolution_high],
+            "estimate": self.refined,
             "scatter_interval": [self.scatter_low, self.scatter_high],
+            "grid_best": self.value,
+            "best": self.value,
+            "resolution_bracket": [self.resolution_low, self.resolution_high],
+            "distance": self.distance,
             "measured_log_area_sd": self.scatter_sd,
             "log_area_sd_used": self.scatter_sd_used,
             "n_loads": self.n_loads,
@@ -140,11 +158,18 @@ class ScanBest:
             "at_scan_edge": self.at_scan_edge,
             "criterion": "least root-mean-square distance of ln(rendered Otsu area) from "
             "ln(measured Otsu area) over the loads; tie-break: IoU at the largest load",
+            "estimate_definition": "the vertex in ln(value) of the parabola of chi2 through the "
+            "grid's best value and its two neighbours (the grid's best where it lies at the "
+            "scan's end or the three points are not convex); it lies inside scatter_interval",
+            "grid_best_definition": "the scanned value with the least distance (also `best`); "
+            "distance, iou_largest, area_ratio_largest, best_loads and best_rendered_fit are "
+            "its, and it may lie outside scatter_interval, which belongs to the estimate",
             "scatter_interval_definition": "values with n D^2 / s^2 within the chi2(1) "
             "quantile at `confidence` of its minimum; s the residual sd of the measured ln "
-            "areas about their power-law fit, inflated by the Birge ratio where the best value "
-            "misses by more (log_area_sd_used); a parabola in ln(value) through the best value "
-            "and its neighbours (vertex: refined), linear beyond; null: open at the scan's end",
+            "areas about their power-law fit, inflated by the Birge ratio where the grid's best "
+            "value misses by more (log_area_sd_used); a parabola in ln(value) through the grid's "
+            "best value and its neighbours (vertex: estimate), linear beyond; null: open at the "
+            "scan's end",
         }
 
 
@@ -237,3 +262,60 @@ def best_scan_value(
         confidence=float(confidence),
         at_scan_edge=best in (0, len(values) - 1),
     )
+
+
+def estimate_columns(best: Mapping | None) -> dict:
+    """A scan's estimate and the interval that belongs to it, as model-table columns, from its
+    best.json record (``None``, for a scene's row: empty columns). The interval's ends are
+    ``None`` where it is open at the scan's end."""
+    if best is None:
+        return {"estimate": None, "estimate_low": None, "estimate_high": None}
+    low, high = best["scatter_interval"]
+    return {"estimate": best["estimate"], "estimate_low": low, "estimate_high": high}
+
+
+def significant(value: float, digits: int = 3) -> str:
+    """``value`` to ``digits`` significant digits, in plain notation where it is short
+    (4.47, 0.447, 2170, 40000)."""
+    return f"{float(f'{value:.{digits}g}'):g}"
+
+
+def interval_text(low: float | None, high: float | None) -> str:
+    """A scan's interval as '4.61–6.13'; with an end the scan does not bound, '2170 to open',
+    and with neither, 'open both ways'."""
+    if low is None and high is None:
+        return "open both ways"
+    ends = ["open" if end is None else significant(end) for end in (low, high)]
+    return (" to " if None in (low, high) else "–").join(ends)
+
+
+def estimate_text(best: Mapping) -> str:
+    """A best.json record as figures and tables state it: the parameter's estimate, its
+    interval at its confidence, and the grid's best named as such ('k = 5.31 MPa/nm (95%
+    interval 4.61–6.13; grid's best 4.47)')."""
+    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    low, high = best["scatter_interval"]
+    return (
+        f"{symbol} = {significant(best['estimate'])} {unit} ({best['confidence']:.0%} interval "
+        f"{interval_text(low, high)}; grid's best {significant(best['grid_best'])})"
+    )
+
+
+def grid_best_text(best: Mapping) -> str:
+    """The grid's best value of a best.json record, for a figure that shows the model there,
+    with the estimate beside it ("the grid's best k = 4.47 MPa/nm (estimate 5.31, 95%
+    interval 4.61–6.13)")."""
+    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    low, high = best["scatter_interval"]
+    return (
+        f"the grid's best {symbol} = {significant(best['grid_best'])} {unit} (estimate "
+        f"{significant(best['estimate'])}, {best['confidence']:.0%} interval "
+        f"{interval_text(low, high)})"
+    )
+
+
+def grid_best_label(best: Mapping) -> str:
+    """The grid's best value of a best.json record, short, for a legend or a panel
+    ("grid's best k = 4.47 MPa/nm")."""
+    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    return f"grid's best {symbol} = {significant(best['grid_best'])} {unit}"

@@ -38,6 +38,16 @@ SCAN_TABLE = "scan.csv"
 BEST = "best.json"
 TRUTH = "truth.json"
 ACCURACY_SUMMARY = "summary.json"
+MODELS_TABLE = "models.csv"
+AMONTONS_FIGURE = "amontons"  # its table is AMONTONS_TABLE
+AMONTONS_TABLE = f"{AMONTONS_FIGURE}.csv"
+B12_FIGURE = "B12_models"
+B13_FIGURE = "B13_amontons"
+B10_FIGURE = "B10_curvature"
+# The run's answer (docs/study.md §6), in results/<run>/.
+RUN_SUMMARY = "summary.md"
+VERDICT = "verdict.csv"
+REPORT_PAGE = "report_first_page.rst"
 ACCURACY_FIELDS = "pressure.h5"
 # A figure of the study or of a material: its PNG, its PDF and the CSV of what it shows.
 FIGURE_FORMATS = ("png", "pdf", "csv")

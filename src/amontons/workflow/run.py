@@ -28,6 +28,7 @@ from amontons.workflow.resources import SolveResources
 from amontons.workflow.scenes import Scenes
 from amontons.workflow.spheres import Spheres
 from amontons.workflow.study import Study
+from amontons.workflow.summary import Summary
 from amontons.workflow.targets import Targets
 
 # Locates a file of the workflow folder by its path there (e.g. "schemas/config.schema.yaml").
@@ -71,6 +72,7 @@ class WorkflowRun:
     targets: Targets
     accuracy: AccuracyStudy
     resources: SolveResources
+    summary: Summary
 
     @property
     def materials(self) -> list[str]:
@@ -116,6 +118,7 @@ class WorkflowRun:
             study=study,
             targets=Targets(spheres, scenes, study, paths),
             accuracy=AccuracyStudy(config, spheres, paths),
+            summary=Summary(config["materials"], spheres, scenes, study, paths),
             resources=SolveResources.from_files(
                 config, spheres, locate("resources.json"), locate("timing_model.json")
             ),

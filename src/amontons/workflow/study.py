@@ -118,7 +118,7 @@ class Study:
         """The study's figures of one sphere that its scans and scenes allow."""
         names = []
         if self.scenes.runnable_scans(sphere):
-            names += ["B8_scans", "B12_models"]
+            names += ["B8_scans", files.B12_FIGURE]
         if self.scenes.scans_of(K) and self.scenes.runnable_scans(sphere):
             if self.spheres.has(sphere, AFM_AFTER):
                 names.append("B9_flattening")
@@ -138,7 +138,7 @@ class Study:
             for sphere in self.spheres.of(material):
                 out += self.sphere_figures(material, sphere)
             if self.scanned(material):
-                out.append(f"{self.paths.material(material)}/models.csv")
+                out.append(f"{self.paths.material(material)}/{files.MODELS_TABLE}")
         return out
 
     def overview_outputs(self) -> list[str]:
@@ -146,7 +146,7 @@ class Study:
         curvature pairs); built by `all` and `study`, not by a material's target."""
         out = []
         if self.scenes.scans and self.spheres.materials_with(self.materials, RHEOMETER):
-            out += figure_files(self.paths.study_results, "B13_amontons")
+            out += figure_files(self.paths.study_results, files.B13_FIGURE)
         if self.curvature_pairs:
-            out += figure_files(self.paths.study_results, "B10_curvature")
+            out += figure_files(self.paths.study_results, files.B10_FIGURE)
         return out

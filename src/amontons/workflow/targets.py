@@ -111,7 +111,9 @@ class Targets:
         """Friction per sphere and the Amontons-deviation figure and table per material."""
         return self.sphere_outputs(
             materials, FRICTION_RESULTS, having=RHEOMETER
-        ) + self.material_figures(self.spheres.materials_with(materials, RHEOMETER), ["amontons"])
+        ) + self.material_figures(
+            self.spheres.materials_with(materials, RHEOMETER), [files.AMONTONS_FIGURE]
+        )
 
     def surface(self, materials) -> list[str]:
         """The topography of every sphere with both AFM maps."""
@@ -129,7 +131,7 @@ class Targets:
     def figures(self, materials) -> list[str]:
         """The per-material figures and tables: load-area and Amontons deviation."""
         return self.material_figures(materials, ["load_area"]) + self.material_figures(
-            self.spheres.materials_with(materials, RHEOMETER), ["amontons"]
+            self.spheres.materials_with(materials, RHEOMETER), [files.AMONTONS_FIGURE]
         )
 
     def material(self, materials) -> list[str]:

@@ -1,0 +1,155 @@
+"""The study's verdict from the model tables, and the pages that show it (docs/study.md §6)."""
+
+import base64
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
+from docutils.core import publish_parts  # noqa: E402
+
+from amontons.study_summary import (  # noqa: E402
+    ReportFigure,
+    SummaryError,
+    display_rows,
+    markdown_table,
+    matching_models,
+    report_page,
+    scan_headline,
+    verdict_rows,
+    verdict_text,
+)
+
+MEASURED = {"measured_exponent": 0.82, "measured_ci_low": 0.80, "measured_ci_high": 0.84}
+
+
+def _row(model, source, exponent, ratio=1.0, parameter=None, **scan):
+    return {
+        "sphere": "PS",
+        "model": model,
+        "source": source,
+        "parameter": parameter,
+        "value": scan.get("value"),
+        "estimate": scan.get("estimate"),
+        "estimate_low": scan.get("low"),
+        "estimate_high": scan.get("high"),
+        "exponent": exponent,
+        **MEASURED,
+        "exponent_difference": exponent - MEASURED["measured_exponent"],
+        "area_ratio_largest": ratio,
+    }
+
+
+def models_table() -> pd.DataFrame:
+    """A models.csv of one sphere as tabulate_models writes it: four scenes, two scans."""
+    return pd.DataFrame(
+        [
+            _row("elastic", "scene elastic", 0.86, 0.75),
+            _row("penetration_hardness", "scene penetration_hardness", 0.90, 0.96, "p_y_mpa"),
+            _row("hardening", "scene hardening", 0.818, 1.01, "k_mpa_per_nm"),
+            _row("greenwood_tripp", "scene greenwood_tripp", 0.92, float("nan")),
+            _row(
+                "penetration_hardness",
+                "scan p_y, best value",
+                0.91,
+                1.04,
+                "p_y_mpa",
+                value=178.9,
+                estimate=178.9,
+                low=178.9,
+                high=194.4,
+            ),
+            _row(
+                "hardening",
+                "scan k, best value",
+                0.813,
+                1.03,
+                "k_mpa_per_nm",
+                value=4.472,
+                estimate=5.26,
+                low=4.61,
+                high=float("nan"),
+            ),
+        ]
+    )
+
+
+def test_a_plastic_model_is_judged_at_its_scan_and_the_others_at_their_scene():
+    (row,) = verdict_rows(models_table(), "PS", "results/small/PS/models.csv")
+    assert row["hardening_source"] == "scan k, best value"
+    assert row["hardening_exponent"] == 0.813
+    assert row["penetration_hardness_source"] == "scan p_y, best value"
+    assert row["elastic_source"] == "scene elastic"
+    assert row["greenwood_tripp_area_ratio"] is None  # no rendering, no area ratio
+    assert (row["k_estimate"], row["k_low"], row["k_high"], row["k_grid_best"]) == (
+        5.26,
+        4.61,
+        None,  # open at the scan's end
+        4.472,
+    )
+    # only hardening's 0.813 lies inside the measured 0.80-0.84
+    assert row["matching"] == "hardening"
+    assert verdict_text(row) == "contact hardening only"
+
+
+def test_models_inside_the_measured_interval_are_all_named_and_none_singled_out():
+    row = {**MEASURED, "hardening_exponent": 0.80, "elastic_exponent": 0.84}
+    row["penetration_hardness_exponent"] = 0.7999
+    assert matching_models(row) == ["hardening", "elastic"]  # both ends included
+    assert verdict_text({"matching": "hardening;elastic"}) == (
+        "contact hardening, elastic: not decided"
+    )
+    assert verdict_text({"matching": ""}) == "no model"
+
+
+def test_a_best_json_without_the_estimate_is_named():
+    with pytest.raises(SummaryError, match=r"scans/k/best\.json: no 'estimate'.*--forcerun"):
+        scan_headline("PS", {"best": 4.472, "scatter_interval": [4.6, 6.0]}, "PS/scans/k/best.json")
+
+
+def test_a_table_that_is_not_a_model_table_is_named():
+    with pytest.raises(SummaryError, match=r"results/x/PS/models\.csv: no column .*'estimate'"):
+        verdict_rows(
+            pd.DataFrame({"sphere": ["PS"], "model": ["elastic"]}), "PS", "results/x/PS/models.csv"
+        )
+
+
+def test_the_first_page_is_valid_restructured_text_with_the_table_then_the_figures(tmp_path):
+    """docutils renders the page without a system message (an error would show in the
+    report as a red box): the verdict table with one column per sphere, then each figure's
+    PNG embedded byte for byte, in the order given."""
+    verdict = pd.DataFrame(verdict_rows(models_table(), "PS", "models.csv"))
+    figures = []
+    for name in ("b13", "b12"):
+        fig, ax = plt.subplots(figsize=(2, 2))
+        ax.plot([1, 2], [1, 2])
+        fig.savefig(tmp_path / f"{name}.png")
+        plt.close(fig)
+        figures.append(ReportFigure(str(tmp_path / f"{name}.png"), f"Fig. {name}"))
+    page = report_page(verdict, figures, 0.95, "synthetic data", ["models.csv"], "verdict.csv")
+    html = publish_parts(page, writer="html", settings_overrides={"report_level": 1})["html_body"]
+    assert "System Message" not in html
+    assert html.index("<table") < html.index('alt="Fig. b13"') < html.index('alt="Fig. b12"')
+    assert "<caption>Verdict per sphere</caption>" in html
+    for figure in figures:
+        start = html.index(f'alt="{figure.caption}" src="data:image/png;base64,')
+        data = html[start:].split("base64,", 1)[1].split('"', 1)[0]
+        assert base64.b64decode(data) == Path(figure.png).read_bytes()
+
+
+def test_the_reader_table_states_estimate_interval_and_grid_best():
+    verdict = pd.DataFrame(verdict_rows(models_table(), "PS", "models.csv"))
+    lines = display_rows(verdict, 0.95)
+    by_name = {line[0]: line[1:] for line in lines}
+    assert by_name["sphere (material)"] == ["PS"]
+    assert by_name["k (estimate, MPa/nm; 95% interval)"] == [
+        "5.26 (4.61 to open); grid's best 4.47"
+    ]
+    assert by_name["contact hardening at the grid's best k"] == ["0.813 (−0.007), area ×1.03"]
+    assert by_name["Greenwood–Tripp"] == ["0.920 (+0.100)"]
+    table = markdown_table(lines)
+    assert table.splitlines()[1] == "|---|---|" and len(table.splitlines()) == len(lines) + 1
