@@ -88,6 +88,17 @@ def _snakemake(project, *args):
     )
 
 
+def _check(project):
+    """python -m amontons.check on the project, its plans as JSON."""
+    return subprocess.run(
+        [sys.executable, "-m", "amontons.check", "--configfile", "config/test.yaml", "--json"],
+        cwd=project,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
 def _made(project, sphere) -> set[str]:
     folder = project / "results" / SMALL / "PS" / sphere
     return {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
@@ -100,13 +111,7 @@ def lab_run(small_run, tmp_path_factory):
     tmp_path = tmp_path_factory.mktemp("own_data")
     project = _project(tmp_path, small_run, {COMPLETE: []} | {n: c[0] for n, c in CASES.items()})
     dry = _snakemake(project, "-n")
-    check = subprocess.run(
-        [sys.executable, "-m", "amontons.check", "--configfile", "config/test.yaml", "--json"],
-        cwd=project,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    check = _check(project)
     run = _snakemake(project, "--cores", "2")
     return project, dry, check, run
 
@@ -214,13 +219,7 @@ def test_one_corrupt_file_stops_only_its_sphere(small_run, tmp_path):
     run = _snakemake(project, "--cores", "2")
     assert run.returncode != 0
     assert str(image) in run.stderr
-    check = subprocess.run(
-        [sys.executable, "-m", "amontons.check", "--configfile", "config/test.yaml", "--json"],
-        cwd=project,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    check = _check(project)
     plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
     for path in plans[COMPLETE]["outputs"]:
         assert (project / path).is_file(), path
