@@ -19,7 +19,9 @@ def main(
     sources: list[str],
     data_label: str,
     confidence: float,
+    left_out: list[str],
 ) -> None:
+    """``left_out``: per sphere, what its data did not allow and why (the dry run's lines)."""
     page = report_page(
         pd.read_csv(verdict_path),
         [ReportFigure(png, caption) for png, caption in figures.items()],
@@ -27,6 +29,7 @@ def main(
         data_label,
         sources,
         verdict_path,
+        left_out,
     )
     with atomic_path(page_path) as tmp:
         tmp.write_text(page, encoding="utf-8")
@@ -44,4 +47,5 @@ if __name__ == "__main__":
         sources=sm.params.sources,
         data_label=sm.params.data_label,
         confidence=sm.params.confidence,
+        left_out=sm.params.left_out,
     )

@@ -20,6 +20,7 @@ from amontons.study_summary import (  # noqa: E402
     matching_models,
     report_page,
     scan_headline,
+    summary_markdown,
     verdict_rows,
     verdict_text,
 )
@@ -153,3 +154,18 @@ def test_the_reader_table_states_estimate_interval_and_grid_best():
     assert by_name["Greenwood–Tripp"] == ["0.920 (+0.100)"]
     table = markdown_table(lines)
     assert table.splitlines()[1] == "|---|---|" and len(table.splitlines()) == len(lines) + 1
+
+
+def test_the_first_page_and_the_summary_say_what_the_data_did_not_allow():
+    """A sphere's missing file leaves no silent gap: its reason stands on the report's first
+    page, as valid reStructuredText, and in summary.md."""
+    verdict = pd.DataFrame(verdict_rows(models_table(), "PS", "models.csv"))
+    reason = "sphere PS-2 (PS): no rheometer/ folder in lab/PS-2: the friction will not be made"
+    page = report_page(verdict, [], 0.95, "measured data", ["models.csv"], "v.csv", [reason])
+    html = publish_parts(page, writer="html", settings_overrides={"report_level": 1})["html_body"]
+    assert "System Message" not in html and "no rheometer/ folder in lab/PS-2" in html
+    assert "What the data did not allow" not in report_page(
+        verdict, [], 0.95, "measured data", ["models.csv"], "v.csv"
+    )
+    text = summary_markdown("small", "measured data", None, None, [], [reason])
+    assert text.endswith(f"## What the data did not allow\n\n- {reason}\n")

@@ -274,10 +274,13 @@ def report_page(
     data_label: str,
     sources: Sequence[str],
     verdict_path: str,
+    left_out: Sequence[str] = (),
 ) -> str:
     """The report's first page (reStructuredText, included by workflow/report/workflow.rst):
     the verdict table (``verdict``, read from ``verdict_path``, made from the model tables
-    ``sources``), then ``figures`` (Fig. B.13 and each sphere's Fig. B.12)."""
+    ``sources``), what the spheres' data did not allow (``left_out``, one line each, so that
+    a missing row or figure is never a silent gap), then ``figures`` (Fig. B.13 and each
+    sphere's Fig. B.12)."""
     title = f"The answer ({data_label})"
     parts = [
         title,
@@ -292,6 +295,9 @@ def report_page(
         list_table(display_rows(verdict, confidence), "Verdict per sphere"),
         "",
     ]
+    if left_out:
+        parts += ["What the data did not allow:", ""]
+        parts += [f"- {line}" for line in left_out] + [""]
     parts += [_image(figure) for figure in figures]
     return "\n".join(parts)
 

@@ -80,5 +80,6 @@ rule write_report_page:
         sources=list(SUMMARY.verdict_inputs().values()),
         data_label=data_label(SPHERES),
         confidence=config["load_area"]["confidence"],
+        left_out=RUN.left_out(),
     script:
         "../../scripts/write_report_page.py"
