@@ -309,7 +309,8 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
     _edit_config(project, lambda c: c.update(optics={"psf": {"profile_radius_nm": 1800.0}}))
     changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
     # The PSF also renders the three optics scenes of each sphere and every scan value
-    # (2 spheres x 2 scans x 7 values): they follow it, and so does the study built on them.
+    # (2 spheres x 2 scans x 7 values): they follow it, and so do the study built on them and
+    # the run's answer built on the study (verdict, summary, the report's first page).
     study = {
         "best_scan_value": "4",
         "plot_amontons_study": "1",
@@ -318,6 +319,9 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
         "plot_model_curves": "2",
         "plot_scan_maps": "2",
         "tabulate_models": "2",
+        "tabulate_verdict": "1",
+        "summarise_study": "1",
+        "write_report_page": "1",
     }
     assert _job_stats(changed.stdout) == {
         "measure_psf": "2",
