@@ -21,7 +21,7 @@ from pathlib import Path
 from amontons.config import ConfigError, read_config
 from amontons.io.absorbance import read_absorbance_csv
 from amontons.io.heightmap import read_heights
-from amontons.io.layout import AFM_SUFFIXES, FLIM_NAME, REFLECTION_NAME, RawDataError
+from amontons.io.layout import FLIM_NAME, REFLECTION_NAME, RawDataError
 from amontons.io.rheometer import read_rheometer_csv
 from amontons.io.tiff import read_tiff
 from amontons.workflow.run import WorkflowRun
@@ -76,14 +76,6 @@ def describe_file(path: str, read: Callable[[str], dict], sheet_pixel_nm: float 
     return record
 
 
-def _afm_file(spheres: Spheres, sphere: str, stem: str) -> str | None:
-    folder = spheres.raw_dir(sphere)
-    found = [
-        f"{folder}/{stem}{ext}" for ext in AFM_SUFFIXES if Path(f"{folder}/{stem}{ext}").is_file()
-    ]
-    return found[0] if found else None
-
-
 def sphere_files(spheres: Spheres, sphere: str) -> tuple[list[dict], list[str]]:
     """Every raw file of a measured sphere that is there, described, and the errors that
     would stop the run before any job."""
@@ -112,9 +104,8 @@ def sphere_files(spheres: Spheres, sphere: str) -> tuple[list[dict], list[str]]:
     ]
     files += [describe_file(p, read, pixel) for p, read, pixel in singles if Path(p).is_file()]
     for stem in (AFM_BEFORE, AFM_AFTER):
-        path = _afm_file(spheres, sphere, stem)
-        if path is not None:
-            files.append(describe_file(path, _height_map, afm_pixel))
+        if spheres.has(sphere, stem):
+            files.append(describe_file(spheres.afm_path(sphere, stem), _height_map, afm_pixel))
     return files, errors
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from amontons.config.scenes import SCAN_MODELS
 from amontons.simulate.scan import PARAMETER_SYMBOLS, interval_text, significant
 
 # The models of the verdict, in the order the study discusses them (docs/study.md §4), and
@@ -31,7 +32,7 @@ MODELS = {
     "greenwood_tripp": "Greenwood–Tripp",
 }
 # The scanned parameter of each plastic model.
-MODEL_PARAMETERS = {"hardening": "k_mpa_per_nm", "penetration_hardness": "p_y_mpa"}
+MODEL_PARAMETERS = {model: parameter for parameter, model in SCAN_MODELS.items()}
 # The model-table columns the verdict reads.
 MODEL_TABLE_COLUMNS = (
     "sphere",

@@ -111,15 +111,20 @@ def resolve_scene_presets(config: dict, source: str) -> None:
         scene["preset"] = preset
 
 
+def _check_running(config: Mapping, kind: str, source: str) -> None:
+    """``run_<kind>`` may name only entries of ``<kind>`` (scenes or scans)."""
+    unknown = [name for name in config[f"run_{kind}"] if name not in config[kind]]
+    if unknown:
+        raise ConfigError(
+            f"{source}: run_{kind} names {', '.join(map(repr, unknown))}, not in {kind}; "
+            f"expected one of {', '.join(config[kind])}"
+        )
+
+
 def check_scenes(config: Mapping, spheres: Mapping[str, dict], source: str) -> None:
     """Scenes that cannot run stop the run before any job: each message names the scene and
     the key (docs/simulate.md)."""
-    unknown = [name for name in config["run_scenes"] if name not in config["scenes"]]
-    if unknown:
-        raise ConfigError(
-            f"{source}: run_scenes names {', '.join(map(repr, unknown))}, not in scenes; "
-            f"expected one of {', '.join(config['scenes'])}"
-        )
+    _check_running(config, "scenes", source)
     for name in config["run_scenes"]:
         _check_one_scene(name, config["scenes"][name], spheres, source)
 
@@ -155,12 +160,7 @@ def _check_one_scan(name: str, scan: Mapping, config: Mapping, source: str) -> N
 
 def check_scans(config: Mapping, source: str) -> None:
     """Scans that cannot run stop the run before any job (docs/study.md)."""
-    unknown = [name for name in config["run_scans"] if name not in config["scans"]]
-    if unknown:
-        raise ConfigError(
-            f"{source}: run_scans names {', '.join(map(repr, unknown))}, not in scans; "
-            f"expected one of {', '.join(config['scans'])}"
-        )
+    _check_running(config, "scans", source)
     for name in config["run_scans"]:
         _check_one_scan(name, config["scans"][name], config, source)
 

@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from amontons.config.scenes import SCAN_MODELS
 from amontons.simulate.scan_grid import ScanError, scan_values, value_label
 
 __all__ = [
@@ -65,14 +66,10 @@ __all__ = [
     "value_label",
 ]
 
-PARAMETERS = {
-    "p_y_mpa": "penetration_hardness",
-    "k_mpa_per_nm": "hardening",
-}
+# The model each scan parameter belongs to: the config's table, one definition.
+PARAMETERS = SCAN_MODELS
 # How a parameter is written in figures and tables: symbol and unit.
 PARAMETER_SYMBOLS = {"p_y_mpa": ("p_Y", "MPa"), "k_mpa_per_nm": ("k", "MPa/nm")}
-# The sheet column a parameter's scan range is centred on.
-SHEET_COLUMNS = {"p_y_mpa": "hardness_mpa", "k_mpa_per_nm": "hardening_k_mpa_per_nm"}
 # Relative difference in D below which two values count as equally good (tie-break: IoU).
 TIE = 1e-9
 
