@@ -186,10 +186,12 @@ class Spheres:
             missing[REFLECTION] = f"no {REFLECTION_NAME} in {folder}"
         elif self.value(sphere, "reflection_load_mn") is None:
             missing[REFLECTION] = "no reflection_load_mn in the sheet"
-        if not os.path.isfile(self.bead_image(sphere)):
-            missing[BEAD] = f"no {self.bead_image(sphere)}"
-        if not os.path.isfile(self.absorbance_spectrum(sphere)):
-            missing[ABSORBANCE] = f"no {self.absorbance_spectrum(sphere)}"
+        for kind, path in (
+            (BEAD, self.bead_image(sphere)),
+            (ABSORBANCE, self.absorbance_spectrum(sphere)),
+        ):
+            if not os.path.isfile(path):
+                missing[kind] = f"no {path}"
         for stem in (AFM_BEFORE, AFM_AFTER):
             if not any(os.path.isfile(f"{folder}/{stem}{ext}") for ext in AFM_SUFFIXES):
                 missing[stem] = f"no {stem}.* in {folder}"
