@@ -16,6 +16,12 @@ log = logging.getLogger(__name__)
 
 def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str, confidence):
     records = sorted((read_json(p) for p in point_paths), key=lambda r: r["value"])
+    if not records[0]["loads"] and records[0]["outside_scan"]:
+        raise ScanError(
+            f"scan {scan_name}: sphere {records[0]['sphere']}'s AFM scan holds none of the "
+            f"loads' windows ({len(records[0]['outside_scan'])} loads outside_scan); expected "
+            "a scan covering at least the loads a scan is judged on (three)"
+        )
     solved = [r for r in records if r["outside_window"] is None]
     if not solved:
         raise ScanError(
@@ -73,6 +79,7 @@ def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str
             "scene": records[0]["scene"],
             "parameter": records[0]["parameter"],
             "values": [r["value"] for r in records],
+            "outside_scan": records[0]["outside_scan"],
             **best.to_record(),
             "iou_largest": next(r["iou_largest"] for r in records if r["value"] == best.value),
             "area_ratio_largest": next(

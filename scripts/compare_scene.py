@@ -13,9 +13,12 @@ from amontons.measure.area import OtsuSettings, image_contact_area, otsu_contact
 from amontons.plots import plot_scene_comparison
 from amontons.runlog import run_logged
 from amontons.simulate.compare import (
+    OUTSIDE_SCAN,
     afm_scan_centre_in_image_m,
     compare_loads,
+    outside_scan_record,
     register_at_largest_load,
+    sheet_load_index,
     warped_mask,
 )
 from amontons.simulate.render import Rendered
@@ -48,16 +51,45 @@ def main(
             f"rendered at {pixel_m * 1e9:.4g} nm (the sheet's fluorescence_pixel_nm); expected "
             "one pixel size"
         )
+    solve = read_json(solve_path)
+    simulated_mn = solve["loads_mn"]
+    simulated = [sheet_load_index(loads_mn, load) for load in simulated_mn]
     rendered = [
         Rendered(f["image"], pixel_m, otsu_contact_area(f["image"], pixel_m, settings))
         for f in fields
     ]
     measured = [image_contact_area(image, settings) for image in images]
-    registration = register_at_largest_load(rendered, [image.data for image in images])
-    solve = read_json(solve_path)
+    outside = [
+        outside_scan_record(
+            row["load_mn"], row["window_um"], measured[sheet_load_index(loads_mn, row["load_mn"])]
+        )
+        for row in solve["outside_scan"]
+    ]
+    if not rendered:
+        log.warning("%s: no load simulated (outside_scan); nothing to compare", solve_path)
+        write_json(registration_path, {"status": OUTSIDE_SCAN, "registered_at_load_mn": None})
+        write_table(table_path, pd.DataFrame(outside))
+        plot_scene_comparison(
+            loads_mn,
+            [image.data for image in images],
+            [m.mask for m in measured],
+            [None] * len(loads_mn),
+            [None] * len(loads_mn),
+            [None] * len(loads_mn),
+            pixel_m * 1e6,
+            f"{label}: the AFM scan holds no load's window ({data_label})",
+            figure_paths,
+        )
+        return
+    registration = register_at_largest_load(rendered, [images[i].data for i in simulated])
     solver_areas = [row["area_um2"] * 1e-12 for row in solve["loads"]]
     rows = compare_loads(
-        [f * 1e-3 for f in loads_mn], rendered, measured, solver_areas, registration, pixel_m
+        [f * 1e-3 for f in simulated_mn],
+        rendered,
+        [measured[i] for i in simulated],
+        solver_areas,
+        registration,
+        pixel_m,
     )
     for row in rows:
         log.info(
@@ -75,7 +107,7 @@ def main(
         registration_path,
         {
             **registration.to_record(),
-            "registered_at_load_mn": loads_mn[-1],
+            "registered_at_load_mn": simulated_mn[-1],
             "definition": "measured position = rotate(mirror(simulated position about the "
             "rendered image's centre)) + measured image centre + shift; mirror flips columns, "
             "rotation counter-clockwise as displayed",
@@ -83,17 +115,18 @@ def main(
             "image_pixel_nm": pixel_m * 1e9,
         },
     )
-    write_table(table_path, pd.DataFrame([row.to_record() for row in rows]))
+    write_table(table_path, pd.DataFrame([row.to_record() for row in rows] + outside))
+    by_load = dict(zip(simulated, zip(rendered, rows, strict=True), strict=True))
     plot_scene_comparison(
         loads_mn,
         [image.data for image in images],
         [m.mask for m in measured],
         [
-            warped_mask(r, registration, m.mask.shape)
-            for r, m in zip(rendered, measured, strict=True)
+            warped_mask(by_load[i][0], registration, m.mask.shape) if i in by_load else None
+            for i, m in enumerate(measured)
         ],
-        [row.iou for row in rows],
-        [row.area_ratio for row in rows],
+        [by_load[i][1].iou if i in by_load else None for i in range(len(loads_mn))],
+        [by_load[i][1].area_ratio if i in by_load else None for i in range(len(loads_mn))],
         pixel_m * 1e6,
         f"{label}: simulated against measured contact ({data_label})",
         figure_paths,

@@ -13,16 +13,23 @@ log = logging.getLogger(__name__)
 
 
 def main(solve_path: str, render_path: str | None, fit_path: str, confidence: float) -> None:
-    loads = read_json(solve_path)["loads"]
+    solve = read_json(solve_path)
+    loads = solve["loads"]
     rendered = None
     if render_path is not None:
         rendered = pd.read_csv(render_path)["rendered_area_um2"].to_list()
     record = scene_area_fits(
-        [row["load_mn"] for row in loads], [row["area_um2"] for row in loads], rendered, confidence
+        [row["load_mn"] for row in loads],
+        [row["area_um2"] for row in loads],
+        rendered,
+        confidence,
+        solve.get("outside_scan", []),
     )
-    log.info(
-        "%s: solver-area exponent %.4f", solve_path, record["solver_area"]["exponent"]["estimate"]
-    )
+    if record["not_fitted"]:
+        log.warning("%s: %s", solve_path, record["not_fitted"])
+    else:
+        exponent = record["solver_area"]["exponent"]["estimate"]
+        log.info("%s: solver-area exponent %.4f", solve_path, exponent)
     write_json(fit_path, record)
 
 

@@ -13,6 +13,16 @@ from amontons.simulate.render import render_load_series
 
 log = logging.getLogger(__name__)
 
+RENDER_COLUMNS = [
+    "load_mn",
+    "rendered_area_um2",
+    "solver_area_um2",
+    "otsu_threshold",
+    "otsu_separation",
+    "contact_found",
+    "flag",
+]
+
 
 def main(
     fields_path: str,
@@ -26,9 +36,11 @@ def main(
 ) -> None:
     fields, per_load, settings = read_load_series(fields_path)
     psf_fwhm_m = read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9
+    if not fields:
+        log.warning("%s: no load simulated (%s); nothing rendered", fields_path, settings["status"])
     rendered = render_load_series(
         fields,
-        settings["pixel_nm"] * 1e-9,
+        settings.get("pixel_nm", pixel_nm) * 1e-9,
         pixel_m=pixel_nm * 1e-9,
         psf_fwhm_m=psf_fwhm_m,
         rendering=rendering,
@@ -70,7 +82,7 @@ def main(
             "confinement_floor_mpa": confinement_floor_mpa,
         },
     )
-    write_table(table_path, pd.DataFrame(rows))
+    write_table(table_path, pd.DataFrame(rows, columns=RENDER_COLUMNS))
 
 
 if __name__ == "__main__":

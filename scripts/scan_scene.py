@@ -17,13 +17,12 @@ from amontons.io.layout import fluorescence_name, per_load_files
 from amontons.io.rawdata import read_fluorescence_series
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
-from amontons.simulate.compare import compare_loads
+from amontons.simulate.compare import compare_loads, sheet_load_index
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
-from amontons.simulate.scene import scene_for_sphere
 from amontons.simulate.solve import solve_scene
-from amontons.simulate.surface import afm_indenter, load_levelled_map
+from amontons.simulate.surface import afm_indenter, afm_scene, load_levelled_map
 
 log = logging.getLogger(__name__)
 
@@ -45,14 +44,24 @@ def main(
     threads: int,
 ) -> None:
     config = scene_config_at(base_config, scan["parameter"], value)
-    scene = scene_for_sphere(scan["scene"], config, sphere, sphere_record)
-    indenter = afm_indenter(load_levelled_map(levelled_path), scene, levelled_path)
+    levelled = load_levelled_map(levelled_path)
+    scene, coverage = afm_scene(scan["scene"], config, sphere, sphere_record, levelled)
     record = {
         "sphere": sphere,
         "scene": scan["scene"],
         "parameter": scan["parameter"],
         "value": value,
+        "outside_scan": coverage.to_record()["outside_scan"],
     }
+    if scene is None:
+        # The window does not depend on the scanned parameter: no value has a load to solve,
+        # and best_scan_value says so.
+        log.warning("%s = %g: the AFM scan holds no load's window", scan["parameter"], value)
+        write_load_series(fields_path, [], [], record)
+        write_json(point_path, {**record, "log_area_distance": None, "outside_window": None,
+                                "loads": []})  # fmt: skip
+        return
+    indenter = afm_indenter(levelled, scene, levelled_path)
     try:
         solution = solve_scene(scene, indenter, threads=threads)
     except FreeBoundaryError as error:
@@ -73,7 +82,8 @@ def main(
         confinement_floor_pa=config["confinement_floor_mpa"] * 1e6,
         otsu=settings,
     )
-    loads_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
+    sheet_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
+    loads_mn = [sheet_mn[sheet_load_index(sheet_mn, f * 1e3)] for f in scene.loads_n]
     images = read_fluorescence_series(
         per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
     )

@@ -10,11 +10,40 @@ if "snakemake" in globals():
 from amontons.io.fields import write_load_series
 from amontons.io.files import write_json
 from amontons.runlog import run_logged
-from amontons.simulate.scene import scene_for_sphere, synthetic_scene
+from amontons.simulate.scene import synthetic_scene
 from amontons.simulate.solve import solve_scene
-from amontons.simulate.surface import afm_indenter, load_levelled_map, synthetic_indenter
+from amontons.simulate.surface import (
+    afm_indenter,
+    afm_scene,
+    load_levelled_map,
+    synthetic_indenter,
+)
 
 log = logging.getLogger(__name__)
+
+
+def write_outside_scan(fields_path, solve_path, scene_name, scene_config, sphere, coverage):
+    """The records of a scene whose sphere's scan holds none of its loads: no load solved,
+    every load listed as outside_scan with the window it needs (never a failed job)."""
+    log.warning(
+        "scene %s, sphere %s: the AFM scan holds no load's window (%.1f µm about the apex); "
+        "nothing simulated",
+        scene_name,
+        sphere,
+        coverage.largest_window_m * 1e6,
+    )
+    settings = {
+        "scene": scene_name,
+        "sphere": sphere,
+        "surface": scene_config["surface"],
+        "model": scene_config["model"],
+        "optics": scene_config["optics"],
+        "loads_mn": [],
+        "status": "outside_scan",
+        **coverage.to_record(),
+    }
+    write_load_series(fields_path, [], [], settings)
+    write_json(solve_path, {**settings, "wall_time_s": 0.0, "loads": []})
 
 
 def main(
@@ -27,12 +56,18 @@ def main(
     sphere_record: dict | None,
     threads: int,
 ) -> None:
+    coverage = {}
     if sphere is None:
         scene = synthetic_scene(scene_name, scene_config)
         indenter = synthetic_indenter(scene)
     else:
-        scene = scene_for_sphere(scene_name, scene_config, sphere, sphere_record)
-        indenter = afm_indenter(load_levelled_map(levelled_path), scene, levelled_path)
+        levelled = load_levelled_map(levelled_path)
+        scene, scan = afm_scene(scene_name, scene_config, sphere, sphere_record, levelled)
+        if scene is None:
+            write_outside_scan(fields_path, solve_path, scene_name, scene_config, sphere, scan)
+            return
+        coverage = scan.to_record()
+        indenter = afm_indenter(levelled, scene, levelled_path)
     log.info(
         "%s: %d² solver grid of %.1f nm (window %.1f µm); surface rms %.1f nm, slope %.3f "
         "at the solver pixel (%.1f nm, slope %.3f at the map's)",
@@ -49,6 +84,8 @@ def main(
     settings = {
         **scene.to_record(),
         "sphere": sphere,
+        "status": "outside_scan" if coverage.get("outside_scan") else "complete",
+        **coverage,
         "window_centre_in_scan_um": [c * 1e6 for c in indenter.centre_in_scan_m],
         "surface_at_map_pixel": indenter.afm_statistics,
         "surface_at_solver_pixel": indenter.solver_statistics,

@@ -12,6 +12,7 @@ import pandas as pd
 
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
+from amontons.simulate.compare import largest_compared
 from amontons.simulate.fits import model_table_rows
 from amontons.simulate.scan import estimate_columns
 
@@ -23,7 +24,10 @@ _VALUE_INTERVAL = ("value_low", "value_high")
 
 
 def _largest_row(path: str | None) -> dict | None:
-    return None if path is None else pd.read_csv(path).iloc[-1].to_dict()
+    """The comparison's row of the largest load compared (None: no optics, or none compared)."""
+    if path is None:
+        return None
+    return largest_compared(pd.read_csv(path).to_dict("records"))
 
 
 def with_estimate(row: dict, best: dict | None) -> dict:

@@ -401,16 +401,17 @@ def plot_scene_comparison(
     loads_mn: list[float],
     images: list[np.ndarray],
     measured_masks: list[np.ndarray],
-    simulated_masks: list[np.ndarray],
-    ious: list[float],
-    ratios: list[float],
+    simulated_masks: list[np.ndarray | None],
+    ious: list[float | None],
+    ratios: list[float | None],
     pixel_um: float,
     title: str,
     paths: list[str],
 ) -> None:
     """Per load: the measured fluorescence image with its Otsu edge (green, as in appendix
     Fig. B.8) and the registered simulated contact's Otsu edge (magenta), titled with the
-    intersection over union and the simulated/measured area ratio."""
+    intersection over union and the simulated/measured area ratio. A load whose simulated
+    mask is None was not simulated (its window lies outside the AFM scan) and says so."""
     n = len(loads_mn)
     fig, axes = plt.subplots(1, n, figsize=(2.4 * n, 2.8), constrained_layout=True, squeeze=False)
     for ax, load, image, measured, simulated, iou, ratio in zip(
@@ -419,7 +420,7 @@ def plot_scene_comparison(
         extent = [0, image.shape[1] * pixel_um, 0, image.shape[0] * pixel_um]
         ax.imshow(image, cmap="gray", origin="lower", extent=extent)
         for mask, colour in ((measured, "lime"), (simulated, "magenta")):
-            if mask.any():
+            if mask is not None and mask.any():
                 ax.contour(
                     mask.astype(float),
                     levels=[0.5],
@@ -428,7 +429,10 @@ def plot_scene_comparison(
                     origin="lower",
                     extent=extent,
                 )
-        ax.set_title(f"{load:g} mN: IoU {iou:.2f}, A_sim/A {ratio:.2f}", fontsize=7)
+        if simulated is None:
+            ax.set_title(f"{load:g} mN: outside the AFM scan", fontsize=7)
+        else:
+            ax.set_title(f"{load:g} mN: IoU {iou:.2f}, A_sim/A {ratio:.2f}", fontsize=7)
         ax.set_xlabel("x (µm)", fontsize=7)
         ax.tick_params(labelsize=6)
     axes[0, 0].set_ylabel("y (µm)", fontsize=7)

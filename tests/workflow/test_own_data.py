@@ -13,6 +13,8 @@ import pandas as pd
 import pytest
 import yaml
 
+from amontons.io.tiff import read_image, write_image
+
 pytestmark = pytest.mark.workflow
 
 REPO = Path(__file__).resolve().parents[2]
@@ -35,6 +37,9 @@ CASES = {
                                                        "scenes/"]),
     "PS-norheometer": (["rheometer"], ["measure/friction.csv"]),
 }  # fmt: skip
+# AFM scans cut about their centre to a side (µm) that holds the elastic scene's windows of the
+# three smaller loads (44 µm at 100 mN; 55 µm at 200 mN), and none (28 µm at 25 mN).
+CUT_SCANS = {"PS-cutscan": 50.0, "PS-noload": 24.0}
 # What the PSF enters: the sphere without a bead image renders with the stand-in, so these
 # records may differ from the complete sphere's (the PSF and the rendered areas must).
 PSF_DEPENDENT = {
@@ -49,14 +54,27 @@ PSF_DEPENDENT = {
 STAND_IN = {"fwhm_nm": 500.0, "fwhm_se_nm": 25.0}
 
 
+def _cut_scan(path: Path, side_um: float) -> None:
+    """The AFM scan at ``path`` cut to a square of ``side_um`` about its centre, with its
+    pixel size (as a smaller scan of the same instrument would be)."""
+    scan = read_image(path)
+    side = int(round(side_um * 1e-6 / scan.pixel_m))
+    n0, n1 = scan.data.shape
+    r, c = (n0 - side) // 2, (n1 - side) // 2
+    write_image(path, scan.data[r : r + side, c : c + side], scan.pixel_m)
+
+
 def _lab_sphere(small_run, lab: Path, name: str, remove: list[str]) -> Path:
-    """A copy of the virtual PS sphere as measured data, less ``remove``."""
+    """A copy of the virtual PS sphere as measured data, less ``remove``, and with its AFM scan
+    cut where CUT_SCANS names it."""
     folder = lab / name
     shutil.copytree(small_run / "resources" / "synthetic" / SMALL / "PS", folder)
     (folder / "truth.json").unlink()
     for entry in remove:
         path = folder / entry
         shutil.rmtree(path) if path.is_dir() else path.unlink()
+    if name in CUT_SCANS:
+        _cut_scan(folder / "afm_before.tif", CUT_SCANS[name])
     return folder
 
 
@@ -118,7 +136,8 @@ def lab_run(small_run, tmp_path_factory):
     """The run of the complete copy and of one copy per case, with its dry run and the check
     command's plan made before it."""
     tmp_path = tmp_path_factory.mktemp("own_data")
-    project = _project(tmp_path, small_run, {COMPLETE: []} | {n: c[0] for n, c in CASES.items()})
+    spheres = {COMPLETE: []} | {n: c[0] for n, c in CASES.items()} | dict.fromkeys(CUT_SCANS, [])
+    project = _project(tmp_path, small_run, spheres)
     dry = _snakemake(project, "-n")
     check = _check(project)
     run = _snakemake(project, "--cores", "2")
@@ -217,9 +236,9 @@ def test_the_material_tables_hold_the_spheres_that_have_their_inputs(lab_run):
     project = lab_run[0]
     material = project / "results" / SMALL / "PS"
     amontons = pd.read_csv(material / "amontons.csv")
-    assert set(amontons["sphere"]) == {COMPLETE, *CASES} - {"PS-norheometer"}
+    assert set(amontons["sphere"]) == {COMPLETE, *CASES, *CUT_SCANS} - {"PS-norheometer"}
     scenes = pd.read_csv(material / "scenes.csv")
-    assert set(scenes["sphere"]) == {COMPLETE, *CASES} - {"PS-noafm"}
+    assert set(scenes["sphere"]) == {COMPLETE, *CASES, *CUT_SCANS} - {"PS-noafm"}
 
 
 def test_one_corrupt_file_stops_only_its_sphere(small_run, tmp_path):
@@ -237,3 +256,69 @@ def test_one_corrupt_file_stops_only_its_sphere(small_run, tmp_path):
         assert (project / path).is_file(), path
     errors = [f["error"] for f in plans["PS-corrupt"]["files"] if "error" in f]
     assert errors and str(image) in errors[0]
+
+
+def _scene_record(project, sphere, name):
+    path = project / "results" / SMALL / "PS" / sphere / "scenes" / "elastic" / name
+    return json.loads(path.read_text()) if name.endswith(".json") else pd.read_csv(path)
+
+
+def test_a_scan_smaller_than_the_contact_simulates_the_loads_it_holds(lab_run):
+    """The cut scan holds the three smaller loads' windows: the scene simulates those, lists
+    200 and 300 mN as outside_scan with the window each needs (larger than the scan holds),
+    compares and fits on the three, and the tables say what was left out."""
+    project = lab_run[0]
+    solve = _scene_record(project, "PS-cutscan", "solve.json")
+    assert solve["loads_mn"] == [25.0, 50.0, 100.0]
+    # the solver's load meets the target to its tolerance, not to the bit
+    assert [row["load_mn"] for row in solve["loads"]] == pytest.approx([25, 50, 100], rel=1e-6)
+    assert [row["load_mn"] for row in solve["outside_scan"]] == [200.0, 300.0]
+    held = solve["largest_window_in_scan_um"]
+    assert solve["window_um"] <= held < min(row["window_um"] for row in solve["outside_scan"])
+    assert held <= min(solve["scan_um"]) <= CUT_SCANS["PS-cutscan"]
+    comparison = _scene_record(project, "PS-cutscan", "comparison.csv")
+    assert comparison["status"].tolist() == ["compared"] * 3 + ["outside_scan"] * 2
+    outside = comparison[comparison["status"] == "outside_scan"]
+    assert outside["iou"].isna().all() and outside["measured_area_um2"].gt(0).all()
+    fit = _scene_record(project, "PS-cutscan", "scene_fit.json")
+    assert fit["loads_mn"] == pytest.approx([25, 50, 100], rel=1e-6)
+    assert fit["not_fitted"] is None
+    assert fit["rendered_area"]["exponent"]["estimate"] > 0
+    scenes = pd.read_csv(project / "results" / SMALL / "PS" / "scenes.csv")
+    row = scenes[(scenes["sphere"] == "PS-cutscan") & (scenes["scene"] == "elastic")].iloc[0]
+    assert row["left_out"] == "outside_scan: 200, 300 mN"
+    complete = scenes[(scenes["sphere"] == COMPLETE)]
+    assert complete["left_out"].isna().all()  # an empty note: nothing left out
+
+
+def test_a_scan_that_holds_no_load_gets_a_record_and_no_failed_job(lab_run):
+    """The scan too small for any load's window: the scene's records say so (no load solved,
+    every load outside_scan, no fit and why), its greenwood_tripp scene (no window) is
+    whole, and the run exits 0 (test_a_missing_file_stops_nothing_else)."""
+    project = lab_run[0]
+    solve = _scene_record(project, "PS-noload", "solve.json")
+    assert solve["status"] == "outside_scan" and solve["loads"] == []
+    assert [row["load_mn"] for row in solve["outside_scan"]] == [25, 50, 100, 200, 300]
+    comparison = _scene_record(project, "PS-noload", "comparison.csv")
+    assert set(comparison["status"]) == {"outside_scan"} and len(comparison) == 5
+    fit = _scene_record(project, "PS-noload", "scene_fit.json")
+    assert fit["solver_area"] is None and "0 loads simulated" in fit["not_fitted"]
+    scenes = pd.read_csv(project / "results" / SMALL / "PS" / "scenes.csv")
+    row = scenes[(scenes["sphere"] == "PS-noload") & (scenes["scene"] == "elastic")].iloc[0]
+    assert pd.isna(row["exponent"]) and "not fitted: 0 loads simulated" in row["left_out"]
+    gt = project / "results" / SMALL / "PS" / "PS-noload" / "scenes" / "greenwood_tripp"
+    assert len(json.loads((gt / "solve.json").read_text())["loads"]) == 5
+
+
+def test_the_check_predicts_the_loads_outside_the_scan(lab_run):
+    """The check reads each scan's size and, with the apex at its centre, names the loads the
+    run then leaves out."""
+    project, _, check, _ = lab_run
+    plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
+    for sphere in (*CUT_SCANS, COMPLETE):
+        predicted = plans[sphere]["scenes"]["elastic"]
+        solve = _scene_record(project, sphere, "solve.json")
+        assert predicted["simulated_mn"] == solve["loads_mn"], sphere
+        assert [r["load_mn"] for r in predicted["outside_scan"]] == [
+            r["load_mn"] for r in solve["outside_scan"]
+        ], sphere

@@ -82,3 +82,39 @@ def side_px(window: float, pixel_m: float) -> int:
     """Solver grid side (px, even) of a window (m) at ``pixel_m`` (m)."""
     n = int(round(window / pixel_m))
     return n + n % 2
+
+
+def grid_window_m(name: str, scene: Mapping, frame: Frame) -> float:
+    """The side (m) of the grid the solver works on: ``side_px`` whole pixels, which may exceed
+    :func:`window_m` by up to a pixel's rounding."""
+    window = window_m(name, scene, frame)
+    pixel = solver_pixel_m(scene, window)
+    return side_px(window, pixel) * pixel
+
+
+class LeftOutLoad(NamedTuple):
+    """A load whose window (m) does not fit in the AFM scan about the sphere's apex."""
+
+    load_n: float
+    window_m: float
+
+
+def frame_in_scan(
+    name: str, scene: Mapping, frame: Frame, scan_window_m: float
+) -> tuple[Frame, tuple[LeftOutLoad, ...]]:
+    """The frame cut to the loads a scan holds, and the loads left out (``outside_scan``).
+
+    ``scan_window_m`` is the side (m) of the largest square about the sphere's apex that lies
+    inside the AFM scan. A load is kept where the grid window sized on it as the largest load
+    fits in that square; the loads increase, so the ones left out are the largest. A scene with
+    a fixed ``side_px`` keeps all its loads or none. The kept frame may hold no load.
+    """
+    kept: list[float] = []
+    left_out: list[LeftOutLoad] = []
+    for load in frame.loads_n:
+        window = grid_window_m(name, scene, frame._replace(loads_n=(*kept, load)))
+        if left_out or window > scan_window_m:
+            left_out.append(LeftOutLoad(load, window))
+        else:
+            kept.append(load)
+    return frame._replace(loads_n=tuple(kept)), tuple(left_out)

@@ -12,7 +12,7 @@ agreement, the fraction of the measured image's pixels on which both masks say t
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +42,7 @@ class LoadComparison:
     def to_record(self) -> dict:
         return {
             "load_mn": self.load_n * 1e3,
+            "status": COMPARED,
             "measured_area_um2": self.measured_area_m2 * 1e12,
             "simulated_area_um2": self.simulated_area_m2 * 1e12,
             "area_ratio": self.area_ratio,
@@ -49,7 +50,44 @@ class LoadComparison:
             "iou": self.iou,
             "pixel_agreement": self.pixel_agreement,
             "measured_contact_found": self.measured_found,
+            "window_um": None,
         }
+
+
+COMPARED = "compared"
+OUTSIDE_SCAN = "outside_scan"
+
+
+def outside_scan_record(load_mn: float, window_um: float, measured: ContactArea) -> dict:
+    """The comparison row of a load the AFM scan did not hold: its measured area, and the
+    window (µm) the simulation would have needed; nothing simulated, so no ratio or IoU."""
+    return {
+        "load_mn": load_mn,
+        "status": OUTSIDE_SCAN,
+        "measured_area_um2": measured.area_m2 * 1e12,
+        "simulated_area_um2": None,
+        "area_ratio": None,
+        "solver_area_um2": None,
+        "iou": None,
+        "pixel_agreement": None,
+        "measured_contact_found": measured.contact_found,
+        "window_um": window_um,
+    }
+
+
+def sheet_load_index(loads_mn: Sequence[float], load_mn: float) -> int:
+    """The index of ``load_mn`` among the sheet's loads (mN), to a relative 1e-9: a scene's
+    loads went through N and back."""
+    for index, load in enumerate(loads_mn):
+        if abs(load - load_mn) <= 1e-9 * abs(load):
+            return index
+    raise ValueError(f"load {load_mn:g} mN is none of the sheet's loads {list(loads_mn)}")
+
+
+def largest_compared(rows: Sequence[Mapping]) -> Mapping | None:
+    """The comparison row of the largest load compared (None where the scan held none)."""
+    compared = [row for row in rows if row["status"] == COMPARED]
+    return compared[-1] if compared else None
 
 
 def intersection_over_union(a: np.ndarray, b: np.ndarray) -> float:

@@ -9,16 +9,35 @@ import numpy as np
 
 from amontons.fits import fit_power_law
 
+# fit_power_law's standard errors need three points: a scene with fewer loads is not fitted.
+MIN_FIT_LOADS = 3
+
 
 def scene_area_fits(
     loads_mn: Sequence[float],
     solver_areas_um2: Sequence[float],
     rendered_areas_um2: Sequence[float] | None,
     confidence: float,
+    outside_scan: Sequence[Mapping] = (),
 ) -> dict:
     """A = A_ref·(F/F_ref)^α fitted to the solver's true area and, for a scene with optics, to
-    the rendered Otsu area (F_ref: the first load; areas in µm²)."""
+    the rendered Otsu area (F_ref: the first load; areas in µm²), over the loads simulated.
+    ``outside_scan`` lists the loads the AFM scan did not hold (solve.json); with fewer than
+    MIN_FIT_LOADS loads simulated, neither fit is made and ``not_fitted`` says why."""
     loads = np.asarray(loads_mn, dtype=float)
+    record = {
+        "quantity": "real contact area versus normal load of a simulated scene, "
+        "A = A_ref (F / F_ref)^exponent",
+        "units": {"prefactor": "um2 (area at x_ref)", "x_ref": "mN"},
+    }
+    left_out = {"loads_mn": loads.tolist(), "outside_scan": [dict(row) for row in outside_scan]}
+    if loads.size < MIN_FIT_LOADS:
+        reason = (
+            f"{loads.size} loads simulated ({len(outside_scan)} outside the AFM scan); a "
+            f"load-area fit needs {MIN_FIT_LOADS} or more"
+        )
+        return {**record, "solver_area": None, "rendered_area": None, **left_out,
+                "not_fitted": reason}  # fmt: skip
 
     def fit(areas):
         return fit_power_law(
@@ -26,12 +45,33 @@ def scene_area_fits(
         ).to_record()
 
     return {
-        "quantity": "real contact area versus normal load of a simulated scene, "
-        "A = A_ref (F / F_ref)^exponent",
-        "units": {"prefactor": "um2 (area at x_ref)", "x_ref": "mN"},
+        **record,
         "solver_area": fit(solver_areas_um2),
         "rendered_area": None if rendered_areas_um2 is None else fit(rendered_areas_um2),
+        **left_out,
+        "not_fitted": None,
     }
+
+
+def left_out_note(fit: Mapping) -> str:
+    """What a scene's fit lacks, in words ('' for a scene that simulated every load): the
+    loads outside the AFM scan and, where it was not fitted, why."""
+    notes = []
+    outside = fit.get("outside_scan") or []
+    if outside:
+        loads = ", ".join(f"{row['load_mn']:g}" for row in outside)
+        notes.append(f"outside_scan: {loads} mN")
+    if fit.get("not_fitted"):
+        notes.append(f"not fitted: {fit['not_fitted']}")
+    return "; ".join(notes)
+
+
+def _chosen_fit(fit: Mapping) -> tuple[str, Mapping | None]:
+    """The area a scene is judged on (the rendered Otsu area where it has optics) and its fit
+    (None where the scene was not fitted)."""
+    if fit["rendered_area"]:
+        return "rendered Otsu", fit["rendered_area"]
+    return "solver", fit["solver_area"]
 
 
 def scene_table_rows(
@@ -42,15 +82,16 @@ def scene_table_rows(
     measured = measured_fit["exponent"]
     rows = []
     for scene, record in scene_fits.items():
-        chosen = record["rendered_area"] or record["solver_area"]
-        exponent = chosen["exponent"]
-        solver = record["solver_area"]["exponent"]
+        area, chosen = _chosen_fit(record)
+        exponent = chosen["exponent"] if chosen else _NO_EXPONENT
+        solver = record["solver_area"]["exponent"] if record["solver_area"] else _NO_EXPONENT
+        difference = None if chosen is None else exponent["estimate"] - measured["estimate"]
         rows.append(
             {
                 "sphere": sphere,
                 "scene": scene,
                 "model": models[scene],
-                "area": "rendered Otsu" if record["rendered_area"] else "solver",
+                "area": area,
                 "exponent": exponent["estimate"],
                 "exponent_ci_low": exponent["ci_low"],
                 "exponent_ci_high": exponent["ci_high"],
@@ -58,13 +99,20 @@ def scene_table_rows(
                 "measured_exponent": measured["estimate"],
                 "measured_ci_low": measured["ci_low"],
                 "measured_ci_high": measured["ci_high"],
-                "difference": exponent["estimate"] - measured["estimate"],
+                "difference": difference,
+                "left_out": left_out_note(record),
             }
         )
     return rows
 
 
+# The exponent columns of a scene that was not fitted: empty, with left_out saying why.
+_NO_EXPONENT = {"estimate": None, "ci_low": None, "ci_high": None}
+
+
 def _exponent_columns(exponent: Mapping, measured: Mapping) -> dict:
+    """An exponent and its interval beside the measured one (empty where not fitted)."""
+    fitted = exponent["estimate"] is not None
     return {
         "exponent": exponent["estimate"],
         "exponent_ci_low": exponent["ci_low"],
@@ -72,7 +120,7 @@ def _exponent_columns(exponent: Mapping, measured: Mapping) -> dict:
         "measured_exponent": measured["estimate"],
         "measured_ci_low": measured["ci_low"],
         "measured_ci_high": measured["ci_high"],
-        "exponent_difference": exponent["estimate"] - measured["estimate"],
+        "exponent_difference": exponent["estimate"] - measured["estimate"] if fitted else None,
     }
 
 
@@ -87,12 +135,13 @@ def model_table_rows(
     parameter and each scan's best value, with its load-area exponent and interval beside the
     measured one, its parameter, and the area ratio and IoU at the largest load.
 
-    ``scenes``: name → {"fit": scene_fit.json, "largest": the comparison's last row or None
-    (no optics), "solve": solve.json}; ``scan_bests``: scan name → best.json."""
+    ``scenes``: name → {"fit": scene_fit.json, "largest": the comparison's row of the largest
+    load compared or None (no optics, or no load in the scan), "solve": solve.json};
+    ``scan_bests``: scan name → best.json."""
     measured = measured_fit["exponent"]
     rows = []
     for name, scene in scenes.items():
-        fit = scene["fit"]["rendered_area"] or scene["fit"]["solver_area"]
+        area, fit = _chosen_fit(scene["fit"])
         largest = scene["largest"]
         parameter = {"penetration_hardness": "p_y_mpa", "hardening": "k_mpa_per_nm"}.get(
             models[name]
@@ -102,14 +151,15 @@ def model_table_rows(
                 "sphere": sphere,
                 "model": models[name],
                 "source": f"scene {name}",
-                "area": "rendered Otsu" if scene["fit"]["rendered_area"] else "solver",
+                "area": area,
                 "parameter": parameter,
-                "value": scene["solve"][parameter] if parameter else None,
+                "value": scene["solve"].get(parameter) if parameter else None,
                 "value_low": None,
                 "value_high": None,
-                **_exponent_columns(fit["exponent"], measured),
+                **_exponent_columns(fit["exponent"] if fit else _NO_EXPONENT, measured),
                 "area_ratio_largest": largest["area_ratio"] if largest else None,
                 "iou_largest": largest["iou"] if largest else None,
+                "left_out": left_out_note(scene["fit"]),
             }
         )
     for name, best in scan_bests.items():
@@ -127,6 +177,7 @@ def model_table_rows(
                 **_exponent_columns(best["best_rendered_fit"]["exponent"], measured),
                 "area_ratio_largest": best["area_ratio_largest"],
                 "iou_largest": best["iou_largest"],
+                "left_out": left_out_note(best),
             }
         )
     return rows

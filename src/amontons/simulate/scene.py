@@ -194,6 +194,25 @@ def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -
     return _scene(name, config, frame, record={**record, "sphere": sphere})
 
 
+def scene_in_scan(
+    name: str, config: Mapping, sphere: str, record: Mapping, scan_window_m: float
+) -> tuple[Scene | None, tuple[geometry.LeftOutLoad, ...]]:
+    """The scene ``name`` on the AFM map of ``sphere`` cut to the loads whose window fits in
+    the largest square about the apex that the scan holds (``scan_window_m``, m), and the loads
+    left out (amontons.config.geometry.frame_in_scan). The window is sized on the largest load
+    kept; where no load fits, the scene is None."""
+    if config["surface"] != "afm_before":
+        raise SceneError(f"scene {name}: surface = {config['surface']!r} is not a sphere's map")
+    frame = geometry.sphere_frame(config, record)
+    try:
+        kept, left_out = geometry.frame_in_scan(name, config, frame, scan_window_m)
+    except geometry.GeometryError as exc:
+        raise SceneError(str(exc)) from exc
+    if not kept.loads_n:
+        return None, left_out
+    return _scene(name, config, kept, record={**record, "sphere": sphere}), left_out
+
+
 def synthetic_scene(name: str, config: Mapping) -> Scene:
     """A scene on a synthetic self-affine surface: it names E*, loads and (for the sphere
     geometry) the radius itself, and reads nothing of the experiment."""

@@ -13,18 +13,23 @@ the glass (an AFM scan of the apex, apex up, as is); the glass roughness is negl
 
 from __future__ import annotations
 
+import logging
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from amontons.config.geometry import LeftOutLoad
 from amontons.contact.surfaces import self_affine, sphere
 from amontons.io.fields import read_levelled_map
 from amontons.io.heightmap import TopographyError, read_height_map
 from amontons.io.layout import RawDataError
 from amontons.measure.topography import level_sphere, sphere_cap, square_pixels
 from amontons.physics.roughness import roughness_statistics
-from amontons.simulate.scene import Scene, SceneError
+from amontons.simulate.scene import Scene, SceneError, scene_in_scan
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -148,6 +153,69 @@ def load_levelled_map(path: str | Path) -> LevelledMap:
     )
 
 
+def _apex_rc_m(levelled: LevelledMap) -> tuple[float, float]:
+    """The fitted apex (row, col; m from the map's corner)."""
+    n0, n1 = levelled.heights_m.shape
+    # apex_xy_m is (x, y) = (col, row) from the map centre
+    x, y = levelled.apex_xy_m
+    return y + n0 * levelled.pixel_m / 2, x + n1 * levelled.pixel_m / 2
+
+
+def scan_window_m(levelled: LevelledMap) -> float:
+    """Side (m) of the largest square about the fitted apex that lies inside the scan: twice
+    the apex's distance to the nearest edge (0 for an apex outside the scan)."""
+    n0, n1 = levelled.heights_m.shape
+    row, col = _apex_rc_m(levelled)
+    extent = (n0 * levelled.pixel_m, n1 * levelled.pixel_m)
+    return max(0.0, 2 * min(row, col, extent[0] - row, extent[1] - col))
+
+
+@dataclass(frozen=True)
+class ScanCoverage:
+    """What of a scene's loads a sphere's AFM scan holds: the scan's width and height (m), the
+    largest window about the fitted apex inside it (m) and the loads left out, each with the
+    window it needs (amontons.config.geometry.LeftOutLoad)."""
+
+    scan_m: tuple[float, float]
+    largest_window_m: float
+    left_out: tuple[LeftOutLoad, ...]
+
+    def to_record(self) -> dict:
+        """JSON-ready, units in the key names; ``outside_scan`` lists the loads left out."""
+        return {
+            "scan_um": [s * 1e6 for s in self.scan_m],
+            "largest_window_in_scan_um": self.largest_window_m * 1e6,
+            "outside_scan": [
+                {"load_mn": load.load_n * 1e3, "window_um": load.window_m * 1e6}
+                for load in self.left_out
+            ],
+        }
+
+
+def afm_scene(
+    name: str, config: Mapping, sphere: str, record: Mapping, levelled: LevelledMap
+) -> tuple[Scene | None, ScanCoverage]:
+    """The scene ``name`` on ``sphere``'s levelled map at the loads whose window the scan
+    holds (None where it holds none), and what the scan covers."""
+    window = scan_window_m(levelled)
+    scene, left_out = scene_in_scan(name, config, sphere, record, window)
+    n0, n1 = levelled.heights_m.shape
+    scan = (n1 * levelled.pixel_m, n0 * levelled.pixel_m)
+    for load in left_out:
+        log.info(
+            "scene %s, sphere %s: %g mN left out (outside_scan): its window of %.1f µm does not "
+            "fit in the %.1f µm the scan holds about the apex (scan %.1f × %.1f µm)",
+            name,
+            sphere,
+            load.load_n * 1e3,
+            load.window_m * 1e6,
+            window * 1e6,
+            scan[0] * 1e6,
+            scan[1] * 1e6,
+        )
+    return scene, ScanCoverage(scan, window, left_out)
+
+
 def afm_indenter(levelled: LevelledMap, scene: Scene, source: str) -> Indenter:
     """The scene's indenter from a sphere's levelled AFM map: cut to the scene's window about
     the fitted apex and area-averaged to the solver pixel. A window that leaves the scan
@@ -156,8 +224,7 @@ def afm_indenter(levelled: LevelledMap, scene: Scene, source: str) -> Indenter:
     n = scene.side_px
     window = n * scene.pixel_m
     n0, n1 = heights.shape
-    # apex_xy_m is (x, y) = (col, row) from the map centre
-    apex_rc = (levelled.apex_xy_m[1] + n0 * pixel_m / 2, levelled.apex_xy_m[0] + n1 * pixel_m / 2)
+    apex_rc = _apex_rc_m(levelled)
     origin = (apex_rc[0] - window / 2, apex_rc[1] - window / 2)
     try:
         solver = area_average(heights, pixel_m, origin, n, scene.pixel_m)
