@@ -5,11 +5,19 @@ import numpy as np
 import pytest
 from skimage.transform import downscale_local_mean
 
+from amontons.config import geometry
 from amontons.contact.surfaces import self_affine
 from amontons.measure.topography import sphere_cap
+from amontons.physics.hertz import contact_radius
 from amontons.physics.roughness import roughness_statistics
 from amontons.simulate.scene import SceneError, scene_for_sphere
-from amontons.simulate.surface import afm_indenter, area_average, level_afm_map
+from amontons.simulate.surface import (
+    afm_indenter,
+    afm_scene,
+    area_average,
+    level_afm_map,
+    scan_window_m,
+)
 
 SCENE = {
     "surface": "afm_before",
@@ -137,3 +145,55 @@ def test_a_levelled_map_survives_its_hdf5_file(tmp_path):
         levelled.radius_m,
         levelled.apex_xy_m,
     )
+
+
+def test_a_scan_smaller_than_the_largest_window_keeps_the_loads_it_holds():
+    """An off-centre apex in a 40 µm scan: the square about the apex is twice its distance to
+    the nearest edge (to the bit of the geometry); the loads whose window (1.5 × the Hertz
+    diameter, sized as the largest) fits are kept and solved on a window the scan holds, no
+    smaller than the largest kept load needs; the others are left out with their windows."""
+    record = {"diameter_mm": 2.0, "e_star_gpa": 20.0, "loads": [5.0, 10.0, 20.0, 80.0, 160.0]}
+    apex = (3.0e-6, -2.0e-6)  # (row, col) from the map centre
+    levelled = level_afm_map(_sphere_map(400, 100e-9, 1e-3, apex), 100e-9)
+    # nearest edge: the apex's row is 20 + 3 µm from the top, 17 µm from the bottom edge
+    assert scan_window_m(levelled) == pytest.approx(2 * 17e-6, abs=10e-9)
+    scene, coverage = afm_scene("s", SCENE, "S", record, levelled)
+    hertz = {f: contact_radius(f * 1e-3, 1e-3, 20e9) * 2 for f in record["loads"]}
+    held = [f for f in record["loads"] if 1.5 * hertz[f] <= scan_window_m(levelled)]
+    assert [f * 1e3 for f in scene.loads_n] == pytest.approx(held) and len(held) == 3
+    assert [load.load_n * 1e3 for load in coverage.left_out] == pytest.approx([80.0, 160.0])
+    assert all(load.window_m > coverage.largest_window_m for load in coverage.left_out)
+    needed = 1.5 * hertz[held[-1]]
+    assert needed <= scene.window_m <= coverage.largest_window_m
+    assert scene.side_px * scene.pixel_m == pytest.approx(scene.window_m, rel=1e-12)
+    indenter = afm_indenter(levelled, scene, "map.tif")  # the window fits: no SceneError
+    assert indenter.heights.shape == (scene.side_px, scene.side_px)
+    record_out = coverage.to_record()
+    assert [row["load_mn"] for row in record_out["outside_scan"]] == pytest.approx([80, 160])
+    assert record_out["scan_um"] == pytest.approx([40.0, 40.0])
+
+
+def test_a_scan_that_holds_every_window_leaves_the_scene_as_configured():
+    record = {"diameter_mm": 2.0, "e_star_gpa": 20.0, "loads": [5.0, 10.0, 20.0]}
+    levelled = level_afm_map(_sphere_map(900, 100e-9, 1e-3), 100e-9)
+    scene, coverage = afm_scene("s", SCENE, "S", record, levelled)
+    assert scene == scene_for_sphere("s", SCENE, "S", record)
+    assert coverage.left_out == ()
+
+
+def test_a_scan_that_holds_no_window_gives_no_scene_and_every_load_left_out():
+    record = {"diameter_mm": 2.0, "e_star_gpa": 20.0, "loads": [20.0, 80.0]}
+    levelled = level_afm_map(_sphere_map(200, 100e-9, 1e-3), 100e-9)
+    scene, coverage = afm_scene("s", SCENE, "S", record, levelled)
+    assert scene is None
+    assert [load.load_n for load in coverage.left_out] == pytest.approx([0.02, 0.08])
+
+
+def test_a_fixed_window_keeps_every_load_or_none():
+    """side_px fixes the window whatever the load: a scan holds it for all loads or none."""
+    fixed = {**SCENE, "side_px": 100}  # 25 µm at 250 nm
+    record = {"diameter_mm": 2.0, "e_star_gpa": 20.0, "loads": [5.0, 10.0]}
+    frame = geometry.sphere_frame(fixed, record)
+    assert geometry.frame_in_scan("f", fixed, frame, 30e-6).left_out == ()
+    cut = geometry.frame_in_scan("f", fixed, frame, 20e-6)
+    assert cut.frame.loads_n == () and len(cut.left_out) == 2

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
@@ -37,7 +38,7 @@ CASES = {
                                                        "scenes/"]),
     "PS-norheometer": (["rheometer"], ["measure/friction.csv"]),
 }  # fmt: skip
-# AFM scans cut about their centre to a side (µm) that holds the elastic scene's windows of the
+# AFM scans cut about the apex to a side (µm) that holds the elastic scene's windows of the
 # three smaller loads (44 µm at 100 mN; 55 µm at 200 mN), and none (28 µm at 25 mN).
 CUT_SCANS = {"PS-cutscan": 50.0, "PS-noload": 24.0}
 # What the PSF enters: the sphere without a bead image renders with the stand-in, so these
@@ -54,14 +55,26 @@ PSF_DEPENDENT = {
 STAND_IN = {"fwhm_nm": 500.0, "fwhm_se_nm": 25.0}
 
 
-def _cut_scan(path: Path, side_um: float) -> None:
-    """The AFM scan at ``path`` cut to a square of ``side_um`` about its centre, with its
-    pixel size (as a smaller scan of the same instrument would be)."""
-    scan = read_image(path)
-    side = int(round(side_um * 1e-6 / scan.pixel_m))
-    n0, n1 = scan.data.shape
-    r, c = (n0 - side) // 2, (n1 - side) // 2
-    write_image(path, scan.data[r : r + side, c : c + side], scan.pixel_m)
+def _apex_px(heights: np.ndarray) -> tuple[float, float]:
+    """The apex (row, col; px) of a sphere's map: the vertex of the least-squares paraboloid
+    z = a + b r + c c + d (r² + c²)."""
+    rows, cols = np.indices(heights.shape, dtype=float)
+    design = np.stack([np.ones(rows.size), rows.ravel(), cols.ravel(),
+                       (rows**2 + cols**2).ravel()], axis=1)  # fmt: skip
+    _, b, c, d = np.linalg.lstsq(design, heights.ravel(), rcond=None)[0]
+    return -b / (2 * d), -c / (2 * d)
+
+
+def _cut_scans(folder: Path, side_um: float) -> None:
+    """The sphere's AFM scans cut to a square of ``side_um`` about the apex of the map before,
+    with their pixel size: a smaller scan of the same instrument, centred as a user centres
+    it."""
+    before = read_image(folder / "afm_before.tif")
+    side = int(round(side_um * 1e-6 / before.pixel_m))
+    row, col = (int(round(x)) - side // 2 for x in _apex_px(before.data))
+    for name in ("afm_before.tif", "afm_after.tif"):
+        scan = read_image(folder / name)
+        write_image(folder / name, scan.data[row : row + side, col : col + side], scan.pixel_m)
 
 
 def _lab_sphere(small_run, lab: Path, name: str, remove: list[str]) -> Path:
@@ -74,7 +87,7 @@ def _lab_sphere(small_run, lab: Path, name: str, remove: list[str]) -> Path:
         path = folder / entry
         shutil.rmtree(path) if path.is_dir() else path.unlink()
     if name in CUT_SCANS:
-        _cut_scan(folder / "afm_before.tif", CUT_SCANS[name])
+        _cut_scans(folder, CUT_SCANS[name])
     return folder
 
 

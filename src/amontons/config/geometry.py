@@ -99,15 +99,34 @@ class LeftOutLoad(NamedTuple):
     window_m: float
 
 
-def frame_in_scan(
-    name: str, scene: Mapping, frame: Frame, scan_window_m: float
-) -> tuple[Frame, tuple[LeftOutLoad, ...]]:
+class InScan(NamedTuple):
+    """A scene's frame cut to the loads an AFM scan holds, the loads left out, and the window
+    (m) and solver pixel (m) the kept loads are solved on (None, None where none is kept)."""
+
+    frame: Frame
+    left_out: tuple[LeftOutLoad, ...]
+    window_m: float | None
+    pixel_m: float | None
+
+
+def _grid_within(scene: Mapping, limit_m: float) -> tuple[float, float]:
+    """The largest grid window (m, an even number of solver pixels) no wider than ``limit_m``,
+    and its solver pixel (m)."""
+    pixel = solver_pixel_m(scene, limit_m)
+    n = int(limit_m / pixel)
+    return (n - n % 2) * pixel, pixel
+
+
+def frame_in_scan(name: str, scene: Mapping, frame: Frame, scan_window_m: float) -> InScan:
     """The frame cut to the loads a scan holds, and the loads left out (``outside_scan``).
 
     ``scan_window_m`` is the side (m) of the largest square about the sphere's apex that lies
     inside the AFM scan. A load is kept where the grid window sized on it as the largest load
     fits in that square; the loads increase, so the ones left out are the largest. A scene with
-    a fixed ``side_px`` keeps all its loads or none. The kept frame may hold no load.
+    a fixed ``side_px`` keeps all its loads or none. The kept loads are solved on the frame's
+    own window where the scan holds it, else on the largest grid window the scan holds, which
+    is never smaller than the one sized on the largest load kept: as much room about the
+    contact as the scan allows.
     """
     kept: list[float] = []
     left_out: list[LeftOutLoad] = []
@@ -117,4 +136,10 @@ def frame_in_scan(
             left_out.append(LeftOutLoad(load, window))
         else:
             kept.append(load)
-    return frame._replace(loads_n=tuple(kept)), tuple(left_out)
+    cut = frame._replace(loads_n=tuple(kept))
+    if not kept:
+        return InScan(cut, tuple(left_out), None, None)
+    if not left_out:
+        window = window_m(name, scene, frame)
+        return InScan(cut, (), window, solver_pixel_m(scene, window))
+    return InScan(cut, tuple(left_out), *_grid_within(scene, scan_window_m))

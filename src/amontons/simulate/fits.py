@@ -68,7 +68,9 @@ def left_out_note(fit: Mapping) -> str:
 
 def _chosen_fit(fit: Mapping) -> tuple[str, Mapping | None]:
     """The area a scene is judged on (the rendered Otsu area where it has optics) and its fit
-    (None where the scene was not fitted)."""
+    ('not fitted' and None where the scene was not fitted)."""
+    if fit.get("not_fitted"):
+        return "not fitted", None
     if fit["rendered_area"]:
         return "rendered Otsu", fit["rendered_area"]
     return "solver", fit["solver_area"]

@@ -15,7 +15,7 @@ resolves a synthetic scene, which names all of them itself.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from amontons.config import geometry
 from amontons.contact import ContactHardening, PenetrationHardness
@@ -199,18 +199,19 @@ def scene_in_scan(
 ) -> tuple[Scene | None, tuple[geometry.LeftOutLoad, ...]]:
     """The scene ``name`` on the AFM map of ``sphere`` cut to the loads whose window fits in
     the largest square about the apex that the scan holds (``scan_window_m``, m), and the loads
-    left out (amontons.config.geometry.frame_in_scan). The window is sized on the largest load
-    kept; where no load fits, the scene is None."""
+    left out, on the window amontons.config.geometry.frame_in_scan gives them (the scene's own
+    where the scan holds every load); where no load fits, the scene is None."""
     if config["surface"] != "afm_before":
         raise SceneError(f"scene {name}: surface = {config['surface']!r} is not a sphere's map")
     frame = geometry.sphere_frame(config, record)
     try:
-        kept, left_out = geometry.frame_in_scan(name, config, frame, scan_window_m)
+        cut = geometry.frame_in_scan(name, config, frame, scan_window_m)
     except geometry.GeometryError as exc:
         raise SceneError(str(exc)) from exc
-    if not kept.loads_n:
-        return None, left_out
-    return _scene(name, config, kept, record={**record, "sphere": sphere}), left_out
+    if not cut.frame.loads_n:
+        return None, cut.left_out
+    scene = _scene(name, config, cut.frame, record={**record, "sphere": sphere})
+    return replace(scene, window_m=cut.window_m, pixel_m=cut.pixel_m), cut.left_out
 
 
 def synthetic_scene(name: str, config: Mapping) -> Scene:
