@@ -16,7 +16,7 @@ log = logging.getLogger(__name__)
 
 def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str, confidence):
     records = sorted((read_json(p) for p in point_paths), key=lambda r: r["value"])
-    if not records[0]["loads"] and records[0]["outside_scan"]:
+    if all(r.get("loads") == [] for r in records):  # the scan held no load (scan_scene)
         raise ScanError(
             f"scan {scan_name}: sphere {records[0]['sphere']}'s AFM scan holds none of the "
             f"loads' windows ({len(records[0]['outside_scan'])} loads outside_scan); expected "

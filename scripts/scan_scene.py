@@ -83,10 +83,10 @@ def main(
         otsu=settings,
     )
     sheet_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
-    loads_mn = [sheet_mn[sheet_load_index(sheet_mn, f * 1e3)] for f in scene.loads_n]
-    images = read_fluorescence_series(
-        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
-    )
+    simulated = [sheet_load_index(sheet_mn, f * 1e3) for f in scene.loads_n]
+    loads_mn = [sheet_mn[i] for i in simulated]
+    files = per_load_files(fluorescence, sheet_mn, fluorescence_name)
+    images = read_fluorescence_series([files[i] for i in simulated], pixel_nm * 1e-9)
     measured = [image_contact_area(image, settings) for image in images]
     rows = compare_loads(
         [f * 1e-3 for f in loads_mn],

@@ -1,6 +1,7 @@
 """The study's verdict from the model tables, and the pages that show it (docs/study.md §6)."""
 
 import base64
+import io
 from pathlib import Path
 
 import matplotlib
@@ -105,6 +106,9 @@ def test_models_inside_the_measured_interval_are_all_named_and_none_singled_out(
         "contact hardening, elastic: not decided"
     )
     assert verdict_text({"matching": ""}) == "no model"
+    # the verdict table read back: pandas reads the empty cell as NaN
+    read_back = pd.read_csv(io.StringIO("sphere,matching\nPS,\n")).iloc[0].to_dict()
+    assert verdict_text(read_back) == "no model"
 
 
 def test_a_best_json_without_the_estimate_is_named():

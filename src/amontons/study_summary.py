@@ -178,8 +178,10 @@ def parameter_text(row: Mapping, parameter: str) -> str:
 
 
 def verdict_text(row: Mapping) -> str:
-    """Which models give the measured exponent, in words."""
-    matching = [MODELS[m] for m in row["matching"].split(";") if m]
+    """Which models give the measured exponent, in words (an empty cell, which a CSV reads
+    back as NaN: none)."""
+    cell = row["matching"]
+    matching = [MODELS[m] for m in cell.split(";") if m] if isinstance(cell, str) else []
     if not matching:
         return "no model"
     if len(matching) == 1:

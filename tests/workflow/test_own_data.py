@@ -335,3 +335,30 @@ def test_the_check_predicts_the_loads_outside_the_scan(lab_run):
         assert [r["load_mn"] for r in predicted["outside_scan"]] == [
             r["load_mn"] for r in solve["outside_scan"]
         ], sphere
+
+
+def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_run, tmp_path):
+    """The p_Y scan (three values, to keep it short) of the sphere whose AFM scan holds three
+    loads: every value is solved and compared on those three, the best value's fit is over
+    them, and best.json and the model table list 200 and 300 mN as outside_scan."""
+    project = _project(tmp_path, small_run, {"PS-cutscan": []})
+    path = project / "config" / "test.yaml"
+    config = yaml.safe_load(path.read_text())
+    config.update(run_scenes=["penetration_hardness"], run_scans=["p_y"])
+    config["scans"] = {"p_y": {"steps": 3}}
+    path.write_text(yaml.safe_dump(config))
+    run = _snakemake(project, "--cores", "2")
+    assert run.returncode == 0, run.stderr[-3000:]
+    scan = project / "results" / SMALL / "PS" / "PS-cutscan" / "scans" / "p_y"
+    best = json.loads((scan / "best.json").read_text())
+    assert [row["load_mn"] for row in best["outside_scan"]] == [200.0, 300.0]
+    assert [row["load_mn"] for row in best["best_loads"]] == pytest.approx([25, 50, 100])
+    points = pd.read_csv(scan / "scan.csv")
+    # a value soft enough that its contact leaves the window is recorded, never judged
+    judged = points[~points["contact_leaves_window"]]
+    assert len(points) == 3 and len(judged) >= 2 and judged["log_area_distance"].notna().all()
+    for value in judged["value"]:
+        point = json.loads((scan / f"{value:g}" / "scan_point.json").read_text())
+        assert [row["load_mn"] for row in point["loads"]] == pytest.approx([25, 50, 100])
+    models = pd.read_csv(project / "results" / SMALL / "PS" / "models.csv")
+    assert set(models["left_out"]) == {"outside_scan: 200, 300 mN"}
