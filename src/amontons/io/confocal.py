@@ -13,15 +13,13 @@ Accepted, each tested on files its own writer made (tests/io/test_confocal.py):
 
 Which plane is used is an :class:`ImageChoice` (config ``optics.images``). A file whose
 choice cannot be met raises ImageError listing what it holds (channel names, series, frames).
-Writes (the virtual experiment's) are atomic.
+The writers (the virtual experiment's) are in amontons.io.confocal_writers.
 """
 
 from __future__ import annotations
 
 import logging
-import uuid
 import xml.etree.ElementTree as ElementTree
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,9 +27,8 @@ import numpy as np
 import pylibCZIrw.czi as pyczi
 import tifffile
 
-from amontons.io.files import atomic_path
 from amontons.io.layout import confocal_suffix
-from amontons.io.tiff import Image, ImageError, read_image, resolve_pixel, write_image
+from amontons.io.tiff import Image, ImageError, read_image, resolve_pixel
 
 log = logging.getLogger(__name__)
 
@@ -51,9 +48,6 @@ _UNITS_PER_M = {
 _OME_DEFAULT_UNIT = "µm"  # OME-XML: PhysicalSizeX without a unit is in µm
 _CZI_PIXEL_TYPES = {"Gray8": np.uint8, "Gray16": np.uint16, "Gray32Float": np.float32}
 _FRAMES_MEAN = "mean"
-# The formats the virtual experiment can write its images in (config
-# virtual_experiment.formats.images) and the file suffix of each.
-IMAGE_FORMATS = {"tif": ".tif", "ome_tiff": ".ome.tif", "czi": ".czi"}
 
 
 @dataclass(frozen=True)
@@ -206,40 +200,44 @@ def _czi_pixel(path: Path, metadata: dict) -> float | None:
     return _square_pixel(path, *sizes)
 
 
+def _czi_pixel_type(path: Path, czi: pyczi.CziReader) -> str:
+    """The one grey-level pixel type of a CZI's channels ('Invalid': a channel with no plane)."""
+    kinds = {kind for kind in czi.pixel_types.values() if kind != "Invalid"}
+    if len(kinds) != 1 or not kinds <= set(_CZI_PIXEL_TYPES):
+        raise ImageError(
+            f"{path}: CZI pixel types {sorted(kinds)}; expected one grey-level type "
+            f"({', '.join(_CZI_PIXEL_TYPES)})"
+        )
+    return kinds.pop()
+
+
 def _czi_planes(path: Path, series: int) -> Planes:
-    """A CZI's scene ``series``: every channel, every T and Z plane (absent ones read as 0)."""
+    """A CZI's scene ``series``: every channel, every T and Z plane (a channel the metadata
+    name but no plane was written for reads as 0)."""
     with pyczi.open_czi(str(path)) as czi:
         scenes = czi.scenes_bounding_rectangle
         count = max(len(scenes), 1)
         if not 0 <= series < count:
             raise _series_error(path, series, count)
         box = czi.total_bounding_box
-        kinds = set(czi.pixel_types.values())
-        if not kinds <= set(_CZI_PIXEL_TYPES):
-            raise ImageError(
-                f"{path}: CZI pixel types {sorted(kinds)}; expected grey levels "
-                f"({', '.join(_CZI_PIXEL_TYPES)})"
-            )
-        channels = range(*box.get("C", (0, 1)))
+        kind = _czi_pixel_type(path, czi)
         frames = [
             (t, z) for t in range(*box.get("T", (0, 1))) for z in range(*box.get("Z", (0, 1)))
         ]
         scene = series if scenes else None
         stack = np.stack(
             [
-                np.stack(
-                    [
-                        czi.read(plane={"C": c, "T": t, "Z": z}, scene=scene)[..., 0]
-                        for c in channels
-                    ]
-                )
+                [
+                    czi.read(plane={"C": c, "T": t, "Z": z}, scene=scene, pixel_type=kind)[..., 0]
+                    for c in range(*box.get("C", (0, 1)))
+                ]
                 for t, z in frames
             ]
         )
         metadata = czi.metadata
-    dtype = _CZI_PIXEL_TYPES[next(iter(kinds))]
     names = _czi_channels(metadata, stack.shape[1])
-    return Planes(stack.astype(dtype, copy=False), names, count, _czi_pixel(path, metadata), "CZI")
+    data = stack.astype(_CZI_PIXEL_TYPES[kind], copy=False)
+    return Planes(data, names, count, _czi_pixel(path, metadata), "CZI")
 
 
 def read_planes(path: str | Path, series: int = 0) -> Planes:
@@ -362,41 +360,3 @@ def read_confocal(
         path, planes.pixel_m, fallback_pixel_m, f"{planes.format} metadata"
     )
     return Image(data=data, pixel_m=pixel_m, path=path, pixel_source=source)
-
-
-def write_ome_tiff(path: str | Path, data: np.ndarray, pixel_m: float) -> None:
-    """Write a 2-D image as a one-channel OME-TIFF with its pixel size (PhysicalSizeX/Y in
-    µm)."""
-    pixel_um = pixel_m * 1e6
-    # The OME-XML's UUID follows from the pixels, so the same image gives the same bytes.
-    checksum = zlib.crc32(np.ascontiguousarray(data).tobytes())
-    metadata = {
-        "UUID": f"urn:uuid:{uuid.uuid5(uuid.NAMESPACE_OID, f'amontons.{checksum}')}",
-        "axes": "YX",
-        "PhysicalSizeX": pixel_um,
-        "PhysicalSizeXUnit": "µm",
-        "PhysicalSizeY": pixel_um,
-        "PhysicalSizeYUnit": "µm",
-    }
-    with atomic_path(path) as tmp:
-        tifffile.imwrite(tmp, data, ome=True, photometric="minisblack", metadata=metadata)
-
-
-def write_czi(
-    path: str | Path, data: np.ndarray, pixel_m: float, channel: str = "fluorescence"
-) -> None:
-    """Write a 2-D image (uint8, uint16 or float32) as a one-channel CZI with its pixel size
-    (Scaling, m) through pylibCZIrw. libCZI gives every file new GUIDs: the same image gives
-    the same pixels and metadata, not the same bytes."""
-    with atomic_path(path) as tmp, pyczi.create_czi(str(tmp), exist_ok=True) as czi:
-        czi.write(np.ascontiguousarray(data)[..., np.newaxis], plane={"C": 0, "T": 0, "Z": 0})
-        czi.write_metadata(channel_names={0: channel}, scale_x=pixel_m, scale_y=pixel_m)
-
-
-def write_confocal(path: str | Path, data: np.ndarray, pixel_m: float, image_format: str) -> None:
-    """Write a 2-D image in ``image_format`` (a key of IMAGE_FORMATS; the file's suffix must
-    be that format's), with its pixel size (m) in the format's metadata."""
-    writers = {"tif": write_image, "ome_tiff": write_ome_tiff, "czi": write_czi}
-    if image_format not in writers:
-        raise ValueError(f"image format {image_format!r}; expected one of {sorted(writers)}")
-    writers[image_format](path, data, pixel_m)

@@ -31,6 +31,9 @@ BEAD_NAME = f"{BEAD_STEM}.tif"
 # The confocal image formats amontons.io.confocal reads, each tested on files its writer made:
 # OME-TIFF, plain or ImageJ hyperstack TIFF, Zeiss CZI (docs/own-data.md says why no others).
 CONFOCAL_SUFFIXES = (".ome.tif", ".ome.tiff", ".tif", ".tiff", ".czi")
+# The formats the virtual experiment writes its images in (virtual_experiment.formats.images,
+# amontons.io.confocal_writers) and the suffix of each.
+IMAGE_FORMATS = {"tif": ".tif", "ome_tiff": ".ome.tif", "czi": ".czi"}
 ABSORBANCE_NAME = "absorbance.csv"
 FLIM_NAME = "flim.tif"
 FLIM_PTU_NAME = "flim.ptu"
