@@ -359,4 +359,4 @@ def read_confocal(
     pixel_m, source = resolve_pixel(
         path, planes.pixel_m, fallback_pixel_m, f"{planes.format} metadata"
     )
-    return Image(data=data, pixel_m=pixel_m, path=path, pixel_source=source)
+    return Image(data=data, pixel_m=pixel_m, path=path, pixel_source=source, format=planes.format)

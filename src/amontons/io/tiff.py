@@ -38,12 +38,14 @@ class ImageError(ValueError):
 @dataclass(frozen=True)
 class Image:
     """A 2-D image and its square pixel size in metres; ``pixel_source`` says whether that
-    came from the file's metadata ('file') or the sample sheet ('sheet')."""
+    came from the file's metadata ('file') or the sample sheet ('sheet'); ``format`` names the
+    file format it was read from."""
 
     data: np.ndarray
     pixel_m: float
     path: Path
     pixel_source: str = PIXEL_FROM_FILE
+    format: str = "TIFF"
 
 
 @dataclass(frozen=True)
