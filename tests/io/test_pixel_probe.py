@@ -48,6 +48,7 @@ WRITERS = {
     ),
     "hyper.tif": (lambda p: _imagej(p, "um"), True),
     "nounit.tif": (lambda p: _imagej(p, None), False),
+    "uncalibrated.tif": (lambda p: _imagej(p, "pixel"), False),
     "25.czi": (lambda p: write_confocal(p, DATA, 200e-9, "czi"), True),
     "bare.czi": (_czi_without_scaling, False),
 }

@@ -46,6 +46,7 @@ _UNITS_PER_M = {
     "nm": 1e9,
 }
 _OME_DEFAULT_UNIT = "µm"  # OME-XML: PhysicalSizeX without a unit is in µm
+IMAGEJ_UNCALIBRATED = ("pixel", "pixels")  # ImageJ's unit of an image without a pixel size
 _CZI_PIXEL_TYPES = {"Gray8": np.uint8, "Gray16": np.uint16, "Gray32Float": np.float32}
 _FRAMES_MEAN = "mean"
 
@@ -142,9 +143,11 @@ def _ome_pixel_and_channels(
 
 
 def _imagej_pixel(path: Path, tif: tifffile.TiffFile) -> float | None:
+    """An ImageJ file's pixel (m): its resolution tags in its ``unit``; None without a unit
+    or with ImageJ's uncalibrated one, 'pixel'."""
     unit = (tif.imagej_metadata or {}).get("unit")
     tags = tif.pages[0].tags
-    if unit is None or "XResolution" not in tags:
+    if unit is None or unit in IMAGEJ_UNCALIBRATED or "XResolution" not in tags:
         return None
     sizes = []
     for name in ("XResolution", "YResolution"):

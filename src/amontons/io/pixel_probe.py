@@ -80,7 +80,8 @@ def _tiff_states_pixel(path: Path) -> bool:
     if numerator <= 0 or denominator <= 0:
         return False
     if description.startswith("ImageJ="):
-        return re.search(r"^unit=", description, re.MULTILINE) is not None
+        unit = re.search(r"^unit=(.*)$", description, re.MULTILINE)
+        return unit is not None and unit[1].strip() not in ("pixel", "pixels")
     unit = tags.get(_RESOLUTION_UNIT)
     per_unit = numerator / denominator
     return unit == _CENTIMETRE or (unit == _INCH and per_unit > _DISPLAY_DPI_MAX)
