@@ -50,8 +50,9 @@ def _czi(path, stack=STACK, pixel_m=PIXEL_M, channels=CHANNELS, skip=(), scenes=
     return path
 
 
-def test_ome_tiff_written_by_tifffile_gives_the_chosen_channel_frame_and_pixel(tmp_path):
-    path = _ome(tmp_path / "25.ome.tif")
+@pytest.mark.parametrize("name", ["25.ome.tif", "25.ome.tiff"])
+def test_ome_tiff_written_by_tifffile_gives_the_chosen_channel_frame_and_pixel(tmp_path, name):
+    path = _ome(tmp_path / name)
     image = read_confocal(path, None, ImageChoice(channel="reflection", frames=2))
     np.testing.assert_array_equal(image.data, STACK[2, 1])
     assert image.data.dtype == np.uint16
