@@ -201,9 +201,9 @@ def image_pixel_m(sheet_pixel_nm: float | None, area_tables: Sequence[str | Path
     if sheet_pixel_nm is not None:
         return sheet_pixel_nm * 1e-9
     (path,) = area_tables
-    pixels = pd.read_csv(path)["pixel_nm"].unique()
+    pixels = [float(p) for p in pd.read_csv(path)["pixel_nm"].unique()]
     if len(pixels) != 1:
-        raise ValueError(f"{path}: pixel_nm {list(pixels)}; expected one pixel for the series")
+        raise ValueError(f"{path}: pixel_nm {pixels}; expected one pixel for the series")
     return float(pixels[0]) * 1e-9
 
 
