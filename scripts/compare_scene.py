@@ -5,9 +5,10 @@ import logging
 
 import pandas as pd
 
+from amontons.io.confocal import ImageChoice
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_json, write_table
-from amontons.io.layout import RawDataError, fluorescence_name, per_load_files
+from amontons.io.layout import RawDataError, fluorescence_names, per_load_files
 from amontons.io.rawdata import read_fluorescence_series
 from amontons.measure.area import OtsuSettings, image_contact_area, otsu_contact_area
 from amontons.plots import plot_scene_comparison
@@ -34,7 +35,8 @@ def main(
     registration_path: str,
     figure_paths: list[str],
     loads_mn: list[float],
-    pixel_nm: float,
+    pixel_nm: float | None,
+    images: dict,
     otsu: dict,
     data_label: str,
     label: str,
@@ -43,12 +45,14 @@ def main(
     fields, _, attrs = read_load_series(rendered_path)
     pixel_m = attrs["image_pixel_nm"] * 1e-9
     images = read_fluorescence_series(
-        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
+        per_load_files(fluorescence, loads_mn, fluorescence_names),
+        None if pixel_nm is None else pixel_nm * 1e-9,
+        ImageChoice(**images),
     )
     if abs(images[0].pixel_m - pixel_m) > 1e-6 * pixel_m:
         raise RawDataError(
             f"{images[0].path}: pixel {images[0].pixel_m * 1e9:.4g} nm, but the scene was "
-            f"rendered at {pixel_m * 1e9:.4g} nm (the sheet's fluorescence_pixel_nm); expected "
+            f"rendered at {pixel_m * 1e9:.4g} nm (the sheet's or the images' pixel); expected "
             "one pixel size"
         )
     solve = read_json(solve_path)
@@ -146,6 +150,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
+        images=sm.params.images,
         otsu=sm.params.otsu,
         data_label=sm.params.data_label,
         label=f"{sm.wildcards.sphere}, scene {sm.wildcards.scene}",

@@ -2,8 +2,9 @@
 
 import logging
 
+from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_table
-from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.layout import fluorescence_names, per_load_files
 from amontons.io.rawdata import read_fluorescence_series
 from amontons.measure.area import OtsuSettings, contact_area_table, image_contact_area
 from amontons.plots import plot_contact_separation
@@ -17,14 +18,16 @@ def main(
     table_path: str,
     figure_paths: list[str],
     loads_mn: list[float],
-    pixel_nm: float,
+    pixel_nm: float | None,
+    images: dict,
     otsu: dict,
     data_label: str,
     sphere: str,
 ) -> None:
     settings = OtsuSettings.from_config(otsu)
-    paths = per_load_files(fluorescence, loads_mn, fluorescence_name)
-    images = read_fluorescence_series(paths, pixel_nm * 1e-9)
+    paths = per_load_files(fluorescence, loads_mn, fluorescence_names)
+    choice = ImageChoice(**images)
+    images = read_fluorescence_series(paths, None if pixel_nm is None else pixel_nm * 1e-9, choice)
     areas = [image_contact_area(image, settings) for image in images]
     table = contact_area_table(loads_mn, images, areas)
     for row in table.itertuples():
@@ -61,6 +64,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
+        images=sm.params.images,
         otsu=sm.params.otsu,
         data_label=sm.params.data_label,
         sphere=sm.wildcards.sphere,

@@ -2,8 +2,9 @@
 
 import logging
 
+from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json
-from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.layout import fluorescence_names, per_load_files
 from amontons.measure.area import OtsuSettings
 from amontons.measure.edge_gap import measure_edge_gap, unmeasured_edge_gap_record
 from amontons.measure.errors import NotMeasurable
@@ -20,7 +21,9 @@ def main(
     gap_path: str,
     figure_paths: list[str],
     reflection_load_mn: float,
-    pixel_nm: float,
+    pixel_nm: float | None,
+    images: dict,
+    reflection_images: dict,
     otsu: dict,
     newton_rings: dict,
     data_label: str,
@@ -29,12 +32,14 @@ def main(
     e_star_gpa: float,
 ) -> None:
     title = f"{sphere}: Newton-ring gap at {reflection_load_mn:g} mN ({data_label})"
-    (image,) = per_load_files(fluorescence, [reflection_load_mn], fluorescence_name)
+    (image,) = per_load_files(fluorescence, [reflection_load_mn], fluorescence_names)
     try:
         result = measure_edge_gap(
             reflection_path,
             image,
-            pixel_nm * 1e-9,
+            None if pixel_nm is None else pixel_nm * 1e-9,
+            choice=ImageChoice(**images),
+            reflection_choice=ImageChoice(**reflection_images),
             load_mn=reflection_load_mn,
             otsu=OtsuSettings.from_config(otsu),
             n_profiles=newton_rings["n_profiles"],
@@ -98,6 +103,8 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         reflection_load_mn=sm.params.reflection_load_mn,
         pixel_nm=sm.params.pixel_nm,
+        images=sm.params.images,
+        reflection_images=sm.params.reflection_images,
         otsu=sm.params.otsu,
         newton_rings=sm.params.newton_rings,
         data_label=sm.params.data_label,

@@ -2,8 +2,9 @@
 
 import logging
 
+from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json, write_table
-from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.layout import fluorescence_names, per_load_files
 from amontons.measure.area import OtsuSettings
 from amontons.measure.intensity import (
     intensity_pressure_record,
@@ -22,7 +23,8 @@ def main(
     fit_path: str,
     figure_paths: list[str],
     loads_mn: list[float],
-    pixel_nm: float,
+    pixel_nm: float | None,
+    images: dict,
     otsu: dict,
     background_margin_px: int,
     pressure_ref_mpa: float,
@@ -31,9 +33,10 @@ def main(
     sphere: str,
 ) -> None:
     result, backgrounds, excluded = measure_intensity_pressure(
-        per_load_files(fluorescence, loads_mn, fluorescence_name),
+        per_load_files(fluorescence, loads_mn, fluorescence_names),
         loads_mn,
-        pixel_nm * 1e-9,
+        None if pixel_nm is None else pixel_nm * 1e-9,
+        choice=ImageChoice(**images),
         otsu=OtsuSettings.from_config(otsu),
         background_margin_px=background_margin_px,
         pressure_ref_pa=pressure_ref_mpa * 1e6,
@@ -65,6 +68,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
+        images=sm.params.images,
         otsu=sm.params.otsu,
         background_margin_px=sm.params.intensity["background_margin_px"],
         pressure_ref_mpa=sm.params.intensity["pressure_ref_mpa"],

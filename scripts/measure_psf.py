@@ -2,6 +2,7 @@
 
 import logging
 
+from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json
 from amontons.measure.psf import measure_bead
 from amontons.plots import plot_psf_profile
@@ -14,7 +15,8 @@ def main(
     bead_path: str,
     psf_path: str,
     figure_paths: list[str],
-    pixel_nm: float,
+    pixel_nm: float | None,
+    images: dict,
     profile_radius_nm: float,
     centroid_radius_nm: float,
     data_label: str,
@@ -22,7 +24,8 @@ def main(
 ) -> None:
     psf = measure_bead(
         bead_path,
-        pixel_nm * 1e-9,
+        None if pixel_nm is None else pixel_nm * 1e-9,
+        choice=ImageChoice(**images),
         profile_radius_m=profile_radius_nm * 1e-9,
         centroid_radius_m=centroid_radius_nm * 1e-9,
     )
@@ -49,6 +52,7 @@ if __name__ == "__main__":
         psf_path=sm.output.psf,
         figure_paths=[sm.output.png, sm.output.pdf],
         pixel_nm=sm.params.pixel_nm,
+        images=sm.params.images,
         profile_radius_nm=sm.params.psf["profile_radius_nm"],
         centroid_radius_nm=sm.params.psf["centroid_radius_nm"],
         data_label=sm.params.data_label,

@@ -10,9 +10,10 @@ import logging
 import numpy as np
 import pandas as pd
 
+from amontons.io.confocal import ImageChoice
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_table
-from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.layout import fluorescence_names, per_load_files
 from amontons.io.rawdata import read_fluorescence_series
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
@@ -43,14 +44,17 @@ def main(
     table_path: str,
     figure_paths: list[str],
     loads_mn: list[float],
-    pixel_nm: float,
+    pixel_nm: float | None,
+    images: dict,
     otsu: dict,
     label: str,
 ) -> None:
-    pixel_m = pixel_nm * 1e-9
     images = read_fluorescence_series(
-        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_m
+        per_load_files(fluorescence, loads_mn, fluorescence_names),
+        None if pixel_nm is None else pixel_nm * 1e-9,
+        ImageChoice(**images),
     )
+    pixel_m = images[0].pixel_m
     settings = OtsuSettings.from_config(otsu)
     measured = [image_contact_area(image, settings) for image in images]
     shape = images[0].data.shape
@@ -120,7 +124,7 @@ def main(
             "elastic",
             f"hardening\ngrid's best\nk = {significant(best['grid_best'])} MPa/nm",
         ],
-        pixel_nm * 1e-3,
+        pixel_m * 1e6,
         f"{label}: measured and simulated contact at increasing loads; hardening at "
         f"{grid_best_text(best)}; outlines: Otsu masks",
         figure_paths,
@@ -140,6 +144,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
+        images=sm.params.images,
         otsu=sm.params.otsu,
         label=sm.params.label,
     )

@@ -7,9 +7,10 @@ import logging
 import numpy as np
 import pandas as pd
 
+from amontons.io.confocal import ImageChoice
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_table
-from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.layout import fluorescence_names, per_load_files
 from amontons.io.rawdata import read_fluorescence_series
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
@@ -26,12 +27,15 @@ def main(
     table_path: str,
     figure_paths: list[str],
     loads_mn: list[float],
-    pixel_nm: float,
+    pixel_nm: float | None,
+    images: dict,
     otsu: dict,
     label: str,
 ) -> None:
     images = read_fluorescence_series(
-        per_load_files(fluorescence, loads_mn, fluorescence_name), pixel_nm * 1e-9
+        per_load_files(fluorescence, loads_mn, fluorescence_names),
+        None if pixel_nm is None else pixel_nm * 1e-9,
+        ImageChoice(**images),
     )
     measured = images[-1]
     contact = image_contact_area(measured, OtsuSettings.from_config(otsu))
@@ -85,7 +89,7 @@ def main(
     plot_map_grid(
         rows,
         labels,
-        pixel_nm * 1e-3,
+        measured.pixel_m * 1e6,
         f"{label}: contact at {loads_mn[-1]:g} mN, measured and simulated over the scans; "
         f"framed: the grid's best value; estimates: {'; '.join(estimates)}; D: rms log-area "
         "distance over all loads",
@@ -104,6 +108,7 @@ if __name__ == "__main__":
         figure_paths=[sm.output.png, sm.output.pdf],
         loads_mn=sm.params.loads_mn,
         pixel_nm=sm.params.pixel_nm,
+        images=sm.params.images,
         otsu=sm.params.otsu,
         label=sm.params.label,
     )

@@ -7,7 +7,7 @@ import pandas as pd
 
 from amontons.io.fields import read_load_series, write_load_series
 from amontons.io.files import read_json, write_table
-from amontons.measure.area import OtsuSettings
+from amontons.measure.area import OtsuSettings, image_pixel_m
 from amontons.runlog import run_logged
 from amontons.simulate.render import render_load_series
 
@@ -29,24 +29,28 @@ def main(
     psf_path: str,
     rendered_path: str,
     table_path: str,
-    pixel_nm: float,
+    pixel_nm: float | None,
+    pixel_table: list[str],
     rendering: str,
     confinement_floor_mpa: float,
     otsu: dict,
 ) -> None:
     fields, per_load, settings = read_load_series(fields_path)
+    pixel_m = image_pixel_m(pixel_nm, pixel_table)
     psf_fwhm_m = read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9
-    if not fields:
+    rendered = []
+    if fields:
+        rendered = render_load_series(
+            fields,
+            settings["pixel_nm"] * 1e-9,
+            pixel_m=pixel_m,
+            psf_fwhm_m=psf_fwhm_m,
+            rendering=rendering,
+            confinement_floor_pa=confinement_floor_mpa * 1e6,
+            otsu=OtsuSettings.from_config(otsu),
+        )
+    else:
         log.warning("%s: no load simulated (%s); nothing rendered", fields_path, settings["status"])
-    rendered = render_load_series(
-        fields,
-        settings.get("pixel_nm", pixel_nm) * 1e-9,
-        pixel_m=pixel_nm * 1e-9,
-        psf_fwhm_m=psf_fwhm_m,
-        rendering=rendering,
-        confinement_floor_pa=confinement_floor_mpa * 1e6,
-        otsu=OtsuSettings.from_config(otsu),
-    )
     rows = []
     for info, render in zip(per_load, rendered, strict=True):
         rows.append(
@@ -75,7 +79,7 @@ def main(
         ],
         {
             **settings,
-            "image_pixel_nm": pixel_nm,
+            "image_pixel_nm": pixel_m * 1e9,
             "psf_fwhm_nm": psf_fwhm_m * 1e9,
             "psf_source": psf_path,
             "rendering": rendering,
@@ -95,6 +99,7 @@ if __name__ == "__main__":
         rendered_path=sm.output.rendered,
         table_path=sm.output.table,
         pixel_nm=sm.params.pixel_nm,
+        pixel_table=list(sm.input.pixel_table),
         rendering=sm.params.rendering,
         confinement_floor_mpa=sm.params.confinement_floor_mpa,
         otsu=sm.params.otsu,

@@ -11,11 +11,12 @@ if "snakemake" in globals():
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
 from amontons.contact import FreeBoundaryError
+from amontons.io.confocal import ImageChoice
 from amontons.io.fields import write_load_series
 from amontons.io.files import read_json, write_json
-from amontons.io.layout import fluorescence_name, per_load_files
+from amontons.io.layout import fluorescence_names, per_load_files
 from amontons.io.rawdata import read_fluorescence_series
-from amontons.measure.area import OtsuSettings, image_contact_area
+from amontons.measure.area import OtsuSettings, image_contact_area, image_pixel_m
 from amontons.runlog import run_logged
 from amontons.simulate.compare import compare_loads, sheet_load_index
 from amontons.simulate.register import Registration
@@ -39,7 +40,9 @@ def main(
     value: float,
     sphere: str,
     sphere_record: dict,
-    pixel_nm: float,
+    pixel_nm: float | None,
+    pixel_table: list[str],
+    images: dict,
     otsu: dict,
     threads: int,
 ) -> None:
@@ -73,10 +76,11 @@ def main(
         write_json(point_path, {**record, "log_area_distance": None, "outside_window": str(error)})
         return
     settings = OtsuSettings.from_config(otsu)
+    pixel_m = image_pixel_m(pixel_nm, pixel_table)
     rendered = render_load_series(
         solution.fields,
         scene.pixel_m,
-        pixel_m=pixel_nm * 1e-9,
+        pixel_m=pixel_m,
         psf_fwhm_m=read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9,
         rendering=config["rendering"],
         confinement_floor_pa=config["confinement_floor_mpa"] * 1e6,
@@ -85,8 +89,12 @@ def main(
     sheet_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
     simulated = [sheet_load_index(sheet_mn, f * 1e3) for f in scene.loads_n]
     loads_mn = [sheet_mn[i] for i in simulated]
-    files = per_load_files(fluorescence, sheet_mn, fluorescence_name)
-    images = read_fluorescence_series([files[i] for i in simulated], pixel_nm * 1e-9)
+    files = per_load_files(fluorescence, sheet_mn, fluorescence_names)
+    images = read_fluorescence_series(
+        [files[i] for i in simulated],
+        None if pixel_nm is None else pixel_nm * 1e-9,
+        ImageChoice(**images),
+    )
     measured = [image_contact_area(image, settings) for image in images]
     rows = compare_loads(
         [f * 1e-3 for f in loads_mn],
@@ -94,7 +102,7 @@ def main(
         measured,
         [row["area_um2"] * 1e-12 for row in solution.per_load],
         Registration.from_record(read_json(registration_path)),
-        pixel_nm * 1e-9,
+        pixel_m,
     )
     used = [row for row in rows if row.measured_found]
     distance = log_area_distance(
@@ -118,7 +126,7 @@ def main(
             **scene.to_record(),
             "parameter": scan["parameter"],
             "value": value,
-            "image_pixel_nm": pixel_nm,
+            "image_pixel_nm": pixel_m * 1e9,
             "window_centre_in_scan_um": [c * 1e6 for c in indenter.centre_in_scan_m],
         },
     )
@@ -160,6 +168,8 @@ if __name__ == "__main__":
         sphere=sm.wildcards.sphere,
         sphere_record=sm.params.sphere_record,
         pixel_nm=sm.params.pixel_nm,
+        pixel_table=list(sm.input.pixel_table),
+        images=sm.params.images,
         otsu=sm.params.otsu,
         threads=sm.threads,
     )

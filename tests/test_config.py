@@ -75,7 +75,7 @@ def test_misspelled_key_is_named_with_the_allowed_keys(repo, config_schema):
     assert "my.yaml" in message
     assert "'otsu_bin'" in message and "optics" in message
     assert (
-        "allowed keys: absorbance, intensity, lifetime, min_contrast, min_patch_px, "
+        "allowed keys: absorbance, images, intensity, lifetime, min_contrast, min_patch_px, "
         "min_separation, newton_rings, otsu_bins" in message
     )
 
@@ -441,3 +441,33 @@ def test_the_full_runs_rheometer_map_reads_the_exports_its_virtual_rheometer_wri
     assert ExportMap.from_config(config["rheometer_export"]) == ExportMap.from_config(
         EXPORT_SHAPES[shape].column_map()
     )
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("frames", "median", r"optics\.images\.frames = 'median'"),
+        ("frames", -1, r"optics\.images\.frames = -1"),
+        ("channel", -1, r"optics\.images\.channel = -1"),
+        ("series", "first", r"optics\.images\.series = 'first'"),
+    ],
+)
+def test_a_bad_image_choice_is_refused_naming_the_key(repo, config_schema, key, value, message):
+    config = _config(repo)
+    for good in ("fluorescence", 2, None):
+        config["optics"]["images"]["channel"] = good
+        validate(config, config_schema, "my.yaml")
+    config["optics"]["images"][key] = value
+    with pytest.raises(ConfigError, match=message):
+        validate(config, config_schema, "my.yaml")
+
+
+def test_the_sheet_pixel_may_be_left_to_measured_images_but_not_to_the_virtual_experiment(
+    tmp_path, sheet_schema
+):
+    sheet = tmp_path / "materials.tsv"
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "25,50,100", "", "lab/PS"]])
+    assert "fluorescence_pixel_nm" not in read_sample_sheet(sheet, sheet_schema)["PS"]
+    _write_sheet(sheet, [["PS", "PS", "0.6", "3.7", "true", "25,50,100", "", "synthetic"]])
+    with pytest.raises(ConfigError, match="'fluorescence_pixel_nm' is a required property"):
+        read_sample_sheet(sheet, sheet_schema)

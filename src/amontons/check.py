@@ -20,10 +20,12 @@ from pathlib import Path
 
 from amontons.config import ConfigError, geometry, read_config
 from amontons.io.absorbance import read_absorbance_csv
+from amontons.io.confocal import ImageChoice, read_confocal
 from amontons.io.heightmap import read_heights
-from amontons.io.layout import FLIM_NAME, REFLECTION_NAME, RawDataError
+from amontons.io.layout import FLIM_NAME, RawDataError
 from amontons.io.rheometer import read_rheometer_csv
 from amontons.io.tiff import read_tiff
+from amontons.workflow.params import image_choice
 from amontons.workflow.run import WorkflowRun
 from amontons.workflow.spheres import AFM_AFTER, AFM_BEFORE, RHEOMETER, Spheres
 
@@ -38,6 +40,26 @@ def _tiff(path: str) -> dict:
         "dtype": str(image.data.dtype),
         "pixel_nm": None if image.pixel_x_m is None else image.pixel_x_m * 1e9,
     }
+
+
+def confocal_reader(choice: ImageChoice, sheet_pixel_nm: float | None) -> Callable[[str], dict]:
+    """A reader for :func:`describe_file` of a confocal image: the plane ``choice`` picks
+    (amontons.io.confocal), its format, shape, dtype and pixel with where it came from. A
+    choice the file cannot meet, or a file and sheet pixel more than 1 % apart, is the
+    reader's error."""
+    sheet_pixel_m = None if sheet_pixel_nm is None else sheet_pixel_nm * 1e-9
+
+    def read(path: str) -> dict:
+        image = read_confocal(path, sheet_pixel_m, choice)
+        return {
+            "format": image.format,
+            "shape": list(image.data.shape),
+            "dtype": str(image.data.dtype),
+            "pixel_nm": image.pixel_m * 1e9,
+            "pixel_from": image.pixel_source,
+        }
+
+    return read
 
 
 def _height_map(path: str) -> dict:
@@ -68,7 +90,7 @@ def describe_file(path: str, read: Callable[[str], dict], sheet_pixel_nm: float 
     except (ValueError, OSError) as error:
         record["error"] = str(error)
         return record
-    if "pixel_nm" in record:
+    if "pixel_nm" in record and "pixel_from" not in record:
         if record["pixel_nm"] is None and sheet_pixel_nm is not None:
             record.update(pixel_nm=sheet_pixel_nm, pixel_from="sheet")
         elif record["pixel_nm"] is not None:
@@ -76,18 +98,22 @@ def describe_file(path: str, read: Callable[[str], dict], sheet_pixel_nm: float 
     return record
 
 
-def sphere_files(spheres: Spheres, sphere: str) -> tuple[list[dict], list[str]]:
-    """Every raw file of a measured sphere that is there, described, and the errors that
+def sphere_files(
+    spheres: Spheres, sphere: str, choices: tuple[ImageChoice, ImageChoice]
+) -> tuple[list[dict], list[str]]:
+    """Every raw file of a measured sphere that is there, described (confocal images through
+    ``choices``: the fluorescence and bead one, the reflection one), and the errors that
     would stop the run before any job."""
     files, errors = [], []
     fluorescence_pixel = spheres.value(sphere, "fluorescence_pixel_nm")
+    image = confocal_reader(choices[0], fluorescence_pixel)
     afm_pixel = spheres.value(sphere, "afm_pixel_nm")
     try:
         images = spheres.per_load_inputs(sphere, "fluorescence")
     except RawDataError as error:
         errors.append(str(error))
         images = []
-    files += [describe_file(path, _tiff, fluorescence_pixel) for path in images]
+    files += [describe_file(path, image, fluorescence_pixel) for path in images]
     if spheres.has(sphere, RHEOMETER):
         try:
             files += [
@@ -97,8 +123,12 @@ def sphere_files(spheres: Spheres, sphere: str) -> tuple[list[dict], list[str]]:
         except RawDataError as error:
             files.append({"path": f"{spheres.raw_dir(sphere)}/rheometer", "error": str(error)})
     singles = [
-        (spheres.raw_file(sphere, REFLECTION_NAME), _tiff, fluorescence_pixel),
-        (spheres.bead_image(sphere), _tiff, fluorescence_pixel),
+        (
+            spheres.reflection_image(sphere),
+            confocal_reader(choices[1], fluorescence_pixel),
+            fluorescence_pixel,
+        ),
+        (spheres.bead_image(sphere), image, fluorescence_pixel),
         (spheres.absorbance_spectrum(sphere), _absorbance, None),
         (spheres.raw_file(sphere, FLIM_NAME), _tiff, fluorescence_pixel),
     ]
@@ -157,7 +187,10 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
         "errors": [],
     }
     if not run.spheres.is_synthetic(sphere):
-        record["files"], record["errors"] = sphere_files(run.spheres, sphere)
+        choices = tuple(
+            ImageChoice(**image_choice(run.config, reflection)) for reflection in (False, True)
+        )
+        record["files"], record["errors"] = sphere_files(run.spheres, sphere, choices)
     side_um = None
     if run.spheres.has(sphere, AFM_BEFORE):
         side_um = scan_side_um(record["files"], run.spheres.afm_path(sphere, AFM_BEFORE))

@@ -2,9 +2,10 @@
 decide whether an image shows a contact at all."""
 
 import numpy as np
+import pandas as pd
 import pytest
 
-from amontons.measure.area import OtsuSettings, otsu_contact_area
+from amontons.measure.area import OtsuSettings, image_pixel_m, otsu_contact_area
 
 
 def _disk(side, radius_px, inside, outside):
@@ -90,3 +91,13 @@ def test_smallest_contact_the_psf_can_show_is_found():
 def test_constant_image_raises():
     with pytest.raises(ValueError, match="constant"):
         otsu_contact_area(np.full((8, 8), 3.0), 1.0)
+
+
+def test_the_render_pixel_is_the_sheets_else_the_one_the_area_table_recorded(tmp_path):
+    from_files = tmp_path / "contact_area.csv"
+    pd.DataFrame({"load_mn": [25.0, 50.0], "pixel_nm": [250.0, 250.0]}).to_csv(from_files)
+    assert image_pixel_m(200.0, []) == 200.0 * 1e-9  # as the scripts convert the sheet's
+    assert image_pixel_m(None, [from_files]) == 250.0 * 1e-9
+    pd.DataFrame({"load_mn": [25.0, 50.0], "pixel_nm": [250.0, 260.0]}).to_csv(from_files)
+    with pytest.raises(ValueError, match=r"contact_area\.csv: pixel_nm \[250\.0, 260\.0\]"):
+        image_pixel_m(None, [from_files])

@@ -1,19 +1,23 @@
-"""The virtual experiment writes its FLIM and rheometer files in the instrument formats: a PTU
-of time-tagged photons and a rheometer program's export. On the same contact states and seed,
-every other file is the same bytes as on the TIFF and CSV route, friction read from the export
-is the CSV's (to 1e-12, the unit conversion's rounding), and the lifetimes from the photons
-agree with the map's within their standard errors.
+"""The virtual experiment writes its FLIM, rheometer and confocal files in the instrument
+formats: a PTU of time-tagged photons, a rheometer program's export, OME-TIFF or CZI images. On
+the same contact states and seed, every other file is the same bytes as on the TIFF and CSV
+route, friction read from the export is the CSV's (to 1e-12, the unit conversion's rounding),
+the lifetimes from the photons agree with the map's within their standard errors, and the
+confocal images read back as the TIFFs' pixels and pixel sizes, giving the same areas.
 
 Smooth Hertz spheres (analytic contact states) keep the tests free of contact solves."""
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from amontons.config import read_config
-from amontons.io.layout import per_load_files, rheometer_files, rheometer_name
-from amontons.io.rawdata import read_rheometer_traces
+from amontons.io.confocal import read_confocal
+from amontons.io.layout import fluorescence_names, per_load_files, rheometer_files, rheometer_name
+from amontons.io.rawdata import read_bead, read_fluorescence_series, read_rheometer_traces
 from amontons.io.rheometer_export import EXPORT_SHAPES, ExportMap
-from amontons.measure.area import OtsuSettings
+from amontons.io.tiff import read_image
+from amontons.measure.area import OtsuSettings, contact_area_table, image_contact_area
 from amontons.measure.friction import static_friction
 from amontons.measure.lifetime import measure_lifetime
 from amontons.virtual.experiment import write_instruments
@@ -56,19 +60,25 @@ def _write(folder, config, formats):
 
 @pytest.fixture(scope="module")
 def routes(tmp_path_factory, config):
-    """The same sphere written twice: TIFF and CSV; PTU and the semicolons export."""
+    """The same sphere written twice: TIFF and CSV; PTU, the semicolons export and OME-TIFF
+    images. And its images once more as CZI."""
     root = tmp_path_factory.mktemp("formats")
     plain = _write(root / "plain", config, OutputFormats())
-    instrument = _write(root / "instrument", config, OutputFormats("ptu", "semicolons", TCSPC))
+    instrument = _write(
+        root / "instrument", config, OutputFormats("ptu", "semicolons", TCSPC, "ome_tiff")
+    )
+    _write(root / "czi", config, OutputFormats(images="czi"))
     return root, plain, instrument
 
 
 def test_the_other_instruments_write_the_same_bytes(routes):
     root, _, _ = routes
-    names = ["reflection.tif", "bead.tif", "absorbance.csv"]
-    names += [f"fluorescence/{f * 1e3:g}.tif" for f in LOADS_N]
-    for name in names:
-        assert (root / "plain" / name).read_bytes() == (root / "instrument" / name).read_bytes()
+    # (the images: pixel for pixel, test_confocal_images_read_back_as_the_tiffs_...)
+    assert (root / "plain" / "absorbance.csv").read_bytes() == (
+        root / "instrument" / "absorbance.csv"
+    ).read_bytes()
+    assert (root / "instrument" / "reflection.ome.tif").is_file()
+    assert not (root / "instrument" / "reflection.tif").exists()
     assert (root / "instrument" / "flim.ptu").is_file()
     assert not (root / "instrument" / "flim.tif").exists()
 
@@ -76,11 +86,44 @@ def test_the_other_instruments_write_the_same_bytes(routes):
 def test_the_truth_says_which_formats(routes):
     _, plain, instrument = routes
     assert plain["rheometer_format"] == "csv" and plain["flim"]["format"] == "tif"
+    assert plain["image_format"] == "tif" and instrument["image_format"] == "ome_tiff"
     assert instrument["rheometer_format"] == "semicolons" and instrument["flim"]["format"] == "ptu"
     assert instrument["flim"]["photons"]["per_pixel_mean"] == 1000
     for key in ("static_friction_mn", "dynamic_friction_mn", "area_um2"):
         assert plain[key] == instrument[key]
     assert plain["flim"]["contact_pixels"] == instrument["flim"]["contact_pixels"]
+
+
+IMAGE_STEMS = [f"fluorescence/{f * 1e3:g}" for f in LOADS_N] + ["reflection", "bead"]
+
+
+@pytest.mark.parametrize("route, suffix", [("instrument", ".ome.tif"), ("czi", ".czi")])
+def test_confocal_images_read_back_as_the_tiffs_pixels_and_pixel_size(routes, route, suffix):
+    root, _, _ = routes
+    for stem in IMAGE_STEMS:
+        tiff = read_image(root / "plain" / f"{stem}.tif")
+        confocal = read_confocal(root / route / f"{stem}{suffix}")
+        assert confocal.data.dtype == tiff.data.dtype and confocal.data.shape == tiff.data.shape
+        assert confocal.data.tobytes() == tiff.data.tobytes(), stem
+        assert confocal.pixel_m == tiff.pixel_m == PIXEL and confocal.pixel_source == "file"
+
+
+@pytest.mark.parametrize("route", ["instrument", "czi"])
+def test_areas_and_psf_from_the_confocal_images_are_the_tiffs(routes, config, route):
+    root, _, _ = routes
+    loads_mn = [f * 1e3 for f in LOADS_N]
+    otsu = OtsuSettings.from_config(config["optics"])
+    tables = []
+    for folder in (root / "plain", root / route):
+        paths = per_load_files(folder / "fluorescence", loads_mn, fluorescence_names)
+        images = read_fluorescence_series(paths, PIXEL)
+        tables.append(
+            contact_area_table(loads_mn, images, [image_contact_area(i, otsu) for i in images])
+        )
+    assert tables[0]["area_um2"].gt(0).all()
+    pd.testing.assert_frame_equal(tables[0].drop(columns="image"), tables[1].drop(columns="image"))
+    beads = [read_bead(next(f.glob("bead.*")), PIXEL) for f in (root / "plain", root / route)]
+    assert beads[0].data.tobytes() == beads[1].data.tobytes()
 
 
 def test_friction_from_the_export_is_the_csvs(routes):
@@ -138,14 +181,16 @@ def test_formats_are_checked():
         OutputFormats("tif", "xlsx")
     with pytest.raises(ValueError, match="needs the photon-counting settings"):
         OutputFormats("ptu")
+    with pytest.raises(ValueError, match="formats.images = 'lif'; expected one of"):
+        OutputFormats(images="lif")
     with pytest.raises(ValueError, match="shorter than the laser period"):
         TcspcSettings(1000, 200e-12, 2e-9, 30e-9, 25e-9)
     settings = {
-        "formats": {"flim": "ptu", "rheometer": "brackets"},
+        "formats": {"flim": "ptu", "rheometer": "brackets", "images": "czi"},
         "flim_photons_per_pixel": 1000,
         "flim_irf_fwhm_ps": 200.0,
         "flim_irf_peak_ns": 2.0,
         "flim_tcspc_bin_ps": 16.0,
         "flim_sync_rate_mhz": 40.0,
     }
-    assert OutputFormats.from_config(settings) == OutputFormats("ptu", "brackets", TCSPC)
+    assert OutputFormats.from_config(settings) == OutputFormats("ptu", "brackets", TCSPC, "czi")

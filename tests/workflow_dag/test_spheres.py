@@ -1,7 +1,11 @@
 """The selected spheres as the DAG reads them: where their raw files lie and which they are."""
 
+import numpy as np
 import pytest
+import tifffile
 
+from amontons.io.confocal_writers import write_confocal
+from amontons.io.layout import RawDataError
 from amontons.workflow.paths import RunPaths
 from amontons.workflow.spheres import (
     ABSORBANCE,
@@ -142,3 +146,49 @@ def test_without_a_bead_the_psf_is_the_stand_in_or_none(tmp_path):
     assert stand_in.psf_source("lab") == "stand_in" and stand_in.can_render("lab")
     assert stand_in.psf_pattern("stand_in") == "lab"
     assert "optics.psf.stand_in" in stand_in.left_out("lab")[0]
+
+
+def test_confocal_images_are_found_by_any_accepted_suffix(tmp_path):
+    files = {"fluorescence/10mN.ome.tif": "", "fluorescence/20.czi": "", "fluorescence/40.tif": ""}
+    files |= {"reflection.czi": "", "bead.ome.tif": ""}
+    spheres, folder = _spheres(tmp_path, **files)
+    assert spheres.per_load_inputs("lab", "fluorescence") == [
+        str(folder / name) for name in ("fluorescence/10mN.ome.tif", "fluorescence/20.czi",
+                                        "fluorescence/40.tif")
+    ]  # fmt: skip
+    assert spheres.reflection_image("lab") == str(folder / "reflection.czi")
+    assert spheres.bead_image("lab") == str(folder / "bead.ome.tif")
+    assert REFLECTION not in spheres.missing("lab") and BEAD not in spheres.missing("lab")
+
+
+def test_the_virtual_experiments_images_are_named_by_its_format(tmp_path):
+    spheres = Spheres({"syn": {**RECORD, "data_source": "synthetic"}}, RunPaths("full"),
+                      synthetic_images=".ome.tif")  # fmt: skip
+    assert spheres.reflection_image("syn") == "resources/synthetic/full/syn/reflection.ome.tif"
+    assert spheres.bead_image("syn") == "resources/synthetic/full/syn/bead.ome.tif"
+
+
+def test_two_formats_of_one_image_stop_the_run_naming_both(tmp_path):
+    spheres, folder = _spheres(tmp_path, **{"reflection.tif": "", "reflection.czi": ""})
+    with pytest.raises(RawDataError, match=r"reflection\.tif, reflection\.czi; expected one"):
+        spheres.reflection_image("lab")
+
+
+def test_images_without_a_pixel_and_no_sheet_pixel_stop_the_run_naming_sphere_and_file(
+    tmp_path,
+):
+    files = {f"fluorescence/{load}.tif": "" for load in (10, 20, 40)}
+    spheres, folder = _spheres(tmp_path, **files)
+    untagged = np.ones((8, 8), np.uint16)
+    for load in (10, 20):
+        write_confocal(folder / f"fluorescence/{load}.tif", untagged, 200e-9, "ome_tiff")
+    tifffile.imwrite(folder / "fluorescence/40.tif", untagged)  # no resolution tags
+    spheres.check_pixel_sizes()  # the sheet gives the pixel
+    del spheres.records["lab"]["fluorescence_pixel_nm"]
+    message = rf"no fluorescence_pixel_nm in the sheet: sphere lab: {folder}/fluorescence/40\.tif;"
+    with pytest.raises(RawDataError, match=message):
+        spheres.check_pixel_sizes()
+    write_confocal(folder / "fluorescence/40.tif", untagged, 200e-9, "tif")
+    spheres.check_pixel_sizes()  # every image states its own
+    assert spheres.image_pixel_inputs("lab") == ["results/small/PS/lab/measure/contact_area.csv"]
+    assert spheres.image_pixel_inputs("syn") == []

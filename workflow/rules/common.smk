@@ -8,6 +8,7 @@ from snakemake.logging import logger
 from amontons.workflow.params import (
     afm_reading,
     config_slice as _config_slice,
+    image_choice,
     otsu_settings,
     ring_optics,
     sorted_keys,
@@ -86,6 +87,9 @@ loads_mn = SPHERES.loads_mn
 sheet_value = SPHERES.value
 pixel_nm = SPHERES.pixel_nm
 raw_file = SPHERES.raw_file
+reflection_image = SPHERES.reflection_image
+# The suffix of the virtual experiment's confocal images (virtual_experiment.formats.images).
+SYNTHETIC_IMAGE = SPHERES.synthetic_images
 afm_path = SPHERES.afm_path
 per_load_inputs = SPHERES.per_load_inputs
 reflection_fluorescence = SPHERES.reflection_fluorescence
@@ -97,6 +101,9 @@ config_slice = partial(_config_slice, config)
 OTSU = otsu_settings(config)
 RING_OPTICS = ring_optics(config)
 AFM_READING = afm_reading(config)
+# Which plane of a confocal file is the image: the fluorescence and bead one, the reflection one.
+IMAGES = image_choice(config)
+REFLECTION_IMAGES = image_choice(config, reflection=True)
 
 # Scenes, scans and the study (amontons.workflow.scenes, amontons.workflow.study).
 SCENES = RUN.scenes.scenes

@@ -27,6 +27,7 @@ rule measure_contact_area:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
         otsu=OTSU,
         data_label=lambda wc: data_label([wc.sphere]),
     script:
@@ -59,6 +60,7 @@ rule measure_psf:
         runtime=measured_runtime("measure_psf"),
     params:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
         # the bead's fit only: a changed stand-in re-runs no measured PSF
         psf=sorted_keys(
             {
@@ -125,7 +127,7 @@ rule measure_grafting_density:
 
 rule measure_edge_gap:
     input:
-        reflection=lambda wc: raw_file(wc.sphere, "reflection.tif"),
+        reflection=lambda wc: reflection_image(wc.sphere),
         fluorescence=lambda wc: reflection_fluorescence(wc.sphere),
     output:
         gap=f"{MEASURED}/edge_gap.json",
@@ -149,6 +151,8 @@ rule measure_edge_gap:
     params:
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
+        reflection_images=REFLECTION_IMAGES,
         otsu=OTSU,
         newton_rings=config_slice("optics", "newton_rings"),
         data_label=lambda wc: data_label([wc.sphere]),
@@ -184,6 +188,7 @@ rule measure_intensity_pressure:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
         otsu=OTSU,
         intensity=config_slice("optics", "intensity"),
         confidence=config["load_area"]["confidence"],

@@ -107,6 +107,7 @@ rule render_scene:
     input:
         fields=rules.simulate_scene.output.fields,
         psf=rules.measure_psf.output.psf,
+        pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
     output:
         rendered=f"{SCENE}/{RENDERED}",
         table=f"{SCENE}/{RENDER_TABLE}",
@@ -161,6 +162,7 @@ rule compare_scene:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
         otsu=OTSU,
         data_label=lambda wc: data_label([wc.sphere]),
     script:

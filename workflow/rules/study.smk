@@ -10,6 +10,7 @@ rule scan_scene:
         psf=rules.measure_psf.output.psf,
         registration=RUN.scenes.scan_base_registration,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
+        pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
     output:
         point=PATHS.scan_value(SCAN_POINT),
         fields=PATHS.scan_value(RENDERED),
@@ -30,6 +31,7 @@ rule scan_scene:
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
         otsu=OTSU,
     script:
         "../../scripts/scan_scene.py"
@@ -120,6 +122,7 @@ rule plot_scan_maps:
         scans=RUN.study.scan_maps,
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
         otsu=OTSU,
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
     script:
@@ -155,6 +158,7 @@ rule plot_load_series_maps:
         k_scan=RUN.study.k_scan,
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
+        images=IMAGES,
         otsu=OTSU,
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
     script:

@@ -7,8 +7,8 @@ rule generate_virtual_experiment:
     output:
         fluorescence=directory(f"{SYNTHETIC_SPHERE}/fluorescence"),
         rheometer=directory(f"{SYNTHETIC_SPHERE}/rheometer"),
-        reflection=f"{SYNTHETIC_SPHERE}/reflection.tif",
-        bead=f"{SYNTHETIC_SPHERE}/bead.tif",
+        reflection=f"{SYNTHETIC_SPHERE}/reflection{SYNTHETIC_IMAGE}",
+        bead=f"{SYNTHETIC_SPHERE}/bead{SYNTHETIC_IMAGE}",
         absorbance=f"{SYNTHETIC_SPHERE}/absorbance.csv",
         afm_before=f"{SYNTHETIC_SPHERE}/afm_before.tif",
         afm_after=f"{SYNTHETIC_SPHERE}/afm_after.tif",
@@ -49,8 +49,8 @@ use rule generate_virtual_experiment as generate_virtual_experiment_with_flim wi
     output:
         fluorescence=directory(f"{SYNTHETIC_SPHERE}/fluorescence"),
         rheometer=directory(f"{SYNTHETIC_SPHERE}/rheometer"),
-        reflection=f"{SYNTHETIC_SPHERE}/reflection.tif",
-        bead=f"{SYNTHETIC_SPHERE}/bead.tif",
+        reflection=f"{SYNTHETIC_SPHERE}/reflection{SYNTHETIC_IMAGE}",
+        bead=f"{SYNTHETIC_SPHERE}/bead{SYNTHETIC_IMAGE}",
         absorbance=f"{SYNTHETIC_SPHERE}/absorbance.csv",
         afm_before=f"{SYNTHETIC_SPHERE}/afm_before.tif",
         afm_after=f"{SYNTHETIC_SPHERE}/afm_after.tif",

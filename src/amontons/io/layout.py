@@ -1,12 +1,13 @@
 """The raw-data layout a sphere's folder follows, whether real or virtual, and its file names.
 
-<folder>/fluorescence/<load in mN>.tif   one confocal image per load (e.g. 25.tif or 25mN.tif)
+<folder>/fluorescence/<load in mN>.tif   one confocal image per load (e.g. 25.tif or 25mN.tif),
+                                         or .ome.tif or .czi (CONFOCAL_SUFFIXES)
 <folder>/rheometer/<load in mN>.csv      one friction test per load: our CSV
                                          (amontons.io.rheometer) or the program's export,
                                          .csv or .txt (amontons.io.rheometer_export)
-<folder>/reflection.tif                  Newton rings, same field and pixel grid as the
+<folder>/reflection.tif (or .ome.tif, .czi) Newton rings, same field and pixel grid as the
                                          fluorescence image at the sheet's reflection_load_mn
-<folder>/bead.tif                        a 100 nm fluorescent bead, imaged like the contacts
+<folder>/bead.tif (or .ome.tif, .czi)     a 100 nm fluorescent bead, imaged like the contacts
 <folder>/absorbance.csv                  wavelength_nm, absorbance of the probe cover slip
 <folder>/flim.tif                        optional: mean photon arrival time map, ns (float),
 <folder>/flim.ptu                          or the time-tagged photons (PicoQuant PTU, T3 image)
@@ -24,8 +25,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-REFLECTION_NAME = "reflection.tif"
-BEAD_NAME = "bead.tif"
+REFLECTION_STEM, BEAD_STEM = "reflection", "bead"
+REFLECTION_NAME = f"{REFLECTION_STEM}.tif"
+BEAD_NAME = f"{BEAD_STEM}.tif"
+# The confocal image formats amontons.io.confocal reads, each tested on files its writer made:
+# OME-TIFF, plain or ImageJ hyperstack TIFF, Zeiss CZI (docs/own-data.md says why no others).
+CONFOCAL_SUFFIXES = (".ome.tif", ".ome.tiff", ".tif", ".tiff", ".czi")
+# The formats the virtual experiment writes its images in (virtual_experiment.formats.images,
+# amontons.io.confocal_writers) and the suffix of each.
+IMAGE_FORMATS = {"tif": ".tif", "ome_tiff": ".ome.tif", "czi": ".czi"}
 ABSORBANCE_NAME = "absorbance.csv"
 FLIM_NAME = "flim.tif"
 FLIM_PTU_NAME = "flim.ptu"
@@ -54,9 +62,22 @@ class RawDataError(ValueError):
     """A raw-data folder or file does not match what the sample sheet promises."""
 
 
-def fluorescence_name(load_mn: float) -> str:
+def confocal_suffix(path: str | Path) -> str | None:
+    """The suffix of CONFOCAL_SUFFIXES that ``path``'s name ends in ('.ome.tif' before '.tif'),
+    or None."""
+    name = Path(path).name.lower()
+    return next((s for s in CONFOCAL_SUFFIXES if name.endswith(s)), None)
+
+
+def fluorescence_name(load_mn: float, suffix: str = ".tif") -> str:
     """File name of the fluorescence image at ``load_mn`` (e.g. 25 → '25.tif')."""
-    return f"{load_mn:g}.tif"
+    return f"{load_mn:g}{suffix}"
+
+
+def fluorescence_names(load_mn: float) -> tuple[str, ...]:
+    """The names the fluorescence image at ``load_mn`` may have, one per accepted suffix
+    (25 → '25.ome.tif', ..., '25.czi'); :func:`per_load_files` takes the one present."""
+    return tuple(fluorescence_name(load_mn, suffix) for suffix in CONFOCAL_SUFFIXES)
 
 
 def rheometer_name(load_mn: float, suffix: str = ".csv") -> str:
@@ -76,7 +97,9 @@ def same_load(a_mn: float, b_mn: float) -> bool:
 
 def load_of(path: Path) -> float | None:
     """The load in mN a per-load file is named by (``25.tif``, ``25mN.csv``), or None."""
-    stem = path.stem.removesuffix("mN").removesuffix("mn")
+    suffix = confocal_suffix(path)
+    stem = path.name[: -len(suffix)] if suffix else path.stem
+    stem = stem.removesuffix("mN").removesuffix("mn")
     try:
         return float(stem)
     except ValueError:
@@ -126,8 +149,22 @@ def files_by_load(
 
 
 def fluorescence_images(folder: str | Path, loads_mn: Sequence[float]) -> list[Path]:
-    """Paths of the fluorescence images (``<load>.tif``), in the order of ``loads_mn``."""
-    return files_by_load(folder, loads_mn, "*.tif*", "fluorescence", "25.tif")
+    """Paths of the fluorescence images (``<load>`` and one of CONFOCAL_SUFFIXES), in the order
+    of ``loads_mn``."""
+    patterns = [f"*{suffix}" for suffix in CONFOCAL_SUFFIXES]
+    return files_by_load(folder, loads_mn, patterns, "fluorescence", "25.tif")
+
+
+def confocal_file(folder: str | Path, stem: str) -> Path | None:
+    """The image ``stem`` (reflection, bead) in ``folder`` with any of CONFOCAL_SUFFIXES, None
+    if there is none; RawDataError naming the folder and the files if there are several."""
+    folder = Path(folder)
+    found = [folder / f"{stem}{s}" for s in CONFOCAL_SUFFIXES if (folder / f"{stem}{s}").is_file()]
+    if len(found) > 1:
+        raise RawDataError(
+            f"{folder}: {', '.join(p.name for p in found)}; expected one {stem} image"
+        )
+    return found[0] if found else None
 
 
 def rheometer_files(folder: str | Path, loads_mn: Sequence[float]) -> list[Path]:
@@ -157,11 +194,12 @@ def per_load_files(
     ``given`` is either the files themselves (measured data: the workflow matched them to
     the loads; one file may be given as a plain path) or the one folder the virtual
     experiment writes whole, whose files are named by ``name_of(load)``
-    (:func:`fluorescence_name`, :func:`rheometer_name`). No folder is searched: a missing
-    file is an error naming it.
+    (:func:`fluorescence_name`, :func:`rheometer_name`), or by one of the names
+    ``name_of(load)`` returns (:func:`fluorescence_names`: the one present; several present
+    is an error naming them). No folder is searched: a missing file is an error naming it.
     """
     if isinstance(given, str | Path) and Path(given).is_dir():
-        paths = [Path(given) / name_of(load) for load in loads_mn]
+        paths = [_named_file(Path(given), name_of(load)) for load in loads_mn]
     elif isinstance(given, str | Path):
         paths = [Path(given)]
     else:
@@ -175,6 +213,20 @@ def per_load_files(
         if not path.is_file():
             raise RawDataError(f"{path}: no such file (expected one file per load)")
     return paths
+
+
+def _named_file(folder: Path, names: str | tuple[str, ...]) -> Path:
+    """``folder / names`` (one name), or the one of several ``names`` present in ``folder``;
+    RawDataError naming the folder if none or several are."""
+    if isinstance(names, str):
+        return folder / names
+    present = [folder / name for name in names if (folder / name).is_file()]
+    if len(present) != 1:
+        raise RawDataError(
+            f"{folder}: {len(present)} of {', '.join(names)} present "
+            f"({', '.join(p.name for p in present) or 'none'}); expected exactly one"
+        )
+    return present[0]
 
 
 def afm_file(folder: str | Path, stem: str) -> Path:

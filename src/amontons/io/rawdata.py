@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from amontons.io.absorbance import AbsorbanceError, read_absorbance_csv
+from amontons.io.confocal import NO_CHOICE, ImageChoice, read_confocal
 from amontons.io.layout import RawDataError
 from amontons.io.ptu import PhotonImage, PtuError, read_ptu_image
 from amontons.io.rheometer import RheometerError, RheometerTrace, read_rheometer_csv
@@ -52,23 +53,34 @@ def read_rheometer_traces(
     return traces
 
 
-def _read(path: Path, what: str, fallback_pixel_m: float | None) -> Image:
+def _read(
+    path: Path, what: str, fallback_pixel_m: float | None, choice: ImageChoice | None = None
+) -> Image:
+    """``path`` read as a 2-D TIFF (``choice`` None) or as a confocal file's chosen plane."""
     if not path.is_file():
         raise RawDataError(f"{path}: no {what} (expected {path.name} in the sphere's folder)")
     try:
-        return read_image(path, fallback_pixel_m)
+        if choice is None:
+            return read_image(path, fallback_pixel_m)
+        return read_confocal(path, fallback_pixel_m, choice)
     except ImageError as error:
         raise RawDataError(f"{what}: {error}") from error
 
 
-def read_fluorescence(path: str | Path, fallback_pixel_m: float | None = None) -> Image:
-    """One fluorescence image (``<load>.tif``, counts)."""
-    return _read(Path(path), "fluorescence image", fallback_pixel_m)
+def read_fluorescence(
+    path: str | Path, fallback_pixel_m: float | None = None, choice: ImageChoice = NO_CHOICE
+) -> Image:
+    """One fluorescence image (``<load>.tif``, ``.ome.tif`` or ``.czi``; counts): the plane
+    ``choice`` picks (amontons.io.confocal)."""
+    return _read(Path(path), "fluorescence image", fallback_pixel_m, choice)
 
 
-def read_bead(path: str | Path, fallback_pixel_m: float | None = None) -> Image:
-    """The bead image (``bead.tif``, counts)."""
-    return _read(Path(path), "bead image", fallback_pixel_m)
+def read_bead(
+    path: str | Path, fallback_pixel_m: float | None = None, choice: ImageChoice = NO_CHOICE
+) -> Image:
+    """The bead image (``bead.tif``, ``.ome.tif`` or ``.czi``; counts): the plane ``choice``
+    picks."""
+    return _read(Path(path), "bead image", fallback_pixel_m, choice)
 
 
 def read_reflection(
@@ -76,14 +88,16 @@ def read_reflection(
     fallback_pixel_m: float | None = None,
     *,
     like: Image | None = None,
+    choice: ImageChoice = NO_CHOICE,
 ) -> Image:
-    """The reflection image (``reflection.tif``, counts).
+    """The reflection image (``reflection.tif``, ``.ome.tif`` or ``.czi``; counts): the plane
+    ``choice`` picks (its channel may differ from the fluorescence's in the same file).
 
     With ``like`` (the fluorescence image at the reflection load), the reflection must share
     its shape and pixel size: the contact centre and edge found in the fluorescence image are
     used on the reflection image's grid (appendix Fig. B.6 swaps filters, not the field).
     """
-    image = _read(Path(path), "reflection image", fallback_pixel_m)
+    image = _read(Path(path), "reflection image", fallback_pixel_m, choice)
     if like is not None:
         same_pixel = abs(image.pixel_m - like.pixel_m) <= 1e-6 * like.pixel_m
         if image.data.shape != like.data.shape or not same_pixel:
@@ -133,13 +147,14 @@ def read_absorbance(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def read_fluorescence_series(
-    paths: Sequence[str | Path], fallback_pixel_m: float | None
+    paths: Sequence[str | Path], fallback_pixel_m: float | None, choice: ImageChoice = NO_CHOICE
 ) -> list[Image]:
-    """A sphere's fluorescence images (``paths``, one per load); raises RawDataError if
-    their pixel sizes differ (areas and pressures of one series share one pixel)."""
+    """A sphere's fluorescence images (``paths``, one per load; the plane ``choice`` picks of
+    each); raises RawDataError if their pixel sizes differ (areas and pressures of one series
+    share one pixel)."""
     images = []
     for path in paths:
-        image = read_fluorescence(path, fallback_pixel_m)
+        image = read_fluorescence(path, fallback_pixel_m, choice)
         if images and abs(image.pixel_m - images[0].pixel_m) > 1e-6 * images[0].pixel_m:
             raise RawDataError(
                 f"{path}: pixel {image.pixel_m * 1e9:.4g} nm differs from "

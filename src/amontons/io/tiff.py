@@ -24,6 +24,11 @@ _INCH = 2
 # inch resolution this coarse (a pixel of 21 µm or more) is a display default, never the pixel
 # of a microscope or an AFM (their pixels are nm to a few µm), so it is not a pixel size.
 _DISPLAY_DPI_MAX = 1200.0
+# A file's pixel and the sheet's fluorescence_pixel_nm that differ by more than this relative
+# difference belong to different objectives or zooms: the run stops rather than pick one.
+PIXEL_AGREEMENT = 0.01
+# Where an image's pixel size came from (Image.pixel_source, and the measurements' records).
+PIXEL_FROM_FILE, PIXEL_FROM_SHEET = "file", "sheet"
 
 
 class ImageError(ValueError):
@@ -32,11 +37,15 @@ class ImageError(ValueError):
 
 @dataclass(frozen=True)
 class Image:
-    """A 2-D image and its square pixel size in metres."""
+    """A 2-D image and its square pixel size in metres; ``pixel_source`` says whether that
+    came from the file's metadata ('file') or the sample sheet ('sheet'); ``format`` names the
+    file format it was read from."""
 
     data: np.ndarray
     pixel_m: float
     path: Path
+    pixel_source: str = PIXEL_FROM_FILE
+    format: str = "TIFF"
 
 
 @dataclass(frozen=True)
@@ -102,8 +111,9 @@ def read_image(
     Raises ImageError naming the file when it cannot be read, the image is not 2-D, has a
     signed-integer, boolean or complex dtype, contains NaN or infinite pixels, or has no pixel
     size from either its tags or ``fallback_pixel_m``; resolution tags of a display default
-    (inch resolutions of 1200 dpi and below, e.g. 72 dpi) give none. ``allow_nan`` leaves NaN
-    pixels to the caller.
+    (inch resolutions of 1200 dpi and below, e.g. 72 dpi) give none; or when the tags and
+    ``fallback_pixel_m`` (the sheet) differ by more than 1 % (resolve_pixel). ``allow_nan``
+    leaves NaN pixels to the caller.
     """
     path = Path(path)
     tiff = read_tiff(path)
@@ -121,24 +131,42 @@ def read_image(
     if not allow_nan and kind == "f" and not np.all(np.isfinite(data)):
         bad = int(np.count_nonzero(~np.isfinite(data)))
         raise ImageError(f"{path}: {bad} NaN or infinite pixels; expected finite intensities")
-    pixel_m = tag_pixel if tag_pixel is not None else fallback_pixel_m
-    if pixel_m is None:
+    pixel_m, source = resolve_pixel(path, tag_pixel, fallback_pixel_m, "TIFF resolution tags")
+    return Image(data=data, pixel_m=pixel_m, path=path, pixel_source=source)
+
+
+def resolve_pixel(
+    path: Path, file_pixel_m: float | None, sheet_pixel_m: float | None, where: str
+) -> tuple[float, str]:
+    """The pixel size (m) of the image ``path`` and its source ('file' or 'sheet').
+
+    The file's pixel (``file_pixel_m``, read from ``where`` in it) wins; without one the
+    sheet's is used and the log says so. Raises ImageError naming the file and both values
+    when neither gives one, or when both do and differ by more than PIXEL_AGREEMENT.
+    """
+    if file_pixel_m is None and sheet_pixel_m is None:
         raise ImageError(
-            f"{path}: no pixel size in the TIFF resolution tags and none given in the sheet"
+            f"{path}: no pixel size in the {where} and no fluorescence_pixel_nm in the sheet; "
+            "expected one of them"
         )
-    disagree = (
-        tag_pixel is not None
-        and fallback_pixel_m is not None
-        and abs(tag_pixel - fallback_pixel_m) > 0.01 * fallback_pixel_m
-    )
-    if disagree:
-        log.warning(
-            "%s: TIFF pixel %.4g nm differs from the sheet's %.4g nm; using the TIFF's",
+    if file_pixel_m is None:
+        log.info(
+            "%s: no pixel size in the %s; the sheet's %.6g nm is used",
             path,
-            tag_pixel * 1e9,
-            fallback_pixel_m * 1e9,
+            where,
+            sheet_pixel_m * 1e9,
         )
-    return Image(data=data, pixel_m=float(pixel_m), path=path)
+        return float(sheet_pixel_m), PIXEL_FROM_SHEET
+    if sheet_pixel_m is not None:
+        difference = abs(file_pixel_m - sheet_pixel_m) / sheet_pixel_m
+        if difference > PIXEL_AGREEMENT:
+            raise ImageError(
+                f"{path}: the {where} give a pixel of {file_pixel_m * 1e9:.6g} nm, the sheet's "
+                f"fluorescence_pixel_nm is {sheet_pixel_m * 1e9:.6g} nm: they differ by "
+                f"{difference:.2%}; expected them within {PIXEL_AGREEMENT:.0%} (correct the "
+                "sheet, or leave its fluorescence_pixel_nm empty to take the file's)"
+            )
+    return float(file_pixel_m), PIXEL_FROM_FILE
 
 
 def saturated_pixels(data: np.ndarray) -> int:

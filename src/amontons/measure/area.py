@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -192,6 +193,20 @@ def separated_contact(image: Image, otsu: OtsuSettings) -> ContactArea:
     return area
 
 
+def image_pixel_m(sheet_pixel_nm: float | None, area_tables: Sequence[str | Path]) -> float:
+    """The fluorescence images' pixel (m) a simulated contact is rendered at: the sheet's
+    (``sheet_pixel_nm``), else the one the images' files gave, as the contact-area table
+    (:func:`contact_area_table`, the one path of ``area_tables``) recorded it. Raises
+    ValueError naming the table when it holds no single pixel size."""
+    if sheet_pixel_nm is not None:
+        return sheet_pixel_nm * 1e-9
+    (path,) = area_tables
+    pixels = [float(p) for p in pd.read_csv(path)["pixel_nm"].unique()]
+    if len(pixels) != 1:
+        raise ValueError(f"{path}: pixel_nm {pixels}; expected one pixel for the series")
+    return float(pixels[0]) * 1e-9
+
+
 def contact_area_table(
     loads_mn: Sequence[float], images: Sequence[Image], areas: Sequence[ContactArea]
 ) -> pd.DataFrame:
@@ -213,6 +228,7 @@ def contact_area_table(
                 "contact_found": area.contact_found,
                 "flag": area.flag or "",
                 "saturated_pixels": saturated_pixels(image.data),
+                "pixel_source": image.pixel_source,
                 "image": str(image.path),
             }
         )

@@ -17,6 +17,7 @@ import numpy as np
 from scipy import stats
 from scipy.ndimage import binary_fill_holes
 
+from amontons.io.confocal import NO_CHOICE, ImageChoice
 from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_fluorescence, read_reflection
 from amontons.measure.area import OtsuSettings, contact_geometry, separated_contact
@@ -154,6 +155,7 @@ class EdgeGap:
     sheet_radius_m: float | None = None  # Hertz radius of the load from the sheet's E*
     sheet_gap_m: float | None = None  # mean gap of the sheet-radius model
     gap_per_10pct_e_star_m: float | None = None  # its change per +10 % of E*
+    pixel_source: str = "file"  # where the images' pixel size came from: 'file' or 'sheet'
 
     @property
     def edge_gap_m(self) -> float | None:
@@ -211,6 +213,7 @@ class EdgeGap:
             "load_mn": self.load_mn,
             "reflection": str(self.reflection_path),
             "fluorescence": str(self.fluorescence_path),
+            "pixel_source": self.pixel_source,
         }
 
 
@@ -258,6 +261,8 @@ def measure_edge_gap(
     mask_closing_m: float = 0.25e-6,
     margin_m: float = 4e-9,
     spread_margin_m: float = 10e-9,
+    choice: ImageChoice = NO_CHOICE,
+    reflection_choice: ImageChoice = NO_CHOICE,
 ) -> EdgeGap:
     """Gap at the contact edge from the reflection image (appendix Figs. B.6, B.7).
 
@@ -272,6 +277,8 @@ def measure_edge_gap(
     amontons.measure.newton_rings.newton_ring_gap; bright rings sit at the gaps
     (m + ½)·``wavelength_m``/2``n_medium``. ``load_mn`` is the load of both images.
     ``margin_m`` and ``spread_margin_m``: the margins of :func:`undetermined_reason`.
+    ``choice`` and ``reflection_choice``: the planes of confocal files (amontons.io.confocal;
+    both images may be channels of one file).
 
     Raises NoContact if the fluorescence image shows no contact, RingsUnreadable if the
     rings cannot be numbered; an unresolved mean comes back with ``undetermined`` set.
@@ -281,7 +288,7 @@ def measure_edge_gap(
             f"mask closing {mask_closing_m} m, margins {margin_m} and {spread_margin_m} m; "
             "expected all ≥ 0"
         )
-    fluorescence = read_fluorescence(fluorescence_path, fallback_pixel_m)
+    fluorescence = read_fluorescence(fluorescence_path, fallback_pixel_m, choice)
     area = separated_contact(fluorescence, otsu)
     try:
         centre, _ = contact_geometry(area.mask, fluorescence.pixel_m)
@@ -291,7 +298,9 @@ def measure_edge_gap(
     equal_area = float(np.sqrt(binary_fill_holes(area.mask).sum() / np.pi) * pixel)
     closing_px = int(round(mask_closing_m / pixel))
     edges_m = profile_edges(area.mask, centre, n_profiles, closing_px) * pixel
-    reflection = read_reflection(reflection_path, fallback_pixel_m, like=fluorescence)
+    reflection = read_reflection(
+        reflection_path, fallback_pixel_m, like=fluorescence, choice=reflection_choice
+    )
     try:
         rings = newton_ring_gap(
             reflection.data,
@@ -326,4 +335,5 @@ def measure_edge_gap(
         sheet_radius_m=hertz_radius_m,
         sheet_gap_m=sheet_gap,
         gap_per_10pct_e_star_m=per_10pct,
+        pixel_source=fluorescence.pixel_source,
     )

@@ -21,6 +21,7 @@ import pandas as pd
 from scipy.ndimage import binary_dilation
 
 from amontons.fits import PowerLawFit, fit_power_law
+from amontons.io.confocal import NO_CHOICE, ImageChoice
 from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_fluorescence_series
 from amontons.io.tiff import saturated_pixels
@@ -125,9 +126,11 @@ def measure_intensity_pressure(
     background_margin_px: int,
     pressure_ref_pa: float,
     confidence: float = 0.95,
+    choice: ImageChoice = NO_CHOICE,
 ) -> tuple[IntensityPressure, list[float], dict[float, str]]:
     """Mean contact intensity versus mean contact pressure F/A (appendix Fig. B.4), from
-    the fluorescence images ``image_paths`` (one per load of ``loads_mn``).
+    the fluorescence images ``image_paths`` (one per load of ``loads_mn``; ``choice``: the plane
+    of a confocal file, amontons.io.confocal).
 
     Returns the fit, each fitted image's background (counts, from the pixels far from the
     mask) and the loads left out (mN → why): an image in which no contact stands out
@@ -135,7 +138,7 @@ def measure_intensity_pressure(
     Raises RawDataError if fewer than three loads are left.
     """
     images, masks, backgrounds, kept_loads, excluded = [], [], [], [], {}
-    series = read_fluorescence_series(image_paths, fallback_pixel_m)
+    series = read_fluorescence_series(image_paths, fallback_pixel_m, choice)
     for load, image in zip(loads_mn, series, strict=True):
         path = image.path
         saturated = saturated_pixels(image.data)

@@ -23,13 +23,14 @@ Pixel coordinates: the centre of pixel (row i, column j) is at x = j·pixel_m, y
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 from scipy.ndimage import uniform_filter
 from scipy.special import erf
 
+from amontons.io.confocal import NO_CHOICE, ImageChoice
 from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_bead
 from amontons.io.tiff import saturated_pixels
@@ -61,6 +62,7 @@ class PsfMeasurement:
     profile_counts: np.ndarray  # radial average: mean counts per ring
     n_pixels_fitted: int
     dispersion: float  # Pearson χ²/(n − 5) of the fit: 1 for Poisson counts
+    pixel_source: str | None = None  # 'file' or 'sheet' where read from a bead image
 
     def to_record(self) -> dict:
         """JSON-ready record, units in the key names."""
@@ -75,6 +77,7 @@ class PsfMeasurement:
             "noise_sd_counts": self.noise_sd_counts,
             "poisson_dispersion": self.dispersion,
             "centroid_nm": [c * 1e9 for c in self.centroid_m],
+            "pixel_source": self.pixel_source,
         }
 
 
@@ -341,11 +344,13 @@ def measure_bead(
     *,
     profile_radius_m: float,
     centroid_radius_m: float,
+    choice: ImageChoice = NO_CHOICE,
 ) -> PsfMeasurement:
-    """PSF FWHM from the bead image ``path`` (:func:`measure_psf`)."""
-    image = read_bead(path, fallback_pixel_m)
+    """PSF FWHM from the bead image ``path`` (:func:`measure_psf`; ``choice``: its plane, for a
+    confocal file), recording where its pixel size came from (file or sheet)."""
+    image = read_bead(path, fallback_pixel_m, choice)
     try:
-        return measure_psf(
+        psf = measure_psf(
             image.data,
             image.pixel_m,
             profile_radius_m=profile_radius_m,
@@ -353,3 +358,4 @@ def measure_bead(
         )
     except PsfError as error:
         raise RawDataError(f"{image.path}: {error}") from error
+    return replace(psf, pixel_source=image.pixel_source)

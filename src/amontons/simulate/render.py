@@ -81,10 +81,7 @@ def render_load_series(
     window_m: float | None = None,
 ) -> list[Rendered]:
     """Every load of a scene rendered and thresholded (one pixel averager for all loads), on
-    an image over ``window_m`` (m, centred; None: the whole solver window). No field, no
-    image: a scene whose scan held none of its loads renders nothing."""
-    if not fields:
-        return []
+    an image over ``window_m`` (m, centred; None: the whole solver window)."""
     shape = fields[0]["contact"].shape
     side = image_side_px(shape[0] * spacing_m if window_m is None else window_m, pixel_m)
     averager = PixelAverager(shape, spacing_m, (side, side), pixel_m)

@@ -25,10 +25,10 @@ from amontons.fits import fit_power_law
 from amontons.io.files import write_json
 from amontons.io.layout import (
     ABSORBANCE_NAME,
-    BEAD_NAME,
+    BEAD_STEM,
     FLIM_NAME,
     FLIM_PTU_NAME,
-    REFLECTION_NAME,
+    REFLECTION_STEM,
     fluorescence_name,
     rheometer_name,
 )
@@ -245,21 +245,29 @@ def write_instruments(
     counts_per_sqrt_pa = settings.contact_counts / np.sqrt(mean_pressure_min)
 
     fluorescence_rng = instrument_rng(seed, sphere, "fluorescence")
+    suffix, image_format = formats.image_suffix, formats.images
     for state in states:
-        path = out_dir / "fluorescence" / fluorescence_name(state.load_n * 1e3)
-        write_fluorescence(path, state, pixel_m, counts_per_sqrt_pa, settings, fluorescence_rng)
+        path = out_dir / "fluorescence" / fluorescence_name(state.load_n * 1e3, suffix)
+        write_fluorescence(
+            path, state, pixel_m, counts_per_sqrt_pa, settings, fluorescence_rng, image_format
+        )
         log.info("%s: %s (%d² px)", sphere, path, state.contact.shape[0])
 
     reflected = _matching(states, reflection_load_n)
     write_reflection(
-        out_dir / REFLECTION_NAME,
+        out_dir / f"{REFLECTION_STEM}{suffix}",
         reflected,
         pixel_m,
         settings,
         instrument_rng(seed, sphere, "reflection"),
+        image_format,
     )
     bead_centre = write_bead(
-        out_dir / BEAD_NAME, pixel_m, settings, instrument_rng(seed, sphere, "bead")
+        out_dir / f"{BEAD_STEM}{suffix}",
+        pixel_m,
+        settings,
+        instrument_rng(seed, sphere, "bead"),
+        image_format,
     )
     density_per_um2, peak = write_absorbance(
         out_dir / ABSORBANCE_NAME, settings, instrument_rng(seed, sphere, "absorbance")
@@ -324,6 +332,7 @@ def write_instruments(
         "rotation_radius_mm": settings.rotation_radius_m * 1e3,
         "sliding_speed_um_s": settings.sliding_speed_m_s * 1e6,
         "rheometer_format": formats.rheometer,
+        "image_format": formats.images,
         "flim": flim_truth,
     }
 

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from amontons.io.absorbance import write_absorbance_csv
+from amontons.io.confocal_writers import write_confocal
 from amontons.io.heightmap import write_height_map
 from amontons.io.layout import AFM_AFTER_NAME, AFM_BEFORE_NAME
 from amontons.io.ptu import write_ptu_image
@@ -67,9 +68,11 @@ def write_fluorescence(
     counts_per_sqrt_pa: float,
     settings: InstrumentSettings,
     rng: np.random.Generator,
+    image_format: str = "tif",
 ) -> None:
     """Confocal image: local intensity ∝ the probe's emission (√max(p, p_c) in contact,
-    appendix Fig. B.4), PSF, background, noise."""
+    appendix Fig. B.4), PSF, background, noise; in ``image_format`` (amontons.io.layout
+    IMAGE_FORMATS)."""
     signal = counts_per_sqrt_pa * state.emission_sqrt_pa
     image = render_fluorescence(
         signal,
@@ -78,7 +81,7 @@ def write_fluorescence(
         background_counts=settings.background_counts,
         rng=rng,
     )
-    write_image(path, image, pixel_m)
+    write_confocal(path, image, pixel_m, image_format)
 
 
 def write_reflection(
@@ -87,8 +90,10 @@ def write_reflection(
     pixel_m: float,
     settings: InstrumentSettings,
     rng: np.random.Generator,
+    image_format: str = "tif",
 ) -> None:
-    """Reflection image of the gap map: Newton rings (eq. B.1), on the fluorescence grid."""
+    """Reflection image of the gap map: Newton rings (eq. B.1), on the fluorescence grid; in
+    ``image_format``."""
     image = render_reflection(
         state.gap_m,
         pixel_m,
@@ -99,13 +104,18 @@ def write_reflection(
         psf_fwhm_m=settings.psf_fwhm_m,
         rng=rng,
     )
-    write_image(path, image, pixel_m)
+    write_confocal(path, image, pixel_m, image_format)
 
 
 def write_bead(
-    path: Path, pixel_m: float, settings: InstrumentSettings, rng: np.random.Generator
+    path: Path,
+    pixel_m: float,
+    settings: InstrumentSettings,
+    rng: np.random.Generator,
+    image_format: str = "tif",
 ) -> tuple[float, float]:
-    """Image of a 100 nm bead (the PSF) near the field centre; returns its centre (x, y) in m."""
+    """Image of a 100 nm bead (the PSF) near the field centre, in ``image_format``; returns
+    its centre (x, y) in m."""
     side = int(np.ceil(settings.bead_field_m / pixel_m)) | 1
     # Off the pixel grid by a random sub-pixel amount, as a real bead is.
     centre = tuple(((side - 1) / 2 + rng.uniform(-0.5, 0.5)) * pixel_m for _ in range(2))
@@ -118,7 +128,7 @@ def write_bead(
         settings.background_counts,
         rng,
     )
-    write_image(path, image, pixel_m)
+    write_confocal(path, image, pixel_m, image_format)
     return centre
 
 

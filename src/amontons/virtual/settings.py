@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from amontons.io.layout import IMAGE_FORMATS
 from amontons.io.rheometer_export import EXPORT_SHAPES
 from amontons.virtual.afm import AfmSettings
 from amontons.virtual.flim import TcspcSettings
@@ -13,6 +14,7 @@ from amontons.virtual.rough_contact import SolverSettings
 
 FLIM_FORMATS = ("tif", "ptu")
 RHEOMETER_FORMATS = ("csv", *EXPORT_SHAPES)
+IMAGE_FORMAT_NAMES = tuple(IMAGE_FORMATS)
 
 
 @dataclass(frozen=True)
@@ -112,12 +114,15 @@ class OutputFormats:
 
     ``flim``: 'tif' (the mean arrival time map) or 'ptu' (the time-tagged photons, which need
     ``tcspc``); ``rheometer``: 'csv' (our own) or one of the export shapes of
-    amontons.io.rheometer_export.EXPORT_SHAPES. The default is the TIFF and CSV route.
+    amontons.io.rheometer_export.EXPORT_SHAPES; ``images``: the confocal images' format, a key
+    of amontons.io.layout.IMAGE_FORMATS ('tif', 'ome_tiff', 'czi'). The default is the TIFF and
+    CSV route.
     """
 
     flim: str = "tif"
     rheometer: str = "csv"
     tcspc: TcspcSettings | None = None
+    images: str = "tif"
 
     def __post_init__(self):
         if self.flim not in FLIM_FORMATS:
@@ -129,20 +134,31 @@ class OutputFormats:
                 f"virtual_experiment.formats.rheometer = {self.rheometer!r}; expected one of "
                 f"{RHEOMETER_FORMATS}"
             )
+        if self.images not in IMAGE_FORMAT_NAMES:
+            raise ValueError(
+                f"virtual_experiment.formats.images = {self.images!r}; expected one of "
+                f"{IMAGE_FORMAT_NAMES}"
+            )
         if self.flim == "ptu" and self.tcspc is None:
             raise ValueError("a PTU FLIM file needs the photon-counting settings (tcspc)")
 
     @classmethod
     def from_config(cls, settings: Mapping) -> OutputFormats:
-        """From the ``virtual_experiment`` config slice: its ``formats`` (flim, rheometer) and,
-        for a PTU, the photon-counting keys (amontons.virtual.flim.TcspcSettings)."""
+        """From the ``virtual_experiment`` config slice: its ``formats`` (flim, rheometer,
+        images) and, for a PTU, the photon-counting keys (amontons.virtual.flim.TcspcSettings)."""
         formats = settings["formats"]
         flim = formats["flim"]
         return cls(
             flim=flim,
             rheometer=formats["rheometer"],
             tcspc=TcspcSettings.from_config(settings) if flim == "ptu" else None,
+            images=formats["images"],
         )
+
+    @property
+    def image_suffix(self) -> str:
+        """The suffix of the confocal images ('.tif', '.ome.tif', '.czi')."""
+        return IMAGE_FORMATS[self.images]
 
 
 # The formats of the small-data run and of every test that does not choose one.

@@ -48,3 +48,14 @@ def afm_reading(config: Mapping) -> dict:
             "line_levelling": surface["line_levelling"],
         }
     )
+
+
+def image_choice(config: Mapping, reflection: bool = False) -> dict:
+    """Which plane of a confocal file is the image (config optics.images), as the keyword
+    arguments of amontons.io.confocal.ImageChoice: the fluorescence and bead channel, or with
+    ``reflection`` the reflection image's (its own where given, else the same)."""
+    images = config["optics"]["images"]
+    channel = images["channel"]
+    if reflection and images["reflection_channel"] is not None:
+        channel = images["reflection_channel"]
+    return sorted_keys({"channel": channel, "series": images["series"], "frames": images["frames"]})

@@ -22,6 +22,7 @@ from amontons.config.sheet import (
     check_shared_files,
     read_sample_sheet,
 )
+from amontons.io.layout import IMAGE_FORMATS
 from amontons.workflow.accuracy import AccuracyStudy
 from amontons.workflow.paths import RunPaths
 from amontons.workflow.resources import SolveResources
@@ -107,7 +108,9 @@ class WorkflowRun:
             paths,
             psf_stand_in=config["optics"]["psf"].get("stand_in") is not None,
             synthetic_flim=config["virtual_experiment"]["formats"]["flim"],
+            synthetic_images=IMAGE_FORMATS[config["virtual_experiment"]["formats"]["images"]],
         )
+        spheres.check_pixel_sizes()
         scenes = Scenes(config, spheres, paths)
         study = Study(config, spheres, scenes, paths)
         return cls(

@@ -15,16 +15,20 @@ from collections.abc import Mapping
 from amontons.io.layout import (
     ABSORBANCE_NAME,
     AFM_SUFFIXES,
-    BEAD_NAME,
+    BEAD_STEM,
+    CONFOCAL_SUFFIXES,
     FLUORESCENCE_DIR,
-    REFLECTION_NAME,
+    REFLECTION_STEM,
     RHEOMETER_DIR,
+    RawDataError,
     afm_file,
+    confocal_file,
     flim_file,
     fluorescence_images,
     rheometer_files,
 )
-from amontons.workflow.paths import RunPaths
+from amontons.io.pixel_probe import states_pixel_size
+from amontons.workflow.paths import CONTACT_AREA, RunPaths
 
 # The sheet values a scene takes from its sphere.
 SCENE_COLUMNS = ("diameter_mm", "e_star_gpa", "loads", "hardness_mpa", "hardening_k_mpa_per_nm")
@@ -67,14 +71,18 @@ class Spheres:
         paths: RunPaths,
         psf_stand_in: bool = False,
         synthetic_flim: str = "tif",
+        synthetic_images: str = ".tif",
     ):
         """``psf_stand_in``: whether the config gives a PSF (optics.psf.stand_in) for the
         spheres with no bead image; ``synthetic_flim``: the format of the virtual experiment's
-        FLIM file ('tif' or 'ptu', config virtual_experiment.formats.flim)."""
+        FLIM file ('tif' or 'ptu', config virtual_experiment.formats.flim);
+        ``synthetic_images``: the suffix of its confocal images ('.tif', '.ome.tif', '.czi';
+        amontons.io.layout.IMAGE_FORMATS of virtual_experiment.formats.images)."""
         self.records = dict(records)
         self.paths = paths
         self.psf_stand_in = psf_stand_in
         self.synthetic_flim = synthetic_flim
+        self.synthetic_images = synthetic_images
         self._missing: dict[str, dict[str, str]] = {}
 
     def __iter__(self):
@@ -122,9 +130,47 @@ class Spheres:
         value = self.records[sphere].get(column)
         return None if value is None else float(value)
 
-    def pixel_nm(self, sphere: str) -> float:
-        """The fluorescence images' pixel, nm."""
-        return float(self.records[sphere]["fluorescence_pixel_nm"])
+    def pixel_nm(self, sphere: str) -> float | None:
+        """The fluorescence images' pixel from the sheet, nm; None where the sheet leaves it
+        to the files' metadata."""
+        return self.value(sphere, "fluorescence_pixel_nm")
+
+    def image_pixel_inputs(self, sphere: str) -> list[str]:
+        """What a rule that renders a contact at the fluorescence pixel reads that pixel from:
+        nothing where the sheet gives it (fluorescence_pixel_nm), else the sphere's measured
+        contact-area table, which records the pixel each image's file gave
+        (amontons.measure.area.image_pixel_m)."""
+        if self.pixel_nm(sphere) is not None:
+            return []
+        return [self.paths.measured(CONTACT_AREA, self.material_of(sphere), sphere)]
+
+    def images_without_pixel(self, sphere: str) -> list[str]:
+        """The confocal images of a measured sphere whose sheet row gives no
+        fluorescence_pixel_nm that state no pixel size in their metadata either
+        (amontons.io.pixel_probe); none where the sheet gives one. Images that do not match
+        the loads, or whose header cannot be read, are left to the errors that name them."""
+        if self.is_synthetic(sphere) or self.pixel_nm(sphere) is not None:
+            return []
+        try:
+            images = self.per_load_inputs(sphere, "fluorescence")
+        except RawDataError:
+            images = []
+        singles = (self.reflection_image(sphere), self.bead_image(sphere))
+        images += [path for path in singles if os.path.isfile(path)]
+        return [path for path in images if not _states_pixel(path)]
+
+    def check_pixel_sizes(self) -> None:
+        """Stop the run before any job where an image has no pixel size: RawDataError naming
+        each sphere and its images that state none while the sheet gives none."""
+        lacking = {sphere: self.images_without_pixel(sphere) for sphere in self.records}
+        lines = [f"sphere {s}: {', '.join(paths)}" for s, paths in lacking.items() if paths]
+        if lines:
+            raise RawDataError(
+                "images without a pixel size in their metadata, and no fluorescence_pixel_nm "
+                f"in the sheet: {'; '.join(lines)}; expected the sheet's fluorescence_pixel_nm "
+                "for these spheres, or images that state their pixel (OME-TIFF PhysicalSizeX, "
+                "CZI Scaling, TIFF resolution tags)"
+            )
 
     def per_load_inputs(self, sphere: str, kind: str) -> str | list[str]:
         """The per-load raw files of a sphere, 'fluorescence' or 'rheometer', in load order.
@@ -149,6 +195,20 @@ class Spheres:
         load = self.value(sphere, "reflection_load_mn")
         return images[[abs(load - f) < 1e-9 for f in self.loads_mn(sphere)].index(True)]
 
+    def confocal_image(self, sphere: str, stem: str) -> str:
+        """A sphere's one confocal image ``stem`` (reflection, bead): the virtual experiment's
+        in its format; a measured sphere's in whichever of amontons.io.layout.CONFOCAL_SUFFIXES
+        it is (two stop the run, naming them). With none present the TIFF is named, so the
+        missing input is reported by that name."""
+        if self.is_synthetic(sphere):
+            return self.raw_file(sphere, f"{stem}{self.synthetic_images}")
+        found = confocal_file(self.raw_dir(sphere), stem)
+        return str(found) if found else self.raw_file(sphere, f"{stem}{CONFOCAL_SUFFIXES[2]}")
+
+    def reflection_image(self, sphere: str) -> str:
+        """The reflection image (Newton rings) of a sphere."""
+        return self.confocal_image(sphere, REFLECTION_STEM)
+
     def afm_path(self, sphere: str, stem: str) -> str:
         """A sphere's AFM height map ``stem`` (afm_before / afm_after): the virtual experiment
         writes TIFF; measured data may be any format amontons.io.layout.AFM_SUFFIXES lists (two
@@ -162,8 +222,8 @@ class Spheres:
 
     def bead_image(self, sphere: str) -> str:
         """The bead image a sphere's PSF is measured from: the sheet's bead_file (shared by
-        many spheres) or the sphere's own bead.tif."""
-        return self.records[sphere].get("bead_file") or self.raw_file(sphere, BEAD_NAME)
+        many spheres) or the sphere's own bead image (bead.tif, .ome.tif, .czi)."""
+        return self.records[sphere].get("bead_file") or self.confocal_image(sphere, BEAD_STEM)
 
     def absorbance_spectrum(self, sphere: str) -> str:
         """The absorbance spectrum of a sphere's cover slip: the sheet's absorbance_file
@@ -182,8 +242,9 @@ class Spheres:
     def _look(self, sphere: str) -> dict[str, str]:
         folder = self.raw_dir(sphere)
         missing = {}
-        if not os.path.isfile(self.raw_file(sphere, REFLECTION_NAME)):
-            missing[REFLECTION] = f"no {REFLECTION_NAME} in {folder}"
+        if not os.path.isfile(self.reflection_image(sphere)):
+            names = ", ".join(REFLECTION_STEM + suffix for suffix in CONFOCAL_SUFFIXES)
+            missing[REFLECTION] = f"no reflection image ({names}) in {folder}"
         elif self.value(sphere, "reflection_load_mn") is None:
             missing[REFLECTION] = "no reflection_load_mn in the sheet"
         for kind, path in (
@@ -266,6 +327,15 @@ class Spheres:
         """The sheet values a scene takes from its sphere (None where a cell is empty)."""
         row = self.records[sphere]
         return {key: row.get(key) for key in SCENE_COLUMNS}
+
+
+def _states_pixel(path: str) -> bool:
+    """Whether the image ``path`` states its pixel size; an unreadable header counts as yes
+    here, since the job that reads it stops naming the file."""
+    try:
+        return states_pixel_size(path)
+    except RawDataError:
+        return True
 
 
 def names_pattern(names) -> str:

@@ -1,0 +1,125 @@
+"""Whether a confocal image's file states its pixel size, read from its header alone with the
+standard library: the workflow asks this when it builds the DAG (amontons.workflow.spheres),
+so that a measured sphere whose images carry no pixel size, and whose sheet row gives none,
+stops the run before any job, naming the sphere and the file.
+
+The readers (amontons.io.confocal, amontons.io.tiff) take the pixel from the same places:
+
+- TIFF: the resolution tags with a centimetre or inch unit, an inch resolution above the
+  display defaults (amontons.io.tiff); an ImageJ hyperstack: the tags with the ImageJ ``unit``;
+  an OME-TIFF: PhysicalSizeX in the OME-XML;
+- CZI: the Scaling of the XML metadata segment (X distance > 0).
+
+tests/io/test_pixel_probe.py holds the probe to the readers on files their writers made.
+"""
+
+from __future__ import annotations
+
+import re
+import struct
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+from amontons.io.layout import RawDataError, confocal_suffix
+
+_IMAGE_DESCRIPTION, _X_RESOLUTION, _RESOLUTION_UNIT = 270, 282, 296
+_CENTIMETRE, _INCH = 3, 2
+_DISPLAY_DPI_MAX = 1200.0  # amontons.io.tiff: an inch resolution up to this is a display default
+# TIFF field types: byte size of one value
+_TYPE_SIZES = {1: 1, 2: 1, 3: 2, 4: 4, 5: 8, 6: 1, 7: 1, 8: 2, 9: 4, 10: 8, 11: 4, 12: 8, 16: 8}
+_CZI_MAGIC = b"ZISRAWFILE"
+_CZI_METADATA = b"ZISRAWMETADATA"
+_CZI_METADATA_POSITION = 92  # FileHeader: offset of the metadata segment's position (int64)
+_CZI_XML_START = 32 + 256  # metadata segment: header, then sizes and spare, then the XML
+
+
+def _tiff_tags(path: Path) -> dict[int, object]:
+    """The ImageDescription, XResolution and ResolutionUnit of a TIFF's (or BigTIFF's) first
+    page, as text, (numerator, denominator) and int."""
+    with open(path, "rb") as stream:
+        head = stream.read(16)
+        order = {b"II": "<", b"MM": ">"}.get(head[:2])
+        if order is None:
+            raise RawDataError(f"{path}: not a TIFF (no II or MM byte order mark)")
+        (version,) = struct.unpack(order + "H", head[2:4])
+        big = version == 43
+        offset = struct.unpack(order + ("Q" if big else "I"), head[8:16] if big else head[4:8])[0]
+        stream.seek(offset)
+        count_format, entry_size = (order + "Q", 20) if big else (order + "H", 12)
+        (count,) = struct.unpack(count_format, stream.read(struct.calcsize(count_format)))
+        entries = stream.read(count * entry_size)
+        tags = {}
+        for i in range(count):
+            entry = entries[i * entry_size : (i + 1) * entry_size]
+            code, kind = struct.unpack(order + "HH", entry[:4])
+            if code not in (_IMAGE_DESCRIPTION, _X_RESOLUTION, _RESOLUTION_UNIT):
+                continue
+            n = struct.unpack(order + ("Q" if big else "I"), entry[4:12] if big else entry[4:8])[0]
+            inline = entry[12:20] if big else entry[8:12]
+            size = n * _TYPE_SIZES.get(kind, 1)
+            if size <= len(inline):
+                value = inline[:size]
+            else:
+                stream.seek(struct.unpack(order + ("Q" if big else "I"), inline)[0])
+                value = stream.read(size)
+            if code == _IMAGE_DESCRIPTION:
+                tags[code] = value.rstrip(b"\0").decode("utf-8", "replace")
+            elif code == _X_RESOLUTION:
+                tags[code] = struct.unpack(order + "II", value[:8])
+            else:
+                tags[code] = struct.unpack(order + "H", value[:2])[0]
+    return tags
+
+
+def _tiff_states_pixel(path: Path) -> bool:
+    tags = _tiff_tags(path)
+    description = str(tags.get(_IMAGE_DESCRIPTION, ""))
+    if "<OME" in description:
+        return re.search(r'PhysicalSizeX="[0-9.eE+-]*[1-9]', description) is not None
+    numerator, denominator = tags.get(_X_RESOLUTION, (0, 0))
+    if numerator <= 0 or denominator <= 0:
+        return False
+    if description.startswith("ImageJ="):
+        unit = re.search(r"^unit=(.*)$", description, re.MULTILINE)
+        return unit is not None and unit[1].strip() not in ("pixel", "pixels")
+    unit = tags.get(_RESOLUTION_UNIT)
+    per_unit = numerator / denominator
+    return unit == _CENTIMETRE or (unit == _INCH and per_unit > _DISPLAY_DPI_MAX)
+
+
+def _czi_states_pixel(path: Path) -> bool:
+    with open(path, "rb") as stream:
+        header = stream.read(_CZI_METADATA_POSITION + 8)
+        if not header.startswith(_CZI_MAGIC) or len(header) < _CZI_METADATA_POSITION + 8:
+            raise RawDataError(f"{path}: not a CZI (no ZISRAWFILE header)")
+        (position,) = struct.unpack("<q", header[_CZI_METADATA_POSITION:])
+        stream.seek(position)
+        segment = stream.read(_CZI_XML_START)
+        if not segment.startswith(_CZI_METADATA) or len(segment) < _CZI_XML_START:
+            raise RawDataError(f"{path}: no metadata segment where the CZI header points")
+        (xml_size,) = struct.unpack("<i", segment[32:36])
+        xml = stream.read(xml_size)
+    try:
+        root = ElementTree.fromstring(xml)
+    except ElementTree.ParseError as error:
+        raise RawDataError(f"{path}: unreadable CZI metadata ({error})") from error
+    for distance in root.iter("Distance"):
+        if distance.get("Id") == "X":
+            value = distance.findtext("Value") or "0"
+            return float(value) > 0
+    return False
+
+
+def states_pixel_size(path: str | Path) -> bool:
+    """Whether the confocal image ``path`` (a suffix of amontons.io.layout.CONFOCAL_SUFFIXES)
+    states its pixel size in its metadata. Raises RawDataError naming the file when its header
+    cannot be read."""
+    path = Path(path)
+    try:
+        if confocal_suffix(path) == ".czi":
+            return _czi_states_pixel(path)
+        return _tiff_states_pixel(path)
+    except (OSError, struct.error, ValueError, UnicodeDecodeError) as error:
+        if isinstance(error, RawDataError):
+            raise
+        raise RawDataError(f"{path}: unreadable image header ({error})") from error

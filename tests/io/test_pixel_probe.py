@@ -1,0 +1,74 @@
+"""The header probe the DAG asks whether an image states its pixel size
+(amontons.io.pixel_probe) agrees with the readers on files their own writers made: where it
+says yes, the reader finds a pixel with no sheet value; where it says no, the reader needs
+one."""
+
+import numpy as np
+import pylibCZIrw.czi as pyczi
+import pytest
+import tifffile
+
+from amontons.io.confocal import ImageChoice, read_confocal
+from amontons.io.confocal_writers import write_confocal
+from amontons.io.layout import RawDataError
+from amontons.io.pixel_probe import states_pixel_size
+from amontons.io.tiff import ImageError
+
+DATA = np.arange(1, 65, dtype=np.uint16).reshape(8, 8)
+
+
+def _czi_without_scaling(path):
+    with pyczi.create_czi(str(path), exist_ok=True) as czi:
+        czi.write(DATA[..., np.newaxis], plane={"C": 0, "T": 0, "Z": 0})
+        czi.write_metadata(channel_names={0: "fluorescence"})
+
+
+def _imagej(path, unit):
+    metadata = {"axes": "YX", **({"unit": unit} if unit else {})}
+    tifffile.imwrite(path, DATA, imagej=True, resolution=(4.0, 4.0), metadata=metadata)
+
+
+WRITERS = {
+    "25.tif": (lambda p: write_confocal(p, DATA, 200e-9, "tif"), True),
+    "big.tif": (
+        lambda p: tifffile.imwrite(
+            p, DATA, bigtiff=True, resolution=(5e4, 5e4), resolutionunit="CENTIMETER"
+        ),
+        True,
+    ),
+    "untagged.tif": (lambda p: tifffile.imwrite(p, DATA), False),
+    "72dpi.tif": (
+        lambda p: tifffile.imwrite(p, DATA, resolution=(72, 72), resolutionunit=2),
+        False,
+    ),
+    "25.ome.tif": (lambda p: write_confocal(p, DATA, 200e-9, "ome_tiff"), True),
+    "bare.ome.tif": (
+        lambda p: tifffile.imwrite(p, DATA, ome=True, photometric="minisblack"),
+        False,
+    ),
+    "hyper.tif": (lambda p: _imagej(p, "um"), True),
+    "nounit.tif": (lambda p: _imagej(p, None), False),
+    "uncalibrated.tif": (lambda p: _imagej(p, "pixel"), False),
+    "25.czi": (lambda p: write_confocal(p, DATA, 200e-9, "czi"), True),
+    "bare.czi": (_czi_without_scaling, False),
+}
+
+
+@pytest.mark.parametrize("name", list(WRITERS))
+def test_the_probe_says_what_the_reader_finds(tmp_path, name):
+    write, states = WRITERS[name]
+    path = tmp_path / name
+    write(path)
+    assert states_pixel_size(path) is states
+    if states:
+        assert read_confocal(path, None, ImageChoice()).pixel_source == "file"
+    else:
+        with pytest.raises(ImageError, match="no pixel size in the"):
+            read_confocal(path, None, ImageChoice())
+
+
+@pytest.mark.parametrize("name", ["25.tif", "25.czi"])
+def test_a_file_that_is_not_its_format_is_named(tmp_path, name):
+    (tmp_path / name).write_bytes(b"GIF89a not an image at all")
+    with pytest.raises(RawDataError, match=rf"{name}: not a"):
+        states_pixel_size(tmp_path / name)
