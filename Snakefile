@@ -34,6 +34,13 @@ include: "workflow/rules/accuracy.smk"
 include: "workflow/rules/summary.smk"
 
 
+# A failed run names, per sphere, each step that failed and its error, and keeps them in
+# results/<run>/failed_jobs.csv (docs/workflow.md, "When a job fails").
+onerror:
+    for line in report_failed_jobs(log, RUN.paths):
+        logger.error(line)
+
+
 # Default target: every output of every selected material.
 rule all:
     default_target: True

@@ -269,6 +269,12 @@ def test_one_corrupt_file_stops_only_its_sphere(small_run, tmp_path):
         assert (project / path).is_file(), path
     errors = [f["error"] for f in plans["PS-corrupt"]["files"] if "error" in f]
     assert errors and str(image) in errors[0]
+    # the failure, per sphere, with its error, in the run's record and at the end of its log
+    failed = pd.read_csv(project / "results" / SMALL / "failed_jobs.csv")
+    assert set(failed["sphere"]) == {"PS-corrupt"} and set(failed["material"]) == {"PS"}
+    assert failed["error"].str.contains(str(image), regex=False).all()
+    assert all((project / log).is_file() for log in failed["log"])
+    assert f"sphere PS-corrupt (PS): {failed['rule'].iloc[0]} failed:" in run.stderr
 
 
 def _scene_record(project, sphere, name):

@@ -5,6 +5,7 @@ from functools import partial
 
 from snakemake.logging import logger
 
+from amontons.workflow.failures import report_failed_jobs
 from amontons.workflow.params import (
     afm_reading,
     config_slice as _config_slice,

@@ -1,0 +1,104 @@
+"""The jobs a run could not finish, per sphere: read from Snakemake's log when the run stops
+with an error, written to ``failed_jobs.csv`` in the run's results folder and printed, so that
+a failure names the sphere, the step and the error, not only a job number (docs/workflow.md,
+"When a job fails").
+
+Snakemake logs each failed job as an ``Error in rule <name>:`` block whose indented lines give
+its output and log files. A job's sphere and material come from those paths (the run's layout,
+amontons.workflow.paths); its error is the last exception line of its own log.
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from dataclasses import astuple, dataclass, fields
+from pathlib import Path
+
+from amontons.workflow.paths import RunPaths
+
+_BLOCK = re.compile(r"^Error in rule (?P<rule>\S+):\n(?P<body>(?:[ \t]+\S.*\n?)*)", re.MULTILINE)
+_ENTRY = re.compile(r"^[ \t]+(?P<key>[\w-]+): (?P<value>.*)$", re.MULTILINE)
+# An exception's last line, as Python prints it: "package.module.SomeError: message".
+_EXCEPTION = re.compile(r"^(?:[\w.]+\.)?\w*(?:Error|Exception)\b.*$")
+FAILED_JOBS = "failed_jobs.csv"
+
+
+@dataclass(frozen=True)
+class FailedJob:
+    """One job that failed: its rule, the sphere and material its files belong to ('' for a
+    run-wide job), its log file and the error its log ends with."""
+
+    rule: str
+    material: str
+    sphere: str
+    log: str
+    error: str
+
+
+def _entries(body: str) -> dict[str, str]:
+    return {m["key"]: m["value"].strip() for m in _ENTRY.finditer(body)}
+
+
+def _owner(paths: list[str], root: str) -> tuple[str, str]:
+    """(material, sphere) of the first path below ``root``/<material>/<sphere>/."""
+    for path in paths:
+        parts = Path(path).parts
+        base = Path(root).parts
+        if parts[: len(base)] == base and len(parts) > len(base) + 2:
+            return parts[len(base)], parts[len(base) + 1]
+    return "", ""
+
+
+def last_error(log_text: str) -> str:
+    """The last exception line of a job's log ('' where it has none)."""
+    lines = [line.strip() for line in log_text.splitlines()]
+    errors = [line for line in lines if _EXCEPTION.match(line)]
+    return errors[-1] if errors else ""
+
+
+def failed_jobs(snakemake_log: str, paths: RunPaths, workdir: Path = Path(".")) -> list[FailedJob]:
+    """The failed jobs of a run, from the text of Snakemake's log, with the error read from
+    each job's own log (relative to ``workdir``) where it is there."""
+    jobs = []
+    for block in _BLOCK.finditer(snakemake_log):
+        entries = _entries(block["body"])
+        log = entries.get("log", "").split(" (check log")[0].split(", ")[0]
+        outputs = entries.get("output", "").split(", ")
+        material, sphere = _owner([*outputs, log], paths.results)
+        if not sphere:
+            material, sphere = _owner([log], paths.logs)
+        job_log = workdir / log if log else None
+        error = last_error(job_log.read_text()) if job_log and job_log.is_file() else ""
+        jobs.append(FailedJob(block["rule"], material, sphere, log, error))
+    return jobs
+
+
+def write_failed_jobs(path: str | Path, jobs: list[FailedJob]) -> None:
+    """The failed jobs as CSV, one row per job (columns: FailedJob's fields)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow([f.name for f in fields(FailedJob)])
+        writer.writerows(astuple(job) for job in jobs)
+
+
+def failure_lines(jobs: list[FailedJob]) -> list[str]:
+    """One line per failed job, for the terminal: the sphere, the step, the error, the log."""
+    lines = []
+    for job in jobs:
+        where = f"sphere {job.sphere} ({job.material})" if job.sphere else "run"
+        lines.append(f"{where}: {job.rule} failed: {job.error or 'see its log'} [{job.log}]")
+    return lines
+
+
+def report_failed_jobs(snakemake_logs: str | Path | list, paths: RunPaths) -> list[str]:
+    """Read the run's Snakemake log (the ``log`` of Snakefile's onerror: one path, or a list
+    of them as Snakemake 9 gives), write ``failed_jobs.csv`` in its results folder and return
+    the lines to print."""
+    logs = [snakemake_logs] if isinstance(snakemake_logs, str | Path) else snakemake_logs
+    text = "".join(Path(log).read_text() for log in logs if Path(log).is_file())
+    jobs = failed_jobs(text, paths)
+    write_failed_jobs(f"{paths.results}/{FAILED_JOBS}", jobs)
+    return failure_lines(jobs)
