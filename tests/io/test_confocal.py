@@ -102,7 +102,19 @@ def test_the_virtual_experiments_writers_round_trip_pixels_and_pixel(tmp_path, i
     write_confocal(tmp_path / f"25{suffix}", data, 200e-9, image_format)
     image = read_confocal(tmp_path / f"25{suffix}", 200e-9)
     assert image.data.tobytes() == data.tobytes() and image.data.dtype == data.dtype
-    assert image.pixel_m == pytest.approx(200e-9, rel=1e-12)
+    # the same double as the plain TIFF's tag (50000 px/cm): 0.2 µm read as float("0.2") / 1e6
+    # was one ulp off, and every area and PSF width measured on it with it
+    assert image.pixel_m == 200e-9
+
+
+@pytest.mark.parametrize("pixel_nm", ["200", "130", "32", "97.65625"])
+def test_decimal_pixel_sizes_read_as_the_nearest_double_in_every_unit(tmp_path, pixel_nm):
+    metres = float(pixel_nm + "e-9")
+    for unit, text in (("µm", f"{float(pixel_nm) / 1000!r}"), ("nm", pixel_nm)):
+        path = tmp_path / f"{unit}.ome.tif"
+        metadata = {"axes": "YX", "PhysicalSizeX": text, "PhysicalSizeXUnit": unit}
+        tifffile.imwrite(path, STACK[0, 0], ome=True, metadata=metadata)
+        assert read_confocal(path, None).pixel_m == metres, unit
 
 
 # --- bad files: each kind stops with a named error ---

@@ -21,6 +21,8 @@ from __future__ import annotations
 import logging
 import xml.etree.ElementTree as ElementTree
 from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -98,6 +100,17 @@ def _per_metre(path: Path, unit: str) -> float:
     return _UNITS_PER_M[unit]
 
 
+def _decimal_metres(path: Path, text: str, unit: str) -> float:
+    """The length ``text`` (decimal digits) in ``unit``, in metres: the double nearest the
+    decimal value. float(text) / 1e6 rounds twice (0.2 µm gives 2.0000000000000002e-07 m),
+    so the same 200 nm pixel would come out one ulp away from a TIFF tag's 50000 px/cm."""
+    try:
+        length = Decimal(text.strip())
+    except InvalidOperation:
+        raise ImageError(f"{path}: pixel size {text!r}; expected a number") from None
+    return float(length / Decimal(_per_metre(path, unit)))
+
+
 def _square_pixel(path: Path, x_m: float | None, y_m: float | None) -> float | None:
     """The pixel (m) of square pixels; ImageError naming the file for rectangular ones."""
     if x_m is not None and y_m is not None and abs(x_m - y_m) > 1e-6 * x_m:
@@ -138,7 +151,7 @@ def _ome_pixel_and_channels(
     for axis in ("X", "Y"):
         value = pixels.get(f"PhysicalSize{axis}")
         unit = pixels.get(f"PhysicalSize{axis}Unit", _OME_DEFAULT_UNIT)
-        sizes.append(None if value is None else float(value) / _per_metre(path, unit))
+        sizes.append(None if value is None else _decimal_metres(path, value, unit))
     return _square_pixel(path, *sizes), names
 
 
@@ -152,7 +165,9 @@ def _imagej_pixel(path: Path, tif: tifffile.TiffFile) -> float | None:
     sizes = []
     for name in ("XResolution", "YResolution"):
         numerator, denominator = tags[name].value if name in tags else tags["XResolution"].value
-        sizes.append(denominator / numerator / _per_metre(path, unit) if numerator else None)
+        # exact rational arithmetic, rounded once (as _decimal_metres)
+        per_m = Fraction(_per_metre(path, unit))
+        sizes.append(float(Fraction(denominator, numerator) / per_m) if numerator else None)
     return _square_pixel(path, *sizes)
 
 
