@@ -1,6 +1,6 @@
-"""The fused numba path of the CG (the default) against the numpy reference loop.
+"""The fused numba path of the CG (the solver's) against the numpy reference loop.
 
-Both run the same algorithm (amontons.contact.cg, amontons.contact.fused); they differ in
+Both run the same algorithm (amontons.contact.cg, tests/contact/numpy_oracle.py); they differ in
 summation order and in when the displacement is refreshed by a full convolution (the fused
 path applies up to ~12-32 changed points as point responses, the numpy one up to 3), so the
 iterates agree to round-off, not bit for bit. The converged fields are held to 1e-10 (area
@@ -8,6 +8,9 @@ fraction, approach over the rms height), far below the solve tolerance, and the 
 counts to 5 % (issue 23's bounds): a wrong kernel moves the fixed point by at least the
 tolerance or changes the iteration path.
 """
+
+import importlib.util
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -21,13 +24,26 @@ from amontons.contact.convolution import get_operator
 from amontons.contact.plasticity import _WinklerOperator
 
 
+def _load_oracle():
+    """The numpy reference loop (tests/contact/numpy_oracle.py; tests import by file)."""
+    spec = importlib.util.spec_from_file_location(
+        "numpy_oracle", Path(__file__).with_name("numpy_oracle.py")
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.numpy_polonsky_keer
+
+
+numpy_polonsky_keer = _load_oracle()
+
+
 def _pair(op, h, **kw):
     """(numpy reference, fused) outcomes of the same solve."""
     base = {"pixel_area": 1.0, "h_scale": float(h.std()), "tol": 1e-9, "max_iter": 2000}
     base.update(kw)
     with threadpool_limits(limits=1):  # as solve() runs it: no spinning BLAS threads
-        ref = polonsky_keer(op, h, kernels=False, **base)
-        new = polonsky_keer(op, h, kernels=True, **base)
+        ref = numpy_polonsky_keer(op, h, **base)
+        new = polonsky_keer(op, h, **base)
     return ref, new
 
 

@@ -216,6 +216,30 @@ def solve(
         )
 
 
+def solve_with_options(
+    heights, spacing, e_star, opts: SolveOptions, *, load=None, displacement=None
+):
+    """One cold solve under options already validated (:func:`.inputs.solve_options`, then
+    perhaps :func:`dataclasses.replace`): how a test selects a kernel set that
+    :func:`solve` does not offer (``bounded_load_sweep=False``). Units as :func:`solve`;
+    no warm start, no plastic history, no coarse-to-fine start."""
+    h = check_heights(heights)
+    load, displacement = check_control(load, displacement)
+    plastic_prev = None if opts.law is None else np.zeros(h.shape)
+    with threadpool_limits(limits=1):
+        return _solve_step(
+            h,
+            check_positive("spacing", spacing, "m"),
+            check_positive("e_star", e_star, "Pa"),
+            opts,
+            load=load,
+            displacement=displacement,
+            warm_start=None,
+            plastic_prev=plastic_prev,
+            coarse_to_fine=False,
+        )
+
+
 def solve_load_series(
     heights,
     spacing,
@@ -527,6 +551,7 @@ def _solve_plastic(h, spacing, e_star, opts, *, load, displacement, warm_start, 
         max_iter=opts.max_iter,
         max_outer=opts.max_outer,
         route=opts.route,
+        bounded_load_sweep=opts.bounded_load_sweep,
     )
     info = _solve_info(
         opts,

@@ -169,7 +169,7 @@ class PeriodicConvolution(_MultiplierMixin):
 
         With :meth:`multiply_energy` and :meth:`inverse` this is ``__call__`` taken apart, so
         that the CG step can have ``Σ p·(K*p)`` from the spectrum and skip the inverse when
-        the displacement is taken afresh anyway (:mod:`.fused`). pyfftw backend only.
+        the displacement is taken afresh anyway (:mod:`.cg`). pyfftw backend only.
         """
         if _fft.aligned(p, self.shape):
             self._fwd.update_arrays(p, self._spec)

@@ -30,7 +30,10 @@ class SolveOptions:
 
     ``max_iter`` is resolved from the grid; ``route`` is ``"elastic"`` without a law, else
     the plastic route; ``max_outer`` is resolved for plastic solves and None for elastic ones
-    and the ``"bounded"`` route (no outer loop).
+    and the ``"bounded"`` route (no outer loop). ``bounded_load_sweep``: the kernel set of
+    bounded load control, the fused sweep (True, the only one :func:`solve_options` gives)
+    or the numpy step with a convolution per step (False: the reference the tests select
+    with :func:`dataclasses.replace`).
     """
 
     periodic: bool
@@ -43,6 +46,7 @@ class SolveOptions:
     route: str
     max_outer: int | None
     raise_on_failure: bool
+    bounded_load_sweep: bool = True
 
 
 def solve_options(

@@ -3,7 +3,7 @@
 The numpy path of :func:`amontons.contact.cg.polonsky_keer` spends ~40 passes over the grid
 per iteration on masks, axpys, reductions, the projection and the violator search. These
 kernels do the same arithmetic in three or four sweeps (docs/models.md §2.2 gives the
-algorithm, :mod:`.fused` the order):
+algorithm, :mod:`.cg` the order):
 
 ``gap_moments``   moments of the gap on the free set (approach, ``G``, ``Σ g t_old``,
                   ``Σ t_old``);
@@ -30,7 +30,7 @@ call through :func:`numba.set_num_threads` (see :func:`kernel_threads`).
 
 Units: pressures in Pa, lengths in m; ``sigma`` is the dimensionless scale of the stored
 pressure and displacement (true value = ``sigma`` × stored), which lets load control rescale
-the field without a pass (see :mod:`amontons.contact.fused`).
+the field without a pass (see :mod:`amontons.contact.cg`).
 """
 
 from __future__ import annotations
@@ -48,9 +48,9 @@ from . import kernel_cache as _kernel_cache
 # thread count; small enough to balance 2-8 threads from 512² on, large enough that the
 # per-chunk overhead vanishes.
 CHUNK = 16384
-# Changed points (clipped + added) recorded per chunk. The fused solver applies changes as
-# point responses only when there are at most this many in total (.fused.SPARSE_MAX), so a
-# chunk never needs more slots than that.
+# Changed points (clipped + added) recorded per chunk. The solver applies changes as point
+# responses only when there are at most this many in total (.cg.SPARSE_MAX_PERIODIC,
+# SPARSE_MAX_PADDED), so a chunk never needs more slots than that.
 SLOTS = 64
 # Points per block of update's search for clipped points and direction's for violators in a
 # chunk with a few: blocks without one are passed over after a vectorised test.
@@ -180,7 +180,7 @@ def direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, v
     """``t ← m·(sigma·u - h - d + beta·t - shift)`` in place (m); returns ``Σ t``.
 
     Load control passes ``shift = beta·Σ t_old / nc``, which keeps ``Σ t = 0`` on the free
-    set (:mod:`.fused`); displacement control passes 0.
+    set (:mod:`.cg`); displacement control passes 0.
 
     Also counts, per chunk into ``violators``, the constrained points that should be free
     (the violator test of ``update``, which does not depend on the step: ``t = 0`` there).
@@ -319,7 +319,7 @@ def update(
     and :class:`~amontons.contact.cg.BoundedWall`. With ``with_u``, ``u`` gets
     ``-tau/sigma·r`` in place; without, ``u`` is not written (the gaps of the points that
     may join are still read from it) and ``r`` is not read: the caller brings ``u`` to the
-    new pressure itself (:mod:`.fused`).
+    new pressure itself (:mod:`.cg`).
 
     ``p_max`` (Pa) has one entry per point when ``bounded`` is 1, else one entry, ignored
     (no upper bound). Changed points are recorded per chunk in ``idx[c, :]`` (flat index)

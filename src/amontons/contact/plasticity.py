@@ -513,6 +513,7 @@ def solve_plastic(
     max_iter,
     max_outer=None,
     route="winkler",
+    bounded_load_sweep=True,
 ):
     """One load step of a plasticity law, starting from the plastic state ``plastic_prev``.
 
@@ -520,8 +521,9 @@ def solve_plastic(
     increments, exact), ``"bounded"`` (penetration hardness with local increments, one
     bounded CG, exact) or ``"appendix"`` (the appendix's iterative scheme). ``max_outer``
     caps the active-set rounds or the plastic updates per approach (None:
-    :func:`default_max_outer`; unused by ``"bounded"``). Returns a :class:`PlasticState`,
-    converged or not.
+    :func:`default_max_outer`; unused by ``"bounded"``); ``bounded_load_sweep`` picks the
+    kernel set of the ``"bounded"`` route's load control (:func:`.cg.polonsky_keer`).
+    Returns a :class:`PlasticState`, converged or not.
     """
     pixel_area = spacing**2
     h_scale = float(np.std(heights)) or spacing
@@ -582,6 +584,7 @@ def solve_plastic(
                 p_init=p_init,
                 tol=tol,
                 max_iter=max_iter,
+                bounded_load_sweep=bounded_load_sweep,
             )
 
         def bound(h_pl):
@@ -671,6 +674,7 @@ def _hardness_bounded(
     p_init,
     tol,
     max_iter,
+    bounded_load_sweep=True,
 ):
     """Penetration hardness with local increments (eq. B.2) in one bounded CG.
 
@@ -696,6 +700,7 @@ def _hardness_bounded(
         max_iter=max_iter,
         constraint=BoundedWall(p_y),
         raise_on_failure=False,
+        bounded_load_sweep=bounded_load_sweep,
     )
     flow = _penetration_at_bound(out.pressure, out.gap, p_y)
     plastic = plastic_prev + local_increment(flow)

@@ -132,7 +132,7 @@ class SolveInfo:
         plastic increment, repeat, with a root find on the approach under load control).
     convolutions : float
         Convolutions on the finest grid, in FFT pairs: a forward transform whose inverse the
-        solver skipped counts 0.5 (:mod:`amontons.contact.fused`). Plastic routes under load
+        solver skipped counts 0.5 (:mod:`amontons.contact.cg`). Plastic routes under load
         control: those of the final approach only (the root find's trial approaches are not
         counted).
     steepest_descent_resets : int
