@@ -17,7 +17,7 @@ import sys
 import numpy as np
 import pytest
 
-from amontons.contact import kernel_cache, kernels, solve
+from amontons.contact import jit, kernel_cache, kernels, solve
 from amontons.contact.plasticity import PenetrationHardness
 
 # evaluated at collection, before any test has run a kernel
@@ -91,9 +91,9 @@ def test_is_cold_says_no_when_numba_cannot_tell():
 
 
 def test_a_failing_child_warns_and_the_process_goes_on(monkeypatch):
-    monkeypatch.setattr(kernel_cache.sys, "executable", "/bin/false")
+    monkeypatch.setattr(jit.sys, "executable", "/bin/false")
     with pytest.warns(RuntimeWarning, match="child process failed"):
-        kernel_cache._compile_in_child()
+        jit.compile_in_child()
 
 
 def test_the_warm_up_solves_reach_their_routes():

@@ -299,7 +299,7 @@ def _winkler_parts(operator):
     if compliance is None or base is None:
         return operator, None
     # a fresh writable copy: a read-only array is another type to the compiled kernels,
-    # which would then compile in this process (.kernel_cache)
+    # which would then compile in this process (.jit)
     return base, np.array(compliance, dtype=np.float64).ravel()
 
 

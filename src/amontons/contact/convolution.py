@@ -39,7 +39,7 @@ from functools import lru_cache
 import numpy as np
 
 from . import fft as _fft
-from . import kernels as _kernels
+from . import spectrum as _spectrum
 from .greens import hockney_multiplier, periodic_multiplier
 
 
@@ -64,8 +64,8 @@ class _MultiplierMixin:
         at 2.3x the kernel's time on one thread (1.1 against 0.5 ms at 1024², 4.1 against
         1.8 ms at 2048²; benchmarks/README.md, benchmark 1), the same bits (the imaginary
         part of the cast is an exact zero)."""
-        with _kernels.kernel_threads(self.threads):
-            _kernels.multiply_spectrum(self._spec, self._mult_scaled)
+        with _spectrum.spectrum_threads(self.threads):
+            _spectrum.multiply_spectrum(self._spec, self._mult_scaled)
 
     @property
     def multiplier(self) -> np.ndarray:
@@ -181,8 +181,8 @@ class PeriodicConvolution(_MultiplierMixin):
     def multiply_energy(self) -> float:
         """Second half: the work spectrum times the kernel's; returns ``Σ p·(K*p)``
         (m·Pa) of the field last given to :meth:`forward`, by Parseval."""
-        with _kernels.kernel_threads(self.threads):
-            return _kernels.multiply_spectrum_energy(
+        with _spectrum.spectrum_threads(self.threads):
+            return _spectrum.multiply_spectrum_energy(
                 self._spec, self._mult_scaled, self.shape[1] % 2 == 0
             )
 
@@ -346,8 +346,8 @@ class NonPeriodicConvolution(_MultiplierMixin):
     def multiply_energy(self) -> float:
         """The work spectrum times the kernel's; returns ``Σ p·(K*p)`` (m·Pa) over the
         window by Parseval on the padded grid (``p`` is zero on the padding)."""
-        with _kernels.kernel_threads(self.threads):
-            return _kernels.multiply_spectrum_energy(
+        with _spectrum.spectrum_threads(self.threads):
+            return _spectrum.multiply_spectrum_energy(
                 self._spec, self._mult_scaled, self.padded_shape[1] % 2 == 0
             )
 
