@@ -27,7 +27,7 @@ from amontons.contact import (
     solve_load_series,
 )
 from amontons.contact.api import solve_with_options
-from amontons.contact.inputs import solve_options
+from amontons.contact.options import solve_options
 from amontons.contact.surfaces import self_affine, sphere
 
 E_STAR = 3.5e9  # PMMA on glass, Pa

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from amontons.contact import jit, kernel_cache, kernels, solve
-from amontons.contact.plasticity import PenetrationHardness
+from amontons.contact.laws import PenetrationHardness
 
 # evaluated at collection, before any test has run a kernel
 COLD_AT_START = kernel_cache.is_cold(kernels.ENTRY_POINTS)
@@ -26,7 +26,7 @@ COLD_AT_START = kernel_cache.is_cold(kernels.ENTRY_POINTS)
 SOLVES = """
 import hashlib
 from amontons.contact import self_affine, solve, sphere
-from amontons.contact.plasticity import PenetrationHardness
+from amontons.contact.laws import PenetrationHardness
 rough = self_affine((96, 96), 1.0, 0.8, rms_slope=0.1, rng=11)
 a = solve(rough, 1.0, 1.0, load=0.005 * 96**2, periodic=True)
 h = sphere((96, 96), 0.01, 1.0)

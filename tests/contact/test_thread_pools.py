@@ -13,7 +13,7 @@ from threadpoolctl import threadpool_info, threadpool_limits
 import amontons.contact.greenwood_tripp as gt_module
 from amontons.contact import ContactInputError, ConvergenceError, api, solve, solve_load_series
 from amontons.contact.greenwood_tripp import AsperityModel, greenwood_tripp
-from amontons.contact.inputs import check_threads
+from amontons.contact.options import check_threads
 from amontons.contact.surfaces import sphere
 
 CALLER = 2  # the caller's own limit, different from the solve's

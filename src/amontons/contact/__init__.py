@@ -83,17 +83,15 @@ Exceptions
 """
 
 from .api import solve, solve_load_series, solve_scan
-from .plasticity import ContactHardening, PenetrationHardness
-from .result import (
-    CoarseLevel,
+from .errors import (
     ContactError,
     ContactInputError,
-    ContactResult,
     ConvergenceError,
     FreeBoundaryError,
     IgnoredOptionWarning,
-    SolveInfo,
 )
+from .laws import ContactHardening, PenetrationHardness
+from .result import CoarseLevel, ContactResult, SolveInfo
 from .surfaces import self_affine, sphere
 
 __all__ = [

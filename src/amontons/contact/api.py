@@ -12,8 +12,8 @@ from threadpoolctl import threadpool_limits
 
 from .cg import polonsky_keer
 from .convolution import get_operator
-from .fft import DEFAULT_PLANNER_EFFORT
-from .inputs import (
+from .options import (
+    DEFAULT_PLANNER_EFFORT,
     SolveOptions,
     check_control,
     check_heights,
@@ -513,7 +513,7 @@ def _solve_elastic(h, spacing, e_star, opts, *, load, displacement, warm_start, 
     info = _solve_info(
         opts,
         convolutions=out.convolutions,
-        resets=out.info["steepest_descent_resets"],
+        resets=out.resets,
         outer_iterations=0,
         coarse_levels=levels,
         t0=t0,
@@ -523,9 +523,9 @@ def _solve_elastic(h, spacing, e_star, opts, *, load, displacement, warm_start, 
         spacing,
         opts,
         out,
-        elastic=out.displacement_field,
+        elastic=out.elastic_displacement,
         plastic=np.zeros_like(out.pressure),
-        displacement=out.rigid_displacement,
+        displacement=out.displacement,
         info=info,
         what="solver",
     )

@@ -60,7 +60,6 @@ positive-definite linear callable ``op(x, out=...)``, with an optional Winkler c
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
@@ -73,7 +72,8 @@ from .bounded_load import (
     fully_bound_approach,
     impose_bounded_load,
 )
-from .result import CONVERGED, ITERATION_CAP, STALLED, ConvergenceError
+from .errors import CONVERGED, ITERATION_CAP, STALLED, ConvergenceError
+from .result import Outcome
 from .stall import StallMonitor
 
 
@@ -184,32 +184,6 @@ SPARSE_MAX_PADDED = 32
 RECENTRE = 1e3
 
 
-@dataclass
-class CGOutcome:
-    """Raw output of :func:`polonsky_keer` (fields in SI units).
-
-    ``status``: 0 converged, 1 ``max_iter`` reached, 2 stalled; ``message`` says which,
-    with the iterations and the residual.
-    """
-
-    pressure: np.ndarray
-    displacement_field: np.ndarray
-    gap: np.ndarray
-    rigid_displacement: float
-    iterations: int
-    residual: float
-    history: np.ndarray
-    status: int
-    message: str
-    convolutions: float
-    info: dict = field(default_factory=dict)
-
-    @property
-    def converged(self) -> bool:
-        """True when ``status == 0``."""
-        return self.status == CONVERGED
-
-
 def polonsky_keer(
     operator,
     heights,
@@ -226,7 +200,7 @@ def polonsky_keer(
     raise_on_failure=True,
     threads=None,
     bounded_load_sweep=True,
-) -> CGOutcome:
+) -> Outcome:
     """Solve the contact problem by constrained conjugate gradients.
 
     Parameters
@@ -729,10 +703,10 @@ def finish_outcome(
     shape,
     extra=None,
 ):
-    """The CGOutcome of a finished loop (``p`` Pa and ``u = K*p`` m, flat and fresh);
-    raises ConvergenceError on failure when ``raise_on_failure``. ``p`` and ``u`` are the
-    loop's own arrays, allocated for this solve: the outcome holds them without a copy (at
-    2048² two copies and a temporary cost ~0.2 s of fresh pages per solve)."""
+    """The :class:`~.result.Outcome` of a finished loop (``p`` Pa and ``u = K*p`` m, flat
+    and fresh); raises ConvergenceError on failure when ``raise_on_failure``. ``p`` and
+    ``u`` are the loop's own arrays, allocated for this solve: the outcome holds them
+    without a copy."""
     gap = np.subtract(u, h)
     if load_control and p.sum() > 0:
         m = np.empty(p.size)
@@ -751,18 +725,20 @@ def finish_outcome(
             residual_history=hist,
             status=status,
         )
-    return CGOutcome(
+    return Outcome(
         pressure=p.reshape(shape),
-        displacement_field=u.reshape(shape),
         gap=gap.reshape(shape),
-        rigid_displacement=float(d),
+        elastic_displacement=u.reshape(shape),
+        plastic_displacement=None,
+        displacement=float(d),
         iterations=it,
         residual=float(residual),
         history=hist,
+        convolutions=calls,
         status=status,
         message=message,
-        convolutions=calls,
-        info={"steepest_descent_resets": resets, **(extra or {})},
+        resets=resets,
+        info=dict(extra or {}),
     )
 
 

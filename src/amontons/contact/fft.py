@@ -21,80 +21,24 @@ ones here (benchmarks/README.md, "FFTW planner effort"). ``FFTW_PATIENT`` and
 from __future__ import annotations
 
 import contextlib
-import os
 
-# pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
-# kernels (.kernels). libgomp's default lets idle workers spin after each parallel region;
-# on a 2-core machine those spinning threads take the cores from the next region's: a 1024²
-# FFT pair on 2 threads took 48-780 ms instead of 11 ms (benchmarks/README.md, "A second
-# core"). PASSIVE makes idle workers sleep. libgomp reads it when it is loaded, so it is
-# set before pyfftw is imported; a value the user has set is kept.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+import numpy as np
 
-import numpy as np  # noqa: E402
+from .options import (  # noqa: F401 - re-exported: the backend's names, where users look
+    BACKENDS,
+    DEFAULT_PLANNER_EFFORT,
+    HAVE_PYFFTW,
+    PLANNER_EFFORTS,
+    check_planner_effort,
+    resolve_backend,
+    resolve_planner_effort,
+)
+from .wisdom import shared_wisdom
 
-from .result import ContactInputError  # noqa: E402
-from .wisdom import shared_wisdom  # noqa: E402
-
-try:  # pyfftw is optional: numpy.fft is the fallback
+if HAVE_PYFFTW:
     import pyfftw
-
-    HAVE_PYFFTW = True
-except ImportError:  # pragma: no cover - depends on the environment
+else:  # pragma: no cover - depends on the environment
     pyfftw = None
-    HAVE_PYFFTW = False
-
-BACKENDS = ("pyfftw", "numpy")
-
-# FFTW planner flags, cheapest first.
-PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
-# The planner effort of a solve when none is given, on any number of threads: measured plans
-# (kept on disk, so reproducible) were 1.1-1.7x faster than FFTW_ESTIMATE's on one thread
-# and, unlike ESTIMATE's, use a second thread (1024² pair: 8.50 ms on 1 thread, 8.35 ms on
-# 2 with ESTIMATE, 5.38 ms on 2 with MEASURE; benchmarks/README.md, "A second core").
-DEFAULT_PLANNER_EFFORT = "FFTW_MEASURE"
-
-
-def resolve_backend(backend: str | None) -> str:
-    """Return the backend name to use: ``"pyfftw"`` if available, else ``"numpy"``.
-
-    Raises
-    ------
-    ContactInputError
-        (a ValueError) For an unknown name, or ``"pyfftw"`` requested but not importable.
-    """
-    if backend is None:
-        return "pyfftw" if HAVE_PYFFTW else "numpy"
-    if backend not in BACKENDS:
-        raise ContactInputError(
-            f"unknown FFT backend {backend!r}; expected one of {BACKENDS} or None"
-        )
-    if backend == "pyfftw" and not HAVE_PYFFTW:
-        raise ContactInputError("FFT backend 'pyfftw' requested but pyfftw is not importable")
-    return backend
-
-
-def check_planner_effort(planner_effort: str) -> str:
-    """Return ``planner_effort`` if it is one of :data:`PLANNER_EFFORTS`.
-
-    Raises
-    ------
-    ContactInputError
-        (a ValueError) Naming the allowed values.
-    """
-    if not isinstance(planner_effort, str) or planner_effort not in PLANNER_EFFORTS:
-        raise ContactInputError(
-            f"planner_effort must be one of {PLANNER_EFFORTS}, got {planner_effort!r}"
-        )
-    return planner_effort
-
-
-def resolve_planner_effort(planner_effort: str | None) -> str:
-    """The planner effort of a solve: ``planner_effort`` if given (checked), else
-    :data:`DEFAULT_PLANNER_EFFORT` (numpy.fft does not plan; its operators ignore it)."""
-    if planner_effort is not None:
-        return check_planner_effort(planner_effort)
-    return DEFAULT_PLANNER_EFFORT
 
 
 def empty(shape, dtype, backend: str) -> np.ndarray:

@@ -15,7 +15,7 @@ import os
 
 from . import jit, kernels
 from .api import solve
-from .plasticity import ContactHardening, PenetrationHardness
+from .laws import ContactHardening, PenetrationHardness
 from .surfaces import sphere
 
 is_cold = jit.is_cold

@@ -26,7 +26,7 @@ default there. The appendix's iterative scheme (bounded CG, gap, increment, repe
 heights of points that did not yield) and on request (``method="appendix"``, the test
 oracle of both exact routes).
 
-Failures do not raise here: every route returns a :class:`PlasticState` whose ``status``
+Failures do not raise here: every route returns a :class:`~.result.Outcome` whose ``status``
 (0 converged, 1 iteration cap, 2 stalled) and ``message`` say how it stopped, holding the
 last iterate; :func:`amontons.contact.solve` decides whether to raise.
 
@@ -41,96 +41,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import Literal
 
 import numpy as np
 from scipy import optimize
 
 from .cg import BoundedWall, polonsky_keer
+from .errors import ITERATION_CAP, STALLED, ContactInputError, FreeBoundaryError
+from .laws import ContactHardening, Increment, PenetrationHardness
+from .options import MAX_ACTIVE_SET_ROUNDS, default_max_outer
 from .plastic_increments import local_increment, volume_conserving_increment
-from .result import CONVERGED, ITERATION_CAP, STALLED, ContactInputError, FreeBoundaryError
-
-Increment = Literal["local", "volume"]
-METHODS = ("winkler", "bounded", "appendix")
-
-# Default caps on the outer loop (max_outer=None): plastic updates per approach of the
-# appendix scheme, and active-set rounds of the Winkler route.
-MAX_PLASTIC_UPDATES = 200
-MAX_ACTIVE_SET_ROUNDS = 50
-
-
-def _check_increment(increment: str, alpha: float) -> None:
-    if increment not in ("local", "volume"):
-        raise ContactInputError(
-            f"increment must be 'local' (eq. B.2) or 'volume' (eq. B.3), got {increment!r}"
-        )
-    if not 0 < alpha <= 1:
-        raise ContactInputError(f"over-relaxation alpha must be in (0, 1], got {alpha!r}")
-    if increment == "volume" and alpha == 1:
-        raise ContactInputError(
-            "volume-conserving increments (eq. B.3) need over-relaxation alpha < 1; got 1"
-        )
-
-
-@dataclass(frozen=True)
-class PenetrationHardness:
-    """Pressure bounded by the penetration hardness ``p_y`` (Pa; scalar or per-pixel array)."""
-
-    p_y: float | np.ndarray
-    increment: Increment = "local"
-    alpha: float = 1.0
-
-    def __post_init__(self):
-        p_y = np.asarray(self.p_y, dtype=float)
-        if not np.all(np.isfinite(p_y)) or np.any(p_y <= 0):
-            raise ContactInputError(f"p_y must be finite and > 0 (Pa), got min {p_y.min():.3e}")
-        _check_increment(self.increment, self.alpha)
-
-
-@dataclass(frozen=True)
-class ContactHardening:
-    """Local hardening p_Y = k·|h_pl| with hardening coefficient ``k`` in Pa/m.
-
-    (The appendix's k ≈ 7 MPa/nm for PMMA is 7e15 Pa/m.)
-    """
-
-    k: float
-    increment: Increment = "local"
-    alpha: float = 1.0
-
-    def __post_init__(self):
-        if not (np.isfinite(self.k) and self.k > 0):
-            raise ContactInputError(f"k must be finite and > 0 (Pa/m), got {self.k!r}")
-        _check_increment(self.increment, self.alpha)
-
-
-@dataclass
-class PlasticState:
-    """State of one load step (arrays on the solver grid; SI units).
-
-    ``status`` 0 (converged), 1 (iteration cap) or 2 (stalled), with ``message`` saying why;
-    a failed state holds the last iterate. ``iterations``, ``convolutions`` and ``resets``
-    (steepest-descent restarts) are summed over the conjugate-gradient solves of the step.
-    """
-
-    pressure: np.ndarray
-    gap: np.ndarray
-    elastic_displacement: np.ndarray
-    plastic_displacement: np.ndarray
-    displacement: float
-    iterations: int
-    residual: float
-    history: np.ndarray
-    convolutions: float
-    outer_iterations: int
-    resets: int = 0
-    status: int = CONVERGED
-    message: str = ""
-
-    @property
-    def converged(self) -> bool:
-        """True when ``status == 0``."""
-        return self.status == CONVERGED
+from .result import Outcome
 
 
 @dataclass
@@ -145,63 +65,8 @@ class _Tally:
     def add(self, out) -> None:
         self.iterations += out.iterations
         self.convolutions += out.convolutions
-        self.resets += out.info["steepest_descent_resets"]
+        self.resets += out.resets
         self.history.extend(out.history)
-
-
-def check_method(method) -> None:
-    """Raise ContactInputError unless ``method`` is None or one of :data:`METHODS`."""
-    if method is not None and (not isinstance(method, str) or method not in METHODS):
-        raise ContactInputError(
-            f"method must be one of {METHODS} (or None: the law's default), got {method!r}"
-        )
-
-
-def resolve_route(law, method) -> str:
-    """The route of a plastic solve, ``"winkler"``, ``"bounded"`` or ``"appendix"``.
-
-    ``method=None`` picks the law's default: ``"winkler"`` for contact hardening with local
-    increments (exact), ``"bounded"`` for penetration hardness with local increments (one
-    bounded CG, exact), ``"appendix"`` otherwise (the only route there).
-
-    Raises
-    ------
-    ContactInputError
-        An unknown method; ``"winkler"`` or ``"bounded"`` for a law it cannot solve;
-        ``"appendix"`` for contact hardening with ``alpha = 1``.
-    """
-    check_method(method)
-    winkler_ok = isinstance(law, ContactHardening) and law.increment == "local"
-    bounded_ok = isinstance(law, PenetrationHardness) and law.increment == "local"
-    if method is None:
-        method = "winkler" if winkler_ok else "bounded" if bounded_ok else "appendix"
-    if method == "winkler" and not winkler_ok:
-        raise ContactInputError(
-            "method='winkler' (the exact elastic-plus-Winkler route) only solves "
-            f"ContactHardening with local increments, not {law!r}; use method='appendix' or "
-            "None"
-        )
-    if method == "bounded" and not bounded_ok:
-        raise ContactInputError(
-            "method='bounded' (one bounded CG under the force constraint) only solves "
-            f"PenetrationHardness with local increments, not {law!r}; use "
-            "method='appendix' or None"
-        )
-    if method == "appendix" and isinstance(law, ContactHardening) and law.alpha == 1:
-        # with p_Y = k|h_pl| and α = 1 the first update closes every gap at zero pressure,
-        # a fixed point of the scheme that is not the hardening state
-        raise ContactInputError(
-            "the iterative contact-hardening scheme needs over-relaxation alpha < 1; got 1"
-        )
-    return method
-
-
-def default_max_outer(route: str) -> int | None:
-    """Cap on the outer loop of a route when ``max_outer`` is None (None: the route has no
-    outer loop)."""
-    if route == "bounded":
-        return None
-    return MAX_ACTIVE_SET_ROUNDS if route == "winkler" else MAX_PLASTIC_UPDATES
 
 
 def _increment(gap, increment: Increment, periodic: bool):
@@ -287,10 +152,10 @@ def _plastic_iteration(
 def _appendix_state(out, h_pl, displacement, tally, outer):
     """The state of the appendix scheme after a bounded solve ``out`` on h + ``h_pl``,
     with the status and message of that solve."""
-    return PlasticState(
+    return Outcome(
         pressure=out.pressure,
         gap=out.gap,
-        elastic_displacement=out.displacement_field,
+        elastic_displacement=out.elastic_displacement,
         plastic_displacement=h_pl,
         displacement=displacement,
         iterations=tally.iterations,
@@ -479,14 +344,14 @@ def _winkler_state(out, heights, k, floor, flowing, compliance, tally, rounds):
     p = out.pressure
     depth = np.where(flowing & (p > 0), np.maximum(p / k, floor), floor)
     plastic = -depth
-    elastic = out.displacement_field - compliance * p
-    gap = elastic - (heights + plastic) - out.rigid_displacement
-    return PlasticState(
+    elastic = out.elastic_displacement - compliance * p
+    gap = elastic - (heights + plastic) - out.displacement
+    return Outcome(
         pressure=p,
         gap=gap,
         elastic_displacement=elastic,
         plastic_displacement=plastic,
-        displacement=out.rigid_displacement,
+        displacement=out.displacement,
         iterations=tally.iterations,
         residual=out.residual,
         history=np.asarray(tally.history),
@@ -523,7 +388,7 @@ def solve_plastic(
     caps the active-set rounds or the plastic updates per approach (None:
     :func:`default_max_outer`; unused by ``"bounded"``); ``bounded_load_sweep`` picks the
     kernel set of the ``"bounded"`` route's load control (:func:`.cg.polonsky_keer`).
-    Returns a :class:`PlasticState`, converged or not.
+    Returns a :class:`~.result.Outcome`, converged or not.
     """
     pixel_area = spacing**2
     h_scale = float(np.std(heights)) or spacing
@@ -655,7 +520,7 @@ def solve_plastic(
         p_mean = float(np.mean(bound(plastic_prev)))
         target_pixels = min(heights.size, max(1, int(load / (pixel_area * p_mean))))
         d_bearing = -float(np.sort((heights + plastic_prev).ravel())[::-1][target_pixels - 1])
-        d_guess = max(elastic.rigid_displacement, d_bearing)
+        d_guess = max(elastic.displacement, d_bearing)
     # a fully plastic contact's load is a near-staircase in d: one pixel's worth is allowed
     pixel_worth = float(np.max(bound(plastic_prev))) * pixel_area
     return _find_approach(evaluate, load, d_guess, 1e-3 * span, load_tol=tol, load_atol=pixel_worth)
@@ -710,18 +575,18 @@ def _hardness_bounded(
             f"bounded solve under the force constraint: {message}; "
             f"{int(np.count_nonzero(flow))} pixel(s) flowed"
         )
-    return PlasticState(
+    return Outcome(
         pressure=out.pressure,
         gap=out.gap - flow,
-        elastic_displacement=out.displacement_field,
+        elastic_displacement=out.elastic_displacement,
         plastic_displacement=plastic,
-        displacement=out.rigid_displacement,
+        displacement=out.displacement,
         iterations=out.iterations,
         residual=out.residual,
         history=out.history,
         convolutions=out.convolutions,
         outer_iterations=1,
-        resets=out.info["steepest_descent_resets"],
+        resets=out.resets,
         status=out.status,
         message=message,
     )
@@ -733,18 +598,18 @@ def _elastic_state(out, plastic_prev):
     message = out.message
     if out.converged:
         message = f"the hardness is never reached, the elastic solution holds: {message}"
-    return PlasticState(
+    return Outcome(
         pressure=out.pressure,
         gap=out.gap,
-        elastic_displacement=out.displacement_field,
+        elastic_displacement=out.elastic_displacement,
         plastic_displacement=plastic_prev.copy(),
-        displacement=out.rigid_displacement,
+        displacement=out.displacement,
         iterations=out.iterations,
         residual=out.residual,
         history=out.history,
         convolutions=out.convolutions,
         outer_iterations=0,
-        resets=out.info["steepest_descent_resets"],
+        resets=out.resets,
         status=out.status,
         message=message,
     )
