@@ -21,7 +21,7 @@ from amontons.contact import kernels as K
 from amontons.contact import self_affine, sphere
 from amontons.contact.cg import BoundedWall, polonsky_keer
 from amontons.contact.convolution import get_operator
-from amontons.contact.plasticity import _WinklerOperator
+from amontons.contact.winkler import WinklerOperator
 
 
 def _load_oracle():
@@ -108,7 +108,7 @@ def test_winkler_term_matches_numpy(rough):
     step_dots and in the point responses instead of through the wrapper."""
     h, load = rough
     op = get_operator(h.shape, 1.0, 1.0, periodic=True)
-    winkler = _WinklerOperator(op, np.full(h.shape, 1.0 / 0.05))
+    winkler = WinklerOperator(op, np.full(h.shape, 1.0 / 0.05))
     ref, new = _pair(winkler, h, p_init=np.ones_like(h), load=load)
     _assert_same_fixed_point(ref, new, h)
 
@@ -131,7 +131,7 @@ def test_kernels_give_the_same_bits_on_one_and_two_threads(case):
     else:
         kw.update(load=0.005 * n * n)
     if case == "winkler":
-        op = _WinklerOperator(op, np.full(h.shape, 1.0 / 0.05))
+        op = WinklerOperator(op, np.full(h.shape, 1.0 / 0.05))
     one = polonsky_keer(op, h, threads=1, **kw)
     two = polonsky_keer(op, h, threads=2, **kw)
     assert np.array_equal(one.pressure, two.pressure)

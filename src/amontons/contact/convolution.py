@@ -40,7 +40,7 @@ import numpy as np
 
 from . import fft as _fft
 from . import spectrum as _spectrum
-from .greens import hockney_multiplier, periodic_multiplier
+from .greens import hockney_multiplier, love_square, periodic_multiplier
 
 
 def _scaled(mult, scale):
@@ -442,6 +442,20 @@ def get_operator(
     )
 
 
+def operator_for(opts, shape, spacing, e_star):
+    """The cached operator of a grid of ``shape`` (spacing m, E* Pa) under a solve's
+    :class:`~.options.SolveOptions` (boundary, backend, threads, planner effort)."""
+    return get_operator(
+        shape,
+        spacing,
+        e_star,
+        periodic=opts.periodic,
+        backend=opts.backend,
+        threads=opts.threads,
+        planner_effort=opts.planner_effort,
+    )
+
+
 def direct_convolution(p: np.ndarray, spacing: float, e_star: float, *, periodic: bool):
     """Brute-force O(N⁴) convolution, for testing on tiny grids only.
 
@@ -464,8 +478,6 @@ def direct_convolution(p: np.ndarray, spacing: float, e_star: float, *, periodic
         uh = ph * mult
         u = (e0.conj().T @ uh @ e1.conj()).real / (n0 * n1)
         return u
-    from .greens import love_square
-
     half = spacing / 2
     for i in range(n0):
         for j in range(n1):

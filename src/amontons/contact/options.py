@@ -175,6 +175,20 @@ class SolveOptions:
     bounded_load_sweep: bool = True
 
 
+@dataclass(frozen=True)
+class LoadStep:
+    """What one solve is asked, beside the options: exactly one of ``load`` (N) and
+    ``displacement`` (m), a starting pressure ``warm_start`` (Pa) or None, the plastic
+    displacement left by earlier loading ``plastic_prev`` (m; None for elastic solves), and
+    whether an elastic solve starts coarse-to-fine. Validated by :func:`.api.solve`."""
+
+    load: float | None
+    displacement: float | None
+    warm_start: np.ndarray | None = None
+    plastic_prev: np.ndarray | None = None
+    coarse_to_fine: bool = False
+
+
 def solve_options(
     shape,
     *,

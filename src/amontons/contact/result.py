@@ -38,6 +38,7 @@ __all__ = [
     "IgnoredOptionWarning",
     "Outcome",
     "SolveInfo",
+    "Tally",
 ]
 
 
@@ -50,7 +51,8 @@ class Outcome:
     ``displacement`` is the rigid-body approach (m). ``iterations``, ``convolutions`` and
     ``resets`` (steepest-descent restarts) are summed over the CG solves behind it,
     ``outer_iterations`` counts plastic updates or active-set rounds (0: none), ``history``
-    holds the residual after every CG iteration (dimensionless). ``status`` is 0 (converged),
+    holds the residual after every CG iteration (dimensionless), ``coarse_levels`` the
+    :class:`CoarseLevel` solves of a coarse-to-fine start. ``status`` is 0 (converged),
     1 (iteration cap) or 2 (stalled), with ``message`` saying why; ``info`` holds a CG
     solve's counters for benchmarks (how ``u`` followed each step, forward-only transforms).
     """
@@ -68,12 +70,31 @@ class Outcome:
     message: str = ""
     outer_iterations: int = 0
     resets: int = 0
+    coarse_levels: tuple = ()
     info: dict = field(default_factory=dict)
 
     @property
     def converged(self) -> bool:
         """True when ``status == 0``."""
         return self.status == CONVERGED
+
+
+@dataclass
+class Tally:
+    """Work summed over the conjugate-gradient solves of one step (iterations, convolutions,
+    steepest-descent restarts and the residual history of each :class:`Outcome` added)."""
+
+    iterations: int = 0
+    convolutions: float = 0.0
+    resets: int = 0
+    history: list = field(default_factory=list)
+
+    def add(self, out: Outcome) -> None:
+        """Add the work of one CG solve."""
+        self.iterations += out.iterations
+        self.convolutions += out.convolutions
+        self.resets += out.resets
+        self.history.extend(out.history)
 
 
 @dataclass(frozen=True)
