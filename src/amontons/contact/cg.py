@@ -171,13 +171,9 @@ _EMPTY = np.empty(0, dtype=np.intp)
 # one iteration exceed this fraction of it (module docstring; 0 = the original PK rule).
 RESET_FRACTION = 0.01
 # Most changed points (clipped + added) applied to u as point responses instead of a full
-# convolution. One point costs a sweep of the real-space kernel (kernels.add_point_responses:
-# 0.3-0.7 ms at 1024² periodic, 0.5-1.0 ms non-periodic, 1.5-2.6 ms at 2048² periodic, the
-# less the more points share the sweep). Following the step also takes the inverse transform
-# of K*t, which a full update skips, so the break-even is the points whose responses cost
-# a convolution less its inverse: ~12 at 1024² and ~17 at 2048² periodic, ~38 at 1024²
-# non-periodic (benchmarks/bench_point_responses.py; benchmarks/README.md, "Fewer
-# convolutions", which says why the limits were not raised).
+# convolution, periodic and padded: about where the points' responses cost a convolution
+# less its inverse (benchmarks/bench_point_responses.py; benchmarks/README.md, "Fewer
+# convolutions").
 SPARSE_MAX_PERIODIC = 12
 SPARSE_MAX_PADDED = 32
 # Largest Σa²/G of the one-pass moments about the previous approach (see _centred_moments).
