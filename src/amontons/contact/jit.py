@@ -37,8 +37,9 @@ CHILD_ENV = "AMONTONS_KERNEL_WARMUP"
 # what the child runs: the warm-up at the top of the package (`python -m` would import the
 # module twice)
 COMMAND = "from amontons.contact.kernel_cache import main; main()"
-# dispatcher sets already checked in this process (the check costs a disk read)
-_checked: set[tuple[str, ...]] = set()
+# ids of the dispatcher tuples already checked in this process (the check costs a disk
+# read; the tuples are module constants, so their ids stand for them)
+_checked: set[int] = set()
 
 
 @contextlib.contextmanager
@@ -56,13 +57,12 @@ def kernel_threads(threads: int, entry_points):
 
 
 def ensure_cached(dispatchers) -> None:
-    """Once per process and set of ``dispatchers``: if the cache holds no compiled code for
-    one of them, compile every kernel in a child process (:data:`COMMAND`) so that this
-    process loads them from the cache."""
-    key = tuple(d.__name__ for d in dispatchers)
-    if key in _checked:
+    """Once per process and tuple of ``dispatchers`` (a module constant): if the cache
+    holds no compiled code for one of them, compile every kernel in a child process
+    (:data:`COMMAND`) so that this process loads them from the cache."""
+    if id(dispatchers) in _checked:
         return
-    _checked.add(key)
+    _checked.add(id(dispatchers))
     if os.environ.get(CHILD_ENV) or not is_cold(dispatchers):
         return
     compile_in_child()
@@ -70,7 +70,7 @@ def ensure_cached(dispatchers) -> None:
 
 def mark_checked(dispatchers) -> None:
     """Take ``dispatchers`` as checked: this process compiles them itself (the warm-up)."""
-    _checked.add(tuple(d.__name__ for d in dispatchers))
+    _checked.add(id(dispatchers))
 
 
 def is_cold(dispatchers) -> bool:
