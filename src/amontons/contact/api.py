@@ -128,9 +128,9 @@ def solve(
         machine and kept on disk as FFTW wisdom (:mod:`amontons.contact.wisdom`, file
         ``$AMONTONS_FFTW_WISDOM`` or ``~/.cache/amontons``), which every later process
         imports, so the same plan and the same result bytes in every run on the machine.
-        Its plans use ``threads`` (ESTIMATE's do not) and were 1.1-1.7× faster than
-        ``"FFTW_ESTIMATE"``'s on one thread (benchmarks/README.md); ESTIMATE plans by
-        heuristics, without timing or disk. A plan for another thread count differs in
+        Its plans use ``threads`` (ESTIMATE's do not) and are faster than
+        ``"FFTW_ESTIMATE"``'s (benchmarks/README.md); ESTIMATE plans by heuristics, without
+        timing or disk. A plan for another thread count differs in
         round-off only (the answer agrees with the one-thread one to 1e-10). Operators are
         cached per effort. An effort given with the numpy backend is ignored, with a warning.
     raise_on_failure : bool
@@ -195,10 +195,9 @@ def solve(
         warm_start=warm_start is not None,
     )
     # Every native pool (OpenBLAS, OpenMP) runs one thread for the call and is restored after
-    # it, also on an exception. The CG's BLAS calls are level 1 (dot, axpy) on one field:
-    # unbounded, their threads spin against the solver's own (a plain process lost 1.7-3.5x,
-    # issue 21), and even bounded to 2 they made threads=2 11x slower at 512²
-    # (benchmarks/bench_thread_pools.py); ``threads`` goes to FFTW.
+    # it, also on an exception: BLAS threads would spin against the solver's own
+    # (benchmarks/README.md, "Speed as a user gets it"); ``threads`` goes to FFTW and the
+    # kernels.
     with threadpool_limits(limits=1):
         return _solve_step(
             h,

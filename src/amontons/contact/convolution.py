@@ -59,11 +59,9 @@ def fast_padded_shape(shape) -> tuple[int, int]:
 
 class _MultiplierMixin:
     def _multiply(self) -> None:
-        """``spec *= multiplier`` on the operator's threads, by the numba kernel: numpy's
-        complex-by-real product casts the multiplier to complex through a buffer and runs
-        at 2.3x the kernel's time on one thread (1.1 against 0.5 ms at 1024², 4.1 against
-        1.8 ms at 2048²; benchmarks/README.md, benchmark 1), the same bits (the imaginary
-        part of the cast is an exact zero)."""
+        """``spec *= multiplier`` on the operator's threads, by the numba kernel of
+        :mod:`.spectrum` (the same bits as numpy's complex-by-real product, which is slower:
+        benchmarks/README.md, benchmark 1)."""
         with _spectrum.spectrum_threads(self.threads):
             _spectrum.multiply_spectrum(self._spec, self._mult_scaled)
 

@@ -12,10 +12,8 @@ choice is written to FFTW wisdom on disk (:mod:`amontons.contact.wisdom`), which
 later process on the machine imports, so the plan, the round-off and the output bytes are
 the same from run to run, and planning is paid once per transform and machine (0.3 s for
 a 1024² pair). ``FFTW_ESTIMATE`` picks plans by heuristics without timing anything or
-touching the disk; at one thread its pairs took 1.1-1.4× (1024²) and 1.6-1.7× (2048²) the measured
-ones here (benchmarks/README.md, "FFTW planner effort"). ``FFTW_PATIENT`` and
-``FFTW_EXHAUSTIVE`` time more candidates (20 s and 150 s of planning for a 1024² and a
-2048² pair).
+touching the disk; its pairs are slower (benchmarks/README.md, "FFTW planner effort").
+``FFTW_PATIENT`` and ``FFTW_EXHAUSTIVE`` time more candidates (minutes of planning at 2048²).
 """
 
 from __future__ import annotations
@@ -139,21 +137,10 @@ class RealFFT2Pair:
             self.real[...] = np.fft.irfft2(self.spec, s=self.shape)
 
 
-# FFT lengths of the Hockney-padded operator (contact.convolution). FFTW has hard-coded
-# codelets for small factors and uses slower general-purpose algorithms for a large prime
-# factor; its manual (fftw.org/fftw3_doc, "Complex One-Dimensional DFTs") says it is best
-# at sizes 2^a 3^b 5^c 7^d 11^e 13^f with e + f = 0 or 1. Even sizes, because convolutions
-# on odd sizes were 20-40 % slower here (below). Time of one pruned padded convolution,
-# NonPeriodicConvolution(padded_shape=(m, m)), one thread, FFTW_ESTIMATE, 2026-11-23
-# (benchmarks/README.md, "Fast FFT lengths", "Choice of the rule"):
-#   n = 428:  34 ms on 856 = 2³·107,  7.0 ms on 864 = 2⁵·3³,  9.7 ms on 875 = 5³·7 (odd);
-#   n = 461:  29 ms on 922 = 2·461,   8.3 ms on 924 = 2²·3·7·11,  7.6 ms on 936 = 2³·3²·13,
-#             10.7 ms on 945 = 3³·5·7 (odd);
-#   n = 308:  2.9 ms on 616 = 2³·7·11, 3.7 ms on 625 = 5⁴ (odd);
-#   n = 1844: 500 ms on 3688 = 2³·461, 209 ms on 3696 = 2⁴·3·7·11, 237 ms on 3750 = 2·3·5⁴.
-# A 5-smooth length (scipy.fft.next_fast_len) pads further; it was no faster under the
-# solver's default FFTW_ESTIMATE (n = 461: 8.0 ms on 960 = 2⁶·3·5 against 8.3 ms on 924) and
-# faster under FFTW_MEASURE (5.2 against 7.3 ms); both are far from the 2n cost (23-29 ms).
+# FFT lengths of the Hockney-padded operator (contact.convolution): FFTW has hard-coded
+# codelets for small factors and is best at sizes 2^a 3^b 5^c 7^d 11^e 13^f with e + f = 0
+# or 1 (its manual, "Complex One-Dimensional DFTs"); even sizes only (odd ones were slower).
+# Measurements and the choice of the rule: benchmarks/README.md, "Fast FFT lengths".
 FAST_PRIMES = (2, 3, 5, 7)
 FAST_EXTRA = (1, 11, 13)  # at most one factor 11 or 13
 

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 # pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
 # kernels (.kernels). libgomp's default lets idle workers spin after each parallel region;
-# on a 2-core machine those spinning threads take the cores from the next region's: a 1024²
-# FFT pair on 2 threads took 48-780 ms instead of 11 ms (benchmarks/README.md, "A second
-# core"). PASSIVE makes idle workers sleep. libgomp reads it when it is loaded, so it is
-# set before pyfftw is imported; a value the user has set is kept.
+# on a 2-core machine those spinning threads take the cores from the next region's
+# (benchmarks/README.md, "A second core"). PASSIVE makes idle workers sleep. libgomp reads
+# it when it is loaded, so it is set before pyfftw is imported; a value the user has set is
+# kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numpy as np  # noqa: E402
@@ -39,9 +39,8 @@ BACKENDS = ("pyfftw", "numpy")
 # FFTW planner flags, cheapest first.
 PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
 # The planner effort of a solve when none is given, on any number of threads: measured plans
-# (kept on disk, so reproducible) were 1.1-1.7x faster than FFTW_ESTIMATE's on one thread
-# and, unlike ESTIMATE's, use a second thread (1024² pair: 8.50 ms on 1 thread, 8.35 ms on
-# 2 with ESTIMATE, 5.38 ms on 2 with MEASURE; benchmarks/README.md, "A second core").
+# (kept on disk, so reproducible) are faster than FFTW_ESTIMATE's and, unlike them, use a
+# second thread (benchmarks/README.md, "FFTW planner effort", "A second core").
 DEFAULT_PLANNER_EFFORT = "FFTW_MEASURE"
 
 
