@@ -6,22 +6,28 @@ when a change of the numbers is intended, and say so in the commit):
 
     python tests/contact/golden/record.py
 
-Every solve plans its transforms with the solver's default, FFTW_MEASURE, whose plans are
-kept on disk as FFTW wisdom (amontons.contact.wisdom) and imported by every process, so the
-bytes are the same in every process on this machine whatever ran before. (FFTW_ESTIMATE is
-not: FFTW uses imported wisdom for an ESTIMATE plan too, so an ESTIMATE solve gives other
-bytes once a MEASURE solve has imported the wisdom.) One thread. A fresh machine or a
-deleted wisdom file may measure other plans: re-record there.
+Every solve plans its transforms with FFTW_ESTIMATE in a process that imports no FFTW wisdom
+(``AMONTONS_FFTW_WISDOM`` empty, set below before the solver is imported): an ESTIMATE plan
+is chosen by rule, not by timing, so the bytes are the same on every machine of the same kind
+and do not depend on a wisdom file left by earlier runs. (With wisdom, FFTW uses it for an
+ESTIMATE plan too; with FFTW_MEASURE, fresh processes may time their way to other plans.)
+One thread. The script therefore always runs in a process of its own: the test starts it
+with ``--out`` and compares what it writes with the record.
 """
 
 from __future__ import annotations
 
+import argparse
+import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from amontons.contact import (
+# No wisdom in this process: the plans are FFTW_ESTIMATE's alone (see above).
+os.environ["AMONTONS_FFTW_WISDOM"] = ""
+
+from amontons.contact import (  # noqa: E402 (after the wisdom setting)
     ContactHardening,
     PenetrationHardness,
     self_affine,
@@ -32,7 +38,7 @@ from amontons.contact import (
 )
 
 PATH = Path(__file__).with_name("golden.npz")
-EFFORT = {"threads": 1}
+EFFORT = {"threads": 1, "planner_effort": "FFTW_ESTIMATE"}
 FIELDS = ("pressure", "gap", "plastic_displacement")
 SCALARS = ("displacement", "load", "area", "iterations", "residual")
 
@@ -179,11 +185,14 @@ def compute(names=None) -> dict[str, np.ndarray]:
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description="solve the golden cases and store them")
+    parser.add_argument("--out", type=Path, default=PATH, help="npz to write (the record)")
+    args = parser.parse_args(argv)
     data = compute()
-    np.savez_compressed(PATH, **data)
-    size = PATH.stat().st_size
-    print(f"{len(data)} arrays in {PATH} ({size / 1e6:.2f} MB)", file=sys.stderr)
+    np.savez_compressed(args.out, **data)
+    size = args.out.stat().st_size
+    print(f"{len(data)} arrays in {args.out} ({size / 1e6:.2f} MB)", file=sys.stderr)
 
 
 if __name__ == "__main__":
