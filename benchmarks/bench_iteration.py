@@ -18,10 +18,10 @@ three sweeps of a periodic iteration must move (SWEEP_BYTES per point) at the me
 bandwidth of a three-array ``np.add`` timed in the same process, in MEASURE pairs.
 Medians of --repeats.
 
-Paths: ``fused`` (numba kernels, the default of the solver) and ``numpy`` (the reference
-loop, ``kernels=False``). The solve runs inside ``threadpool_limits(1)`` as
-:func:`amontons.contact.solve` does, in a plain process (no thread environment variables,
-unless ``--pinned``).
+Paths: ``fused`` (numba kernels, the solver's one loop) and ``numpy`` (the reference loop
+the tests compare with, tests/contact/numpy_oracle.py). The solve runs inside
+``threadpool_limits(1)`` as :func:`amontons.contact.solve` does, in a plain process (no
+thread environment variables, unless ``--pinned``).
 
     python benchmarks/bench_iteration.py                    # 1024², 2048²
     python benchmarks/bench_iteration.py --sizes 512 1024 2048 --threads 1 2
@@ -30,9 +30,11 @@ unless ``--pinned``).
 
 from __future__ import annotations
 
+import importlib.util
 import statistics
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 from _common import (
@@ -50,6 +52,16 @@ from threadpoolctl import threadpool_limits
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
 from amontons.contact.fft import RealFFT2Pair, resolve_planner_effort
+
+_ORACLE = Path(__file__).resolve().parents[1] / "tests" / "contact" / "numpy_oracle.py"
+
+
+def numpy_polonsky_keer(*args, **kwargs):
+    """The numpy reference loop of the tests (loaded from its file on first use)."""
+    spec = importlib.util.spec_from_file_location("numpy_oracle", _ORACLE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.numpy_polonsky_keer(*args, **kwargs)
 
 
 class TimedOperator:
@@ -93,7 +105,9 @@ def solve_once(op, h, load, kernels, threads):
     timed = TimedOperator(op)
     t0 = time.perf_counter()
     with threadpool_limits(limits=1):
-        out = polonsky_keer(
+        loop = polonsky_keer if kernels else numpy_polonsky_keer
+        extra = {"threads": threads} if kernels else {}
+        out = loop(
             timed,
             h,
             pixel_area=1.0,
@@ -102,8 +116,7 @@ def solve_once(op, h, load, kernels, threads):
             load=load,
             tol=1e-8,
             max_iter=5000,
-            kernels=kernels,
-            threads=threads,
+            **extra,
         )
     return time.perf_counter() - t0, timed.seconds, out
 

@@ -10,8 +10,7 @@ if "snakemake" in globals():
 
 from amontons.accuracy.problems import cost_record, solve_problem, timing_problem
 from amontons.accuracy.settings import timing_points, timing_setting
-from amontons.contact import FreeBoundaryError
-from amontons.contact.plasticity import PenetrationHardness
+from amontons.contact import FreeBoundaryError, PenetrationHardness
 from amontons.io.files import write_json
 from amontons.runlog import run_logged
 from amontons.simulate.surface import load_levelled_map

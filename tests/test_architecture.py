@@ -179,9 +179,126 @@ def test_no_package_imports_a_package_that_imports_it():
 
 
 def test_no_module_outside_the_solver_closes_an_import_circle():
-    """Module by module, every import at any depth. The solver's own circle inside
-    amontons.contact is issue 38's rebuild, and is left out here until then."""
+    """Module by module, every import at any depth. Inside amontons.contact the floor tests
+    below check it, with a reader that tells ``from . import kernels`` (a module) from
+    ``from . import solve`` (the package's __init__)."""
     assert _cycle(_module_graph(exclude="amontons.contact")) == []
+
+
+# The floors of the contact solver, bottom up (docs/models.md §2, "Floors"): a module imports
+# only modules of its own floor or of floors below it, never above.
+CONTACT_FLOORS = (
+    # 1. laws, options, results: what a caller passes and gets
+    ("errors", "laws", "options", "result", "surfaces"),
+    # 2. operators: FFT plans and wisdom, Green's functions, convolutions
+    ("wisdom", "fft", "greens", "jit", "spectrum", "convolution"),
+    # 3. kernel sets: the element-wise work of one iteration
+    ("kernels", "bounded_load"),
+    # 4. the iteration: the one Polonsky-Keer control flow
+    ("stall", "cg"),
+    # 5. routes, chosen from one table
+    ("plastic_increments", "root_find", "elastic", "winkler", "bounded", "appendix", "routes"),
+    # 6. public calls (and the warm-up, which solves through them)
+    ("api", "greenwood_tripp", "kernel_cache", ""),
+)
+CONTACT = "amontons.contact"
+
+
+def _floor_of(module: str) -> int:
+    """The floor (1-6) of a module of amontons.contact ("" is the package's __init__)."""
+    short = module[len(CONTACT) + 1 :] if module != CONTACT else ""
+    return next(i for i, names in enumerate(CONTACT_FLOORS, 1) if short in names)
+
+
+def _contact_imports(path: Path) -> set[str]:
+    """The amontons.contact modules ``path`` imports: a name imported from a package is that
+    module if it is one, else the package (``from . import kernels`` is kernels,
+    ``from amontons.contact import solve`` is the package's __init__)."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    here = _module_name(path).split(".")
+    if path.name != "__init__.py":
+        here = here[:-1]
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = ".".join(here[: len(here) - node.level + 1] + ([base] if base else []))
+            for alias in node.names:
+                full = f"{base}.{alias.name}"
+                found.add(full if full in IMPORTS else base)
+    return {n for n in found if n == CONTACT or n.startswith(CONTACT + ".")}
+
+
+def _contact_graph() -> dict[str, set[str]]:
+    return {
+        module: _contact_imports(path) - {module}
+        for path in (PACKAGE / "contact").glob("*.py")
+        for module in [_module_name(path)]
+    }
+
+
+def test_every_solver_module_has_a_floor():
+    modules = sorted(_contact_graph())
+    assert "amontons.contact.cg" in modules and len(modules) > 20
+    unplaced = []
+    for module in modules:
+        try:
+            _floor_of(module)
+        except StopIteration:
+            unplaced.append(module)
+    assert unplaced == [], "place each in CONTACT_FLOORS (and docs/models.md §2)"
+
+
+def test_no_solver_module_imports_a_floor_above_its_own():
+    graph = _contact_graph()
+    assert "amontons.contact.kernels" in graph["amontons.contact.cg"]
+    upward = [
+        f"{module} (floor {_floor_of(module)}) imports {target} (floor {_floor_of(target)})"
+        for module, targets in sorted(graph.items())
+        for target in sorted(targets)
+        if _floor_of(target) > _floor_of(module)
+    ]
+    assert upward == []
+
+
+def test_no_solver_module_closes_an_import_circle():
+    """Inside amontons.contact, with names imported from the package read as the package:
+    a circle through the __init__ counts too."""
+    assert _cycle(_contact_graph()) == []
+
+
+def _hidden_imports(path: Path) -> list[str]:
+    """Imports of amontons modules anywhere but at a module's top level (in a function, a
+    class, an ``if`` such as ``if TYPE_CHECKING``, a ``try``), with the line. (Optional
+    third-party imports - pyfftw, fcntl - may sit in a ``try`` or a function.)"""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    top = {id(node) for node in tree.body}
+    return [
+        f"{path.name}:{node.lineno}"
+        for node in ast.walk(tree)
+        if id(node) not in top
+        and (
+            (isinstance(node, ast.ImportFrom) and (node.level or "amontons" in (node.module or "")))
+            or (isinstance(node, ast.Import) and any("amontons" in a.name for a in node.names))
+        )
+    ]
+
+
+def test_the_hidden_import_scan_finds_one(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text("def f():\n    from .api import solve\n")
+    assert _hidden_imports(probe) == ["probe.py:2"]
+
+
+def test_the_solver_hides_no_import():
+    """No import hidden in a function or behind ``if TYPE_CHECKING`` to dodge a circle."""
+    hidden = [
+        hit for path in sorted((PACKAGE / "contact").glob("*.py")) for hit in _hidden_imports(path)
+    ]
+    assert hidden == []
 
 
 def _function_level_imports(module: str) -> list[str]:

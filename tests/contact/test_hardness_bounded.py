@@ -15,16 +15,19 @@ Tolerances, and why (both routes solve to the default tol = 1e-8):
 Problem sizes 64²–128², so the file runs in seconds.
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from amontons.contact import (
     ConvergenceError,
     PenetrationHardness,
-    fused,
     solve,
     solve_load_series,
 )
+from amontons.contact.api import solve_with_options
+from amontons.contact.options import solve_options
 from amontons.contact.surfaces import self_affine, sphere
 
 E_STAR = 3.5e9  # PMMA on glass, Pa
@@ -204,7 +207,7 @@ def test_a_bounded_solve_that_cannot_converge_raises(sphere_case):
 
 
 @pytest.mark.parametrize("case", ["sphere", "periodic per-pixel"])
-def test_the_fused_load_step_matches_its_numpy_reference(sphere_case, case, monkeypatch):
+def test_the_fused_load_step_matches_its_numpy_reference(sphere_case, case):
     """The default bounded load step keeps u = K*p by point responses and the rescale
     u <- s·u - (s - 1)·K*p_bound (bounded_load.BoundedLoadSweep); its numpy reference takes
     u afresh after every step. The same step up to one detail (a clipped free point may
@@ -222,8 +225,23 @@ def test_the_fused_load_step_matches_its_numpy_reference(sphere_case, case, monk
         kw = dict(spacing=1.0, e_star=1.0, periodic=True)
     law = PenetrationHardness(p_y)
     new = solve(h, load=load, plasticity=law, **kw)
-    monkeypatch.setattr(fused, "BOUNDED_LOAD_SWEEP", False)
-    ref = solve(h, load=load, plasticity=law, **kw)
+    numpy_step = replace(
+        solve_options(
+            h.shape,
+            periodic=kw.get("periodic", False),
+            tol=1e-8,
+            max_iter=None,
+            threads=1,
+            backend=None,
+            planner_effort=None,
+            plasticity=law,
+            method=None,
+            max_outer=None,
+            raise_on_failure=True,
+        ),
+        bounded_load_sweep=False,
+    )
+    ref = solve_with_options(h, kw["spacing"], kw["e_star"], numpy_step, load=load)
     assert new.success and ref.success
     np.testing.assert_array_equal(new.contact, ref.contact)
     np.testing.assert_allclose(new.pressure, ref.pressure, rtol=0, atol=1e-6 * np.max(p_y))

@@ -17,8 +17,8 @@ import sys
 import numpy as np
 import pytest
 
-from amontons.contact import kernel_cache, kernels, solve
-from amontons.contact.plasticity import PenetrationHardness
+from amontons.contact import jit, kernel_cache, kernels, solve
+from amontons.contact.laws import PenetrationHardness
 
 # evaluated at collection, before any test has run a kernel
 COLD_AT_START = kernel_cache.is_cold(kernels.ENTRY_POINTS)
@@ -26,7 +26,7 @@ COLD_AT_START = kernel_cache.is_cold(kernels.ENTRY_POINTS)
 SOLVES = """
 import hashlib
 from amontons.contact import self_affine, solve, sphere
-from amontons.contact.plasticity import PenetrationHardness
+from amontons.contact.laws import PenetrationHardness
 rough = self_affine((96, 96), 1.0, 0.8, rms_slope=0.1, rng=11)
 a = solve(rough, 1.0, 1.0, load=0.005 * 96**2, periodic=True)
 h = sphere((96, 96), 0.01, 1.0)
@@ -91,9 +91,9 @@ def test_is_cold_says_no_when_numba_cannot_tell():
 
 
 def test_a_failing_child_warns_and_the_process_goes_on(monkeypatch):
-    monkeypatch.setattr(kernel_cache.sys, "executable", "/bin/false")
+    monkeypatch.setattr(jit.sys, "executable", "/bin/false")
     with pytest.warns(RuntimeWarning, match="child process failed"):
-        kernel_cache._compile_in_child()
+        jit.compile_in_child()
 
 
 def test_the_warm_up_solves_reach_their_routes():

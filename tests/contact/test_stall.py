@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from amontons.contact import ConvergenceError, solve
-from amontons.contact.inputs import default_max_iter
+from amontons.contact.options import default_max_iter
 from amontons.contact.stall import STALL_FACTOR, STALL_WINDOW, StallMonitor
 from amontons.contact.surfaces import self_affine
 

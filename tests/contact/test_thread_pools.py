@@ -11,9 +11,9 @@ import pytest
 from threadpoolctl import threadpool_info, threadpool_limits
 
 import amontons.contact.greenwood_tripp as gt_module
-from amontons.contact import ContactInputError, ConvergenceError, api, solve, solve_load_series
+from amontons.contact import ContactInputError, ConvergenceError, elastic, solve, solve_load_series
 from amontons.contact.greenwood_tripp import AsperityModel, greenwood_tripp
-from amontons.contact.inputs import check_threads
+from amontons.contact.options import check_threads
 from amontons.contact.surfaces import sphere
 
 CALLER = 2  # the caller's own limit, different from the solve's
@@ -28,13 +28,13 @@ def _limits():
 def seen_in_cg(monkeypatch):
     """Record the pools' limits each time the CG loop runs."""
     seen = []
-    original = api._run_cg
+    original = elastic.run_cg
 
     def recording(*args, **kwargs):
         seen.append(_limits())
         return original(*args, **kwargs)
 
-    monkeypatch.setattr(api, "_run_cg", recording)
+    monkeypatch.setattr(elastic, "run_cg", recording)
     return seen
 
 

@@ -1,6 +1,8 @@
 """amontons.contact: FFT boundary-element solver for rough frictionless contact.
 
-Self-contained: imports numpy, scipy and (optionally) pyfftw only. SI units throughout:
+Self-contained: it imports numerical libraries only (numpy, scipy, numba for the fused
+kernels, threadpoolctl to bound the native thread pools, and optionally pyfftw), nothing
+else of amontons. Built in six floors (docs/models.md §2.0). SI units throughout:
 lengths in m, pressures and moduli in Pa, forces in N. The models and their equations are
 described in docs/models.md (§2.1 sign conventions and Green's functions, §2.2 the bounded
 Polonsky–Keer conjugate gradient, §2.3 penetration hardness, §2.4 contact hardening,
@@ -26,7 +28,7 @@ planner_effort, raise_on_failure) -> ContactResult``, ``solve_load_series(height
 spacing, e_star, loads, *, ..., warm_starts) -> list[ContactResult]`` and ``solve_scan(heights,
 spacing, e_star, loads, laws, **options) -> list[list[ContactResult]]`` (one load series per
 law, each warm-started from the previous law's); the plasticity laws
-``PenetrationHardness(p_y)`` and ``ContactHardening(k)`` (:mod:`amontons.contact.plasticity`);
+``PenetrationHardness(p_y)`` and ``ContactHardening(k)`` (:mod:`amontons.contact.laws`);
 surface synthesis ``sphere`` and ``self_affine`` (:mod:`amontons.contact.surfaces`).
 
 Result (:class:`ContactResult`, frozen; ``==`` is identity)
@@ -83,17 +85,15 @@ Exceptions
 """
 
 from .api import solve, solve_load_series, solve_scan
-from .plasticity import ContactHardening, PenetrationHardness
-from .result import (
-    CoarseLevel,
+from .errors import (
     ContactError,
     ContactInputError,
-    ContactResult,
     ConvergenceError,
     FreeBoundaryError,
     IgnoredOptionWarning,
-    SolveInfo,
 )
+from .laws import ContactHardening, PenetrationHardness
+from .result import CoarseLevel, ContactResult, SolveInfo
 from .surfaces import self_affine, sphere
 
 __all__ = [

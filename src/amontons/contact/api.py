@@ -1,8 +1,14 @@
-"""Public solve calls: :func:`solve` and :func:`solve_load_series`."""
+"""The public calls: :func:`solve`, :func:`solve_load_series` and :func:`solve_scan`.
+
+The top floor: validates the inputs once into :class:`~.options.SolveOptions` and a
+:class:`~.options.LoadStep`, bounds the native thread pools for the call, runs the route
+(:mod:`.routes`) and turns its Outcome into a :class:`~.result.ContactResult` after the
+checks that make failure loud (non-convergence, non-finite fields, pressure on the window
+edge).
+"""
 
 from __future__ import annotations
 
-import math
 import time
 import warnings
 from collections.abc import Sequence
@@ -10,10 +16,18 @@ from collections.abc import Sequence
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from .cg import polonsky_keer
-from .convolution import get_operator
-from .fft import DEFAULT_PLANNER_EFFORT
-from .inputs import (
+from .elastic import COARSE_MIN_SIZE, finite, has_coarse_level
+from .errors import (
+    STALLED,
+    ContactError,
+    ContactInputError,
+    ConvergenceError,
+    FreeBoundaryError,
+    IgnoredOptionWarning,
+)
+from .options import (
+    DEFAULT_PLANNER_EFFORT,
+    LoadStep,
     SolveOptions,
     check_control,
     check_heights,
@@ -21,27 +35,10 @@ from .inputs import (
     check_plastic_history,
     check_positive,
     check_warm_start,
-    default_max_iter,
     solve_options,
 )
-from .plasticity import solve_plastic
-from .result import (
-    STALLED,
-    CoarseLevel,
-    ContactError,
-    ContactInputError,
-    ContactResult,
-    ConvergenceError,
-    FreeBoundaryError,
-    IgnoredOptionWarning,
-    SolveInfo,
-)
-
-# Coarse levels stop at this many pixels along the shorter side: below it a solve costs
-# nothing and the coarse surface no longer resembles the fine one.
-COARSE_MIN_SIZE = 32
-# Coarse levels only provide a starting guess, so they are solved loosely.
-COARSE_TOL = 1e-4
+from .result import ContactResult, SolveInfo
+from .routes import run_route
 
 
 def solve(
@@ -131,9 +128,9 @@ def solve(
         machine and kept on disk as FFTW wisdom (:mod:`amontons.contact.wisdom`, file
         ``$AMONTONS_FFTW_WISDOM`` or ``~/.cache/amontons``), which every later process
         imports, so the same plan and the same result bytes in every run on the machine.
-        Its plans use ``threads`` (ESTIMATE's do not) and were 1.1-1.7× faster than
-        ``"FFTW_ESTIMATE"``'s on one thread (benchmarks/README.md); ESTIMATE plans by
-        heuristics, without timing or disk. A plan for another thread count differs in
+        Its plans use ``threads`` (ESTIMATE's do not) and are faster than
+        ``"FFTW_ESTIMATE"``'s (benchmarks/README.md); ESTIMATE plans by heuristics, without
+        timing or disk. A plan for another thread count differs in
         round-off only (the answer agrees with the one-thread one to 1e-10). Operators are
         cached per effort. An effort given with the numpy backend is ignored, with a warning.
     raise_on_failure : bool
@@ -198,10 +195,9 @@ def solve(
         warm_start=warm_start is not None,
     )
     # Every native pool (OpenBLAS, OpenMP) runs one thread for the call and is restored after
-    # it, also on an exception. The CG's BLAS calls are level 1 (dot, axpy) on one field:
-    # unbounded, their threads spin against the solver's own (a plain process lost 1.7-3.5x,
-    # issue 21), and even bounded to 2 they made threads=2 11x slower at 512²
-    # (benchmarks/bench_thread_pools.py); ``threads`` goes to FFTW.
+    # it, also on an exception: BLAS threads would spin against the solver's own
+    # (benchmarks/README.md, "Speed as a user gets it"); ``threads`` goes to FFTW and the
+    # kernels.
     with threadpool_limits(limits=1):
         return _solve_step(
             h,
@@ -213,6 +209,30 @@ def solve(
             warm_start=warm_start,
             plastic_prev=plastic_prev,
             coarse_to_fine=bool(coarse_to_fine),
+        )
+
+
+def solve_with_options(
+    heights, spacing, e_star, opts: SolveOptions, *, load=None, displacement=None
+):
+    """One cold solve under options already validated (:func:`.inputs.solve_options`, then
+    perhaps :func:`dataclasses.replace`): how a test selects a kernel set that
+    :func:`solve` does not offer (``bounded_load_sweep=False``). Units as :func:`solve`;
+    no warm start, no plastic history, no coarse-to-fine start."""
+    h = check_heights(heights)
+    load, displacement = check_control(load, displacement)
+    plastic_prev = None if opts.law is None else np.zeros(h.shape)
+    with threadpool_limits(limits=1):
+        return _solve_step(
+            h,
+            check_positive("spacing", spacing, "m"),
+            check_positive("e_star", e_star, "Pa"),
+            opts,
+            load=load,
+            displacement=displacement,
+            warm_start=None,
+            plastic_prev=plastic_prev,
+            coarse_to_fine=False,
         )
 
 
@@ -432,7 +452,7 @@ def _coarse_to_fine_obstacle(opts, shape, warm_start):
         return "the coarse-to-fine start is only implemented for elastic solves"
     if warm_start:
         return "warm_start gives the starting pressure"
-    if not _has_coarse_level(shape):
+    if not has_coarse_level(shape):
         return (
             f"a {shape[0]}x{shape[1]} grid has no coarse level (both sides must be even and "
             f"at least {2 * COARSE_MIN_SIZE} pixels)"
@@ -443,156 +463,23 @@ def _coarse_to_fine_obstacle(opts, shape, warm_start):
 def _solve_step(
     h, spacing, e_star, opts, *, load, displacement, warm_start, plastic_prev, coarse_to_fine
 ):
-    """One validated solve: elastic, or plastic from the plastic state ``plastic_prev``."""
-    if opts.law is None:
-        return _solve_elastic(
-            h,
-            spacing,
-            e_star,
-            opts,
-            load=load,
-            displacement=displacement,
-            warm_start=warm_start,
-            coarse_to_fine=coarse_to_fine,
-        )
-    return _solve_plastic(
-        h,
-        spacing,
-        e_star,
-        opts,
-        load=load,
-        displacement=displacement,
-        warm_start=warm_start,
-        plastic_prev=plastic_prev,
-    )
-
-
-def _solve_elastic(h, spacing, e_star, opts, *, load, displacement, warm_start, coarse_to_fine):
+    """One validated solve by the route of ``opts``, elastic or plastic from the plastic
+    state ``plastic_prev`` (m), checked and made into a ContactResult."""
     t0 = time.perf_counter()
-    levels = ()
-    p_init = warm_start
-    if p_init is None and coarse_to_fine:
-        p_init, levels = _coarse_start(h, spacing, e_star, load, displacement, opts)
-    if p_init is None:
-        p_init = _start_pressure(h, spacing, e_star, load, displacement)
-    out = _run_cg(
-        h,
-        spacing,
-        e_star,
-        opts,
-        load=load,
-        displacement=displacement,
-        p_init=p_init,
-        tol=opts.tol,
-        max_iter=opts.max_iter,
-    )
-    info = _solve_info(
-        opts,
-        convolutions=out.convolutions,
-        resets=out.info["steepest_descent_resets"],
-        outer_iterations=0,
-        coarse_levels=levels,
-        t0=t0,
-    )
-    return _finished(
-        h,
-        spacing,
-        opts,
-        out,
-        elastic=out.displacement_field,
-        plastic=np.zeros_like(out.pressure),
-        displacement=out.rigid_displacement,
-        info=info,
-        what="solver",
-    )
+    step = LoadStep(load, displacement, warm_start, plastic_prev, coarse_to_fine)
+    out = run_route(h, spacing, e_star, opts, step)
+    what = "solver" if opts.law is None else "plastic solve"
+    return _finished(h, spacing, opts, out, info=_solve_info(opts, out, t0), what=what)
 
 
-def _solve_plastic(h, spacing, e_star, opts, *, load, displacement, warm_start, plastic_prev):
-    t0 = time.perf_counter()
-    op = _operator(h.shape, spacing, e_star, opts)
-    p_init = warm_start
-    if p_init is None:
-        p_init = _start_pressure(h + plastic_prev, spacing, e_star, load, displacement)
-    state = solve_plastic(
-        op,
-        h,
-        spacing,
-        opts.law,
-        load=load,
-        displacement=displacement,
-        plastic_prev=plastic_prev,
-        p_init=p_init,
-        periodic=opts.periodic,
-        tol=opts.tol,
-        max_iter=opts.max_iter,
-        max_outer=opts.max_outer,
-        route=opts.route,
-    )
-    info = _solve_info(
-        opts,
-        convolutions=state.convolutions,
-        resets=state.resets,
-        outer_iterations=state.outer_iterations,
-        coarse_levels=(),
-        t0=t0,
-    )
-    return _finished(
-        h,
-        spacing,
-        opts,
-        state,
-        elastic=state.elastic_displacement,
-        plastic=state.plastic_displacement,
-        displacement=state.displacement,
-        info=info,
-        what="plastic solve",
-    )
-
-
-def _operator(shape, spacing, e_star, opts: SolveOptions):
-    """The cached convolution operator of a grid (m, Pa) under the solve's options."""
-    return get_operator(
-        shape,
-        spacing,
-        e_star,
-        periodic=opts.periodic,
-        backend=opts.backend,
-        threads=opts.threads,
-        planner_effort=opts.planner_effort,
-    )
-
-
-def _run_cg(h, spacing, e_star, opts, *, load, displacement, p_init, tol, max_iter):
-    """One Polonsky–Keer solve of the hard-wall problem; returns its outcome, never raises
-    on non-convergence."""
-    h_scale = float(np.std(h))
-    if not np.ptp(h) > 0:
-        # a flat indenter: any length works, the gap is round-off. (np.std of a constant
-        # array is round-off too, ~1e-16 of the height, not 0: that scale would turn the
-        # round-off gap into a residual of order 1.)
-        h_scale = spacing
-    return polonsky_keer(
-        _operator(h.shape, spacing, e_star, opts),
-        h,
-        pixel_area=spacing**2,
-        h_scale=h_scale,
-        p_init=p_init,
-        load=load,
-        displacement=displacement,
-        tol=tol,
-        max_iter=max_iter,
-        raise_on_failure=False,
-    )
-
-
-def _solve_info(opts, *, convolutions, resets, outer_iterations, coarse_levels, t0):
-    """The SolveInfo of a solve that started at ``t0`` (perf_counter, s)."""
+def _solve_info(opts, out, t0):
+    """The SolveInfo of a solve (Outcome ``out``) that started at ``t0`` (perf_counter, s)."""
     return SolveInfo(
         route=opts.route,
-        convolutions=float(convolutions),
-        steepest_descent_resets=int(resets),
-        outer_iterations=int(outer_iterations),
-        coarse_levels=tuple(coarse_levels),
+        convolutions=float(out.convolutions),
+        steepest_descent_resets=int(out.resets),
+        outer_iterations=int(out.outer_iterations),
+        coarse_levels=tuple(out.coarse_levels),
         plasticity=opts.law,
         backend=opts.backend,
         threads=opts.threads,
@@ -604,8 +491,8 @@ def _solve_info(opts, *, convolutions, resets, outer_iterations, coarse_levels, 
     )
 
 
-def _finished(h, spacing, opts, outcome, *, elastic, plastic, displacement, info, what):
-    """The ContactResult of a solve (``outcome``: a CG or plastic state), after the checks:
+def _finished(h, spacing, opts, outcome, *, info, what):
+    """The ContactResult of a solve (``outcome``: the route's Outcome), after the checks:
     non-convergence (raises unless ``raise_on_failure=False``), non-finite fields (raise
     always) and, for a converged non-periodic solution, pressure on the window edge (raises
     always; a non-converged iterate's edge pressure says nothing about the window)."""
@@ -625,11 +512,11 @@ def _finished(h, spacing, opts, outcome, *, elastic, plastic, displacement, info
     return ContactResult(
         pressure=p,
         gap=outcome.gap,
-        elastic_displacement=elastic,
-        plastic_displacement=plastic,
+        elastic_displacement=outcome.elastic_displacement,
+        plastic_displacement=outcome.plastic_displacement,
         contact=p > 0,
         load=float(p.sum()) * spacing**2,
-        displacement=displacement,
+        displacement=outcome.displacement,
         spacing=spacing,
         iterations=outcome.iterations,
         residual=outcome.residual,
@@ -646,7 +533,7 @@ def _finished(h, spacing, opts, outcome, *, elastic, plastic, displacement, info
 def _check_finite(what, outcome, tol):
     """Raise ConvergenceError when a solve's pressure or gap holds NaN or inf (never return
     them, whatever ``raise_on_failure``)."""
-    if not _finite(outcome):
+    if not finite(outcome):
         raise ConvergenceError(
             f"{what} produced non-finite pressure or gap (NaN/inf)",
             iterations=outcome.iterations,
@@ -655,10 +542,6 @@ def _check_finite(what, outcome, tol):
             residual_history=outcome.history,
             status=STALLED,
         )
-
-
-def _finite(outcome) -> bool:
-    return bool(np.isfinite(outcome.pressure).all() and np.isfinite(outcome.gap).all())
 
 
 def _check_free_boundary(p, spacing):
@@ -678,71 +561,3 @@ def _check_free_boundary(p, spacing):
             edge_pixels=n_edge,
             edge_force=f_edge,
         )
-
-
-# --- starting pressures -------------------------------------------------------------------
-
-
-def _start_pressure(h, spacing, e_star, load, displacement):
-    """Starting pressure (Pa) without a warm start: uniform under load control (the solver
-    rescales it to the load), the overlap guess under displacement control."""
-    if load is not None:
-        return np.ones_like(h)
-    return _initial_pressure(h, spacing, e_star, displacement)
-
-
-def _initial_pressure(h, spacing, e_star, displacement):
-    """Starting pressure (Pa) for displacement control: a local-stiffness overlap guess."""
-    overlap = np.maximum(h + displacement, 0.0)
-    n = np.count_nonzero(overlap)
-    if n == 0:
-        return np.zeros_like(h)
-    # a patch of size L has stiffness ~E*/L, so p ~ E* overlap / L
-    return overlap * (e_star / (math.sqrt(n) * spacing))
-
-
-def _has_coarse_level(shape) -> bool:
-    """Whether a grid can be coarsened 2x2 at least once (even sides, >= 2 COARSE_MIN_SIZE)."""
-    n0, n1 = shape
-    return not (n0 % 2 or n1 % 2 or min(n0, n1) < 2 * COARSE_MIN_SIZE)
-
-
-def _coarsen(h):
-    n0, n1 = h.shape
-    return h.reshape(n0 // 2, 2, n1 // 2, 2).mean(axis=(1, 3))
-
-
-def _coarse_start(h, spacing, e_star, load, displacement, opts, levels=()):
-    """Pressure (Pa) on the grid of ``h`` from a solve on a 2x coarser grid, or None, and
-    the coarse levels solved (coarsest first).
-
-    Heights are block-averaged 2x2 (spacing doubles); the coarse pressure is prolonged by
-    pixel replication, which keeps the total force. Recurses down to ``COARSE_MIN_SIZE``.
-    A level that stalls or has no usable pressure gives no start.
-    """
-    if not _has_coarse_level(h.shape):
-        return None, levels
-    hc = _coarsen(h)
-    start, levels = _coarse_start(hc, 2 * spacing, e_star, load, displacement, opts, levels)
-    if start is None:
-        start = _start_pressure(hc, 2 * spacing, e_star, load, displacement)
-    out = _run_cg(
-        hc,
-        2 * spacing,
-        e_star,
-        opts,
-        load=load,
-        displacement=displacement,
-        p_init=start,
-        tol=COARSE_TOL,
-        max_iter=default_max_iter(hc.shape),
-    )
-    if out.status == STALLED or not _finite(out) or not out.pressure.any():
-        return None, levels
-    levels = (*levels, CoarseLevel(hc.shape, out.iterations, out.convolutions))
-    return _prolong(out.pressure), levels
-
-
-def _prolong(p):
-    """Pixel replication 2x2: keeps the total force and the support of the pressure."""
-    return np.repeat(np.repeat(p, 2, axis=0), 2, axis=1)

@@ -1,10 +1,12 @@
-"""Polonsky & Keer (1999) constrained conjugate gradient for the hard-wall contact problem.
+"""The Polonsky–Keer constrained conjugate gradient: the solver's one iteration.
 
 Problem (SI units): find the pressure ``p >= 0`` (Pa) on the grid such that the gap
 ``g = K*p - h - d`` (m) satisfies ``g >= 0`` everywhere and ``g = 0`` where ``p > 0``, with
 either the total force ``A0 Σp = W`` prescribed (load control; ``d`` is then the Lagrange
 multiplier of the force constraint) or the rigid-body approach ``d`` prescribed
-(displacement control). ``K*`` is a convolution operator (m/Pa), ``A0`` the pixel area.
+(displacement control). ``K*`` is a convolution operator (m/Pa), ``A0`` the pixel area. A
+bounded constraint ``0 <= p <= p_max`` (penetration hardness) and an elastic-plus-Winkler
+operator (contact hardening) run through the same loop.
 
 Algorithm (docs/models.md §2.2), per iteration on the free set ``Ic`` (``p > 0``):
 gap ``g`` (load control: minus its mean over ``Ic``, which is the approach ``d``),
@@ -12,77 +14,67 @@ gap ``g`` (load control: minus its mean over ``Ic``, which is the approach ``d``
 load control: minus its mean over ``Ic``), ``r = K*t``, step ``τ = Σ g t / Σ r t``,
 ``p ← max(p - τ t, 0)``; points with ``p = 0`` and ``g < 0`` (penetrating but unloaded)
 get ``p ← -τ g`` and join ``Ic``; load control rescales ``p`` to the target force.
+Two departures from the paper (docs/models.md §2.2; measured in benchmarks/README.md): ``t``
+is given zero sum over ``Ic`` under load control, so ``Σ r t`` is the quadratic form alone
+and can be taken from the spectrum (Parseval); and the conjugation is reset to steepest
+descent only when the points added in one iteration exceed ``RESET_FRACTION`` of the free
+set. The fixed point is Polonsky & Keer's.
 
-Departures from the paper, measured in benchmarks/README.md. Under load control Polonsky &
-Keer keep ``t`` as built and subtract the mean of ``r`` over ``Ic`` in the step; here ``t``
-itself is given zero sum over ``Ic`` (it loses it where points were clipped), so the step
-keeps the force on ``Ic`` and ``Σ r t = Σ t·(K*t)`` needs nothing of ``r`` but the quadratic
-form, which the fused loop takes from the spectrum (Parseval) before the inverse transform.
-Iterations to 1e-8 stay within 3 % of Polonsky & Keer's form on rough surfaces (97 against
-100 at 512², 123 against 123 at 1024², periodic and not) and drop on a small sphere (21-28
-against 25-29 at 64²); the fixed point is the same. Second, Polonsky & Keer reset the
-conjugation to steepest descent (``δ = 0``) whenever *any* point is added. On rough
-surfaces a handful of edge points is added almost every iteration, so the original rule
-runs steepest descent ~90 % of the time. Here the reset happens only when the added points
-exceed ``RESET_FRACTION`` (1 %) of the free set; small additions keep the conjugation.
-Iterations to 1e-8 drop 2-4x (e.g. 368 → 100 at 512², 483 → 123 at 1024²) and the
-converged field is the same (the fixed point does not depend on the direction rule).
+This module owns the control flow: stall detection (:class:`.stall.StallMonitor`), the
+full-contact singularity of periodic displacement control, restarts when no descent
+direction is left, the refresh of ``u = K*p``, convergence and the outcome's status. The
+element-wise work of an iteration is the fused kernel set of :mod:`.kernels` (three sweeps
+plus the convolution ``r = K*t``, taken in halves when the operator offers it), and bounded
+load control takes its step from :mod:`.bounded_load`.
 
 Convergence: two dimensionless measures,
 
 * ``complementarity = max(rms_Ic |g|, max_violators |g|) / h_scale`` with ``h_scale`` the
-  rms height of the indenter (the natural length scale of the problem): the rms gap left
-  on the contact set and the worst penetration off it. It costs nothing (it comes from
-  ``G``), so it is recorded every iteration as the residual;
-* ``change = Σ|p - p_old| / Σp``, the relative pressure change, computed (3 passes) only
-  once the complementarity is below ``tol``.
+  rms height of the indenter: recorded every iteration as the residual;
+* ``change = Σ|p - p_old| / Σp``, the relative pressure change, computed only once the
+  complementarity is below ``tol``.
 
-The solve has converged when both are below ``tol``, the complementarity re-evaluated
-with a freshly convolved ``u`` (never the incrementally updated one); the reported final
-residual is the larger of the two. The outcome's ``status`` is 0 (converged), 1
-(``max_iter`` reached) or 2 (stalled: a periodic displacement-controlled solve reached full
-contact, where the mean pressure is undetermined, or the best residual has not fallen by
-``STALL_FACTOR`` in ``STALL_WINDOW`` iterations, see :class:`.stall.StallMonitor`); see
-:class:`amontons.contact.ContactResult`.
+The solve has converged when both are below ``tol``, the complementarity re-evaluated with a
+freshly convolved ``u`` (never the incrementally updated one); the reported final residual is
+the larger of the two. The outcome's ``status`` is 0 (converged), 1 (``max_iter`` reached) or
+2 (stalled: a periodic displacement-controlled solve reached full contact, where the mean
+pressure is undetermined, or the best residual has stopped falling).
 
-Cost: ``r = K*t`` is at most one convolution per iteration. ``u = K*p`` would be a second
-one, but
-the new pressure is ``s (p - τ t + c)`` with ``c`` non-zero only on the points the
-projection clipped or the violator step added, so ``u ← s (u - τ K*t + K*c)``: with no such
-point this needs no convolution at all, and with at most ``SPARSE_MAX`` of them an operator
-that offers ``add_point_responses`` (the periodic one) adds their responses directly (a
-few grid passes each). Otherwise, and at least every ``refresh`` iterations and before
-convergence is declared, ``u`` is recomputed from scratch. The free set is updated
-sparsely (see :class:`HardWall`), the axpy updates use BLAS, and work arrays are
-SIMD-aligned so the FFTW plans run on them without copies. The fused loop takes ``r = K*t``
-in halves: when ``u`` is recomputed anyway it skips the inverse transform of ``K*t``,
-which only the incremental update needs (:mod:`amontons.contact.fused`).
+Cost: at most one convolution per iteration. ``u`` follows the step linearly
+(``u ← s (u - τ K*t + K*c)``, ``c`` the pressures set by the projection and the violator
+step): with no changed point no convolution at all, with at most ``SPARSE_MAX_PERIODIC`` /
+``SPARSE_MAX_PADDED`` of them their point responses are added
+(:func:`.kernels.add_point_responses`); otherwise, and at least every ``refresh``
+iterations and before convergence is declared, ``u = K*p`` is taken afresh and the inverse
+transform of ``K*t`` is skipped.
 
-Two implementations of the same loop: the default runs the element-wise work in four fused
-numba sweeps (:mod:`amontons.contact.fused`, :mod:`amontons.contact.kernels`; point
-responses for up to 12 periodic / 32 non-periodic changed points, sums independent of the
-thread count); ``kernels=False`` runs the numpy loop below, the reference the tests compare
-against (benchmarks/README.md, benchmark 1).
+Load control rescales ``p`` (and so ``u``) to the target force every iteration at no cost:
+the stored pressure ``P`` and displacement ``U`` carry one common scale ``sigma`` (true
+``p = sigma·P``, ``u = sigma·U``); ``U = K*P`` stays true when only ``sigma`` changes.
 
-Extension points: the constraint is an object with three methods (:class:`HardWall`;
-:class:`BoundedWall` for ``0 <= p <= p_max``, displacement control), and the operator is
-any symmetric positive-definite linear callable ``op(x, out=...)``, so a Winkler term
-``K*t + t/k`` is a wrapper around the convolution.
+The constraint is an object with three methods (:class:`HardWall`; :class:`BoundedWall` for
+``0 <= p <= p_max``); the operator is a convolution of :mod:`.convolution` or any symmetric
+positive-definite linear callable ``op(x, out=...)``, with an optional Winkler compliance
+(``operator`` and ``compliance`` attributes) added inside the kernels.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
-from scipy.linalg.blas import daxpy as _axpy
 
 from . import fft as _fft
-from .result import CONVERGED, ITERATION_CAP, STALLED, ConvergenceError
+from . import kernels as _k
+from .bounded_load import (
+    BoundedLoadSweep,
+    bounded_load_step,
+    fully_bound_approach,
+    impose_bounded_load,
+)
+from .errors import CONVERGED, ITERATION_CAP, STALLED, ConvergenceError
+from .result import Outcome
 from .stall import StallMonitor
-
-_ALIGNED_BACKEND = "pyfftw" if _fft.HAVE_PYFFTW else "numpy"
 
 
 class HardWall:
@@ -136,10 +128,9 @@ class BoundedWall(HardWall):
     Free set ``0 < p < p_max`` (under displacement control a free point that reaches
     ``p_max`` exactly stays free until it crosses it; the load-controlled step counts it as
     at the bound); points at ``p_max`` are constrained and become violators
-    when their gap opens (``g > 0``). Load control runs on the fused loop only, which
-    imposes the load on the free points and leaves those at the bound
-    (:func:`amontons.contact.bounded_load.impose_bounded_load`); a rescale of the whole field, as
-    the numpy loop does, would push points through the bound.
+    when their gap opens (``g > 0``). Load control imposes the load on the free points and
+    leaves those at the bound (:func:`amontons.contact.bounded_load.impose_bounded_load`); a
+    rescale of the whole field would push points through the bound.
     """
 
     bounded = True
@@ -176,39 +167,17 @@ class BoundedWall(HardWall):
 
 
 _EMPTY = np.empty(0, dtype=np.intp)
-_EMPTY_F = np.empty(0, dtype=np.float64)
-# At most this many changed points (clipped + added) are applied to u as point responses
-# (a few grid passes each) instead of a full convolution.
-SPARSE_MAX = 3
 # Reset the conjugation to steepest descent only when the points added to the free set in
 # one iteration exceed this fraction of it (module docstring; 0 = the original PK rule).
 RESET_FRACTION = 0.01
-
-
-@dataclass
-class CGOutcome:
-    """Raw output of :func:`polonsky_keer` (fields in SI units).
-
-    ``status``: 0 converged, 1 ``max_iter`` reached, 2 stalled; ``message`` says which,
-    with the iterations and the residual.
-    """
-
-    pressure: np.ndarray
-    displacement_field: np.ndarray
-    gap: np.ndarray
-    rigid_displacement: float
-    iterations: int
-    residual: float
-    history: np.ndarray
-    status: int
-    message: str
-    convolutions: float
-    info: dict = field(default_factory=dict)
-
-    @property
-    def converged(self) -> bool:
-        """True when ``status == 0``."""
-        return self.status == CONVERGED
+# Most changed points (clipped + added) applied to u as point responses instead of a full
+# convolution, periodic and padded: about where the points' responses cost a convolution
+# less its inverse (benchmarks/bench_point_responses.py; benchmarks/README.md, "Fewer
+# convolutions").
+SPARSE_MAX_PERIODIC = 12
+SPARSE_MAX_PADDED = 32
+# Largest Σa²/G of the one-pass moments about the previous approach (see _centred_moments).
+RECENTRE = 1e3
 
 
 def polonsky_keer(
@@ -225,9 +194,9 @@ def polonsky_keer(
     refresh=100,
     constraint=None,
     raise_on_failure=True,
-    kernels=True,
     threads=None,
-) -> CGOutcome:
+    bounded_load_sweep=True,
+) -> Outcome:
     """Solve the contact problem by constrained conjugate gradients.
 
     Parameters
@@ -252,38 +221,27 @@ def polonsky_keer(
     max_iter : int
         Iteration cap.
     refresh : int
-        Recompute ``u = K*p`` from scratch at least every ``refresh`` iterations. The
-        incrementally updated ``u`` drifts from a fresh ``K*p`` by ~2e-15 of its peak over
-        50-100 linear and sparse updates (512² and 1024² benchmark surfaces, fused path;
-        benchmarks/README.md), and convergence is always declared on a fresh ``u``, so the
-        refresh is a safeguard, not an accuracy knob.
+        Recompute ``u = K*p`` from scratch at least every ``refresh`` iterations (a
+        safeguard against drift of the incremental update; convergence is always declared
+        on a fresh ``u``).
     constraint : HardWall, optional
         The inequality constraint (default: hard wall).
     raise_on_failure : bool
         Raise :class:`ConvergenceError` when the solve stops without converging (status 1
         or 2); else return the last iterate with that status.
-    kernels : bool
-        True (default): run the iteration's element-wise work in fused numba kernels
-        (:mod:`amontons.contact.fused`); False: the numpy loop below, kept as the reference
-        the tests compare against (same iterates up to round-off).
     threads : int, optional
-        Threads of the fused kernels (default: the operator's FFTW ``threads``, else 1).
+        Threads of the kernels (default: the operator's FFTW ``threads``, else 1).
+    bounded_load_sweep : bool
+        Bounded load control: True (default) takes the fused step that keeps ``u = K*p``
+        without a convolution (:class:`.bounded_load.BoundedLoadSweep`); False the numpy
+        step and a convolution per step (:func:`.bounded_load.bounded_load_step`), the
+        reference the tests compare with.
     """
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
-    if constraint.bounded and load is not None and not kernels:
-        # the fused loop imposes the load on the free points (bounded_load.impose_bounded_load);
-        # the numpy reference loop only rescales the whole field, which would push points
-        # at the bound through it
-        raise ValueError(
-            "a bounded constraint under load control needs the fused loop (kernels=True); "
-            "the numpy loop takes displacement control"
-        )
-    if kernels:
-        from .fused import fused_polonsky_keer  # numba import and kernel load on first use
-
-        return fused_polonsky_keer(
+    with _k.kernel_threads(_kernel_threads(operator, threads)):
+        return _loop(
             operator,
             heights,
             pixel_area=pixel_area,
@@ -296,28 +254,71 @@ def polonsky_keer(
             refresh=refresh,
             constraint=constraint,
             raise_on_failure=raise_on_failure,
-            threads=_kernel_threads(operator, threads),
             sparse_max=None,
             reset_fraction=RESET_FRACTION,
-            finish=partial(_finish, constraint, tol, raise_on_failure, pixel_area),
+            bounded_load_sweep=bounded_load_sweep,
+            finish=partial(finish_outcome, constraint, tol, raise_on_failure, pixel_area),
         )
+
+
+def _winkler_parts(operator):
+    """``(convolution, compliance)`` of an elastic-plus-Winkler operator (compliance m/Pa,
+    added inside :func:`.kernels.step_dots`), or ``(operator, None)``."""
+    compliance = getattr(operator, "compliance", None)
+    base = getattr(operator, "operator", None)
+    if compliance is None or base is None:
+        return operator, None
+    # a fresh writable copy: a read-only array is another type to the compiled kernels,
+    # which would then compile in this process (.jit)
+    return base, np.array(compliance, dtype=np.float64).ravel()
+
+
+def _bound_array(constraint, n):
+    """``(p_max per point, bounded flag)`` for the kernels (Pa)."""
+    if not constraint.bounded:
+        return np.full(1, np.inf), False
+    # a fresh writable copy (broadcast_to gives a read-only view), as in _winkler_parts
+    return np.array(np.broadcast_to(constraint.p_max, (n,)), dtype=np.float64), True
+
+
+def _loop(
+    operator,
+    heights,
+    *,
+    pixel_area,
+    h_scale,
+    p_init,
+    load,
+    displacement,
+    tol,
+    max_iter,
+    refresh,
+    constraint,
+    raise_on_failure,
+    sparse_max,
+    reset_fraction,
+    bounded_load_sweep,
+    finish,
+):
     load_control = load is not None
     shape = heights.shape
     n = heights.size
+    backend = "pyfftw" if _fft.HAVE_PYFFTW else "numpy"
 
     def buf():
         # SIMD-aligned work arrays let the FFT plans run on them without copies
-        return _fft.empty(n, np.float64, _ALIGNED_BACKEND)
+        return _fft.empty(n, np.float64, backend)
 
+    base_op, compliance = _winkler_parts(operator)
+    winkler = compliance is not None
+    comp_arg = compliance if winkler else np.zeros(1)
+    p_max, bounded = _bound_array(constraint, n)
     h = buf()
     h[:] = np.ravel(heights)
     p = buf()
     p[:] = np.ravel(p_init)
     if p.min() < 0:
         raise ValueError("p_init must be >= 0")
-    if constraint.bounded:
-        # a warm start from another problem may exceed this one's bound; start admissible
-        np.minimum(p, constraint.p_max, out=p)
     calls = 0
 
     def conv(x, out):
@@ -332,27 +333,63 @@ def polonsky_keer(
             p[:] = 1.0
             total = p.size
         p *= load / (pixel_area * total)
-    u, g, gm, m, r, tmp, p_new = (buf() for _ in range(7))
+    if bounded:
+        # after the load's rescale, which may push a start's points through the bound
+        np.minimum(p, p_max, out=p)
+    # bounded load control: the force is imposed on the free points only (module docstring)
+    bounded_load = bounded and load_control
+    target = load / pixel_area if load_control else 0.0  # Σp, Pa
     t = buf()
     t[:] = 0.0
-    bwork = np.empty(n, dtype=bool)
+    m = np.empty(n, dtype=np.uint8)
+    if bounded_load:
+        _k.free_mask(p, m, p_max, bounded)
+        impose_bounded_load(p, m, t, p_max, target, np.zeros(n), h)
+    u, r = buf(), buf()
+    p_old = None  # a copy of p, taken only when the step may converge
+    nch = _k.n_chunks(n)
+    idx_buf = np.zeros((nch, _k.SLOTS), dtype=np.int64)
+    val_buf = np.zeros((nch, _k.SLOTS))
+    counts = np.zeros((nch, 2), dtype=np.int64)
+    violators = np.zeros(nch, dtype=np.int64)
+    # the violators of chunks with few, recorded by direction for update (kernels.direction)
+    vidx = np.zeros((nch, _k.SLOTS), dtype=np.int64)
+    vg = np.zeros((nch, _k.SLOTS))
+    found = (violators, vidx, vg)
     conv(p, u)
-    nc = constraint.free_mask(p, m, bwork)
+    sigma = 1.0  # true p = sigma·p, u = sigma·u (module docstring)
+    nc = int(_k.free_mask(p, m, p_max, bounded))
     delta = 0.0
     g_old = 1.0
     since_fresh = 0
-    resets = 0  # iterations that added violators and fell back to steepest descent
+    resets = 0
+    recentres = 0  # second moment passes (see _centred_moments)
+    # how u was updated after each step (for benchmarks/bench_iteration.py)
+    updates = dict.fromkeys(
+        ("linear", "point responses", "full: changes", "full: refresh", "full: bounded load"), 0
+    )
     history = []
     d = 0.0 if load_control else float(displacement)
     residual = np.inf
     converged = False
-    stalled = None  # message when the solve cannot go on (status 2)
+    stalled = None
     it = 0
-    # periodic kernel with q = 0 set to 0: a uniform pressure over the whole grid costs no
-    # displacement, so displacement control is singular once every point is in contact
     singular_full = getattr(operator, "periodic", False) and not load_control
-    # operators that can add the response of a few point loads cheaply (the periodic one)
-    sparse_ok = hasattr(operator, "add_point_responses")
+    # every operator of .convolution offers its real-space kernel; a custom one may not
+    sparse_ok = hasattr(base_op, "real_space_kernel")
+    if sparse_max is None:
+        sparse_max = (
+            SPARSE_MAX_PERIODIC if getattr(base_op, "periodic", False) else SPARSE_MAX_PADDED
+        )
+    green = None
+    sweep = None
+    # the convolution r = K*t taken in halves (operator.forward, .multiply_energy, .inverse):
+    # an iteration that takes u = K*p afresh then skips the inverse, half an FFT pair. A
+    # Winkler term needs r in real space (step_dots); the bounded load step updates u itself
+    split = getattr(base_op, "splits", False) and not winkler and not bounded_load
+    forward_only = 0  # forward transforms whose inverse was skipped
+    if bounded_load and bounded_load_sweep and not winkler:
+        sweep = BoundedLoadSweep(base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf)
     monitor = StallMonitor()
     while it < max_iter:
         if history and monitor.update(history[-1]):
@@ -374,161 +411,196 @@ def polonsky_keer(
                     residual_history=np.asarray(history),
                     status=STALLED,
                 )
-            it -= 1  # this iteration did not run
+            it -= 1
             break
-        # --- gap on the free set m (maintained sparsely, see HardWall) ---------------
-        np.subtract(u, h, out=g)
         if nc == 0:
-            # only possible in displacement control (load control keeps Σp = W > 0):
-            # start the free set from the points the constraint says should be free
-            # (penetrating and unloaded; with a bound, also open points at the bound -
-            # those at the bound that penetrate are where they belong)
-            g -= d
-            m[:] = 0.0
-            start = constraint.violators(p, g, m)
+            # displacement control, or bounded load control with every loaded point at the
+            # bound: start the free set from the points the constraint says should be free
+            if load_control:
+                d = fully_bound_approach(sigma * u, h, p, d)
+            g = sigma * u - h - d
+            mf = np.zeros(n)
+            start = constraint.violators(sigma * p, g, mf)
             nc = int(start.size)
             if nc == 0:
-                # every point is at a bound or open and unloaded: already the solution
                 residual = 0.0
                 history.append(0.0)
                 converged = True
-                since_fresh = 1  # recompute u below
+                since_fresh = 1
                 break
-            m[start] = 1.0
-        elif load_control:
-            # rigid-body approach = mean of (u - h) over the contact set (Lagrange mult.)
-            d = float(np.dot(g, m)) / nc
-            g -= d
+            m[:] = 0
+            m[start] = 1
+            t[:] = 0.0
+            if sweep is not None:
+                sweep.forget_bound_displacement()
+        if load_control:
+            d, big_g, gt_old, t_old_sum, recentred = _centred_moments(u, sigma, h, m, t, d, nc)
+            recentres += recentred
         else:
-            g -= d
-        np.multiply(g, m, out=gm)
-        big_g = float(np.dot(gm, gm))
-        # --- conjugate direction (t is already 0 off the free set) -------------------
+            _, big_g, gt_old, _ = _k.gap_moments(u, sigma, h, m, t, d)
+            t_old_sum = 0.0
         beta = delta * big_g / g_old if g_old > 0 else 0.0
-        if beta:
-            # t_new = g + β t_old built in gm's buffer by one axpy, then the buffers swap
-            # (gm is not needed again this iteration); Σ g t_new = G + β Σ g t_old
-            g_dot_t = big_g + beta * float(np.dot(gm, t))
-            # load control: t_old loses its sum over the free set where points were
-            # clipped; take it out again (t is 0 off the free set, so t.sum() is that sum)
-            # so the step keeps the total force. Σ_Ic g = 0 leaves Σ g t_new unchanged
-            shift = beta * float(t.sum()) / nc if load_control else 0.0
-            _axpy(t, gm, a=beta)
-            t, gm = gm, t
-            if shift:
-                _axpy(m, t, a=-shift)
-        else:
-            np.copyto(t, gm)
-            g_dot_t = big_g
+        g_dot_t = big_g + beta * gt_old if beta else big_g
+        # load control: Σ_Ic t = 0 (t_old loses its sum where points were
+        # clipped); the mean of r over Ic then drops out of Σ r t
+        shift = beta * t_old_sum / nc
+        _k.direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, *found)
         g_old = big_g
-        conv(t, r)
-        # load control: Σ_Ic t = 0 (above), so the mean of r over Ic, which Polonsky &
-        # Keer subtract, drops out of Σ r t. A one-point free set has no direction that
-        # keeps its force (its t is round-off): no descent direction (below)
-        rt = 0.0 if load_control and nc == 1 else float(np.dot(r, t))
+        if split:
+            # r = K*t in halves: Σ r t from the spectrum now, the inverse only if u follows
+            # the step incrementally (below)
+            base_op.forward(t.reshape(shape))
+            rt = base_op.multiply_energy()
+            forward_only += 1
+        else:
+            conv_t(base_op, t, r, shape)
+            calls += 1
+            rt, _ = _k.step_dots(r, t, m, comp_arg, winkler)
+        if load_control and nc == 1:
+            # a one-point free set has no direction that keeps its force (its t is
+            # round-off): no descent direction
+            rt = 0.0
         if not (rt > 0 and np.isfinite(rt)):
-            # no descent direction: the gap on the free set is nil or round-off (uniform
-            # full contact; a one-pixel free set, whose gap is 0 by definition of d under
-            # load control) or conjugacy was lost to round-off. The solution if that gap is
-            # below tol and nothing penetrates off the free set; penetrating points join the
-            # free set at p = 0 and the next (steepest-descent) iteration moves them
-            ol = constraint.violators(p, g, m)
+            # no descent direction (the gap on the free set is nil or round-off, or conjugacy
+            # was lost to round-off): the solution if the gap on
+            # the free set is below tol and nothing penetrates off it, judged on a freshly
+            # convolved u; penetrating points join the free set at p = 0 and the next
+            # (steepest-descent) iteration moves them
+            g = sigma * u - h - d
+            ol = constraint.violators(sigma * p, g, m.astype(np.float64))
             pen = float(np.abs(g[ol]).max()) if ol.size else 0.0
             residual = max(np.sqrt(big_g / nc), pen) / h_scale
+            history.append(residual)
             if residual < tol and since_fresh:
-                # judge it on a freshly convolved u, never the incremental one
                 conv(p, u)
                 since_fresh = 0
-                history.append(residual)
                 continue
             if residual < tol:
-                history.append(residual)
                 converged = True
                 break
-            m[ol] = 1.0
-            nc += ol.size
-            # lost conjugacy to round-off: restart from steepest descent
+            m[ol] = 1
+            nc += int(ol.size)
+            if sweep is not None:
+                sweep.forget_bound_displacement()
             delta = 0.0
             g_old = 0.0
-            history.append(residual)
             continue
         tau = g_dot_t / rt
-        # --- update ---------------------------------------------------------------
-        np.multiply(t, -tau, out=p_new)
-        p_new += p
-        clipped = constraint.project(p_new, m)
-        if clipped.size:
-            # pressure added by the projection (for the sparse displacement update)
-            c_clip = p_new[clipped] - (p[clipped] - tau * t[clipped])
-            t[clipped] = 0.0  # clipped points leave the free set, and the direction
-        ol = constraint.violators(p_new, g, m)
-        if ol.size:
-            p_new[ol] -= tau * g[ol]
-            m[ol] = 1.0
-            if ol.size > RESET_FRACTION * nc:
+        rms_ok = np.sqrt(big_g / max(nc, 1)) / h_scale < tol
+        if rms_ok:
+            # the convergence test below needs the pressure change: keep the old field
+            # (this pass is paid only in the last iterations; otherwise p is updated in place)
+            p_old = np.copy(p) if p_old is None else _copy(p, p_old)
+        how = None  # how u followed the step, when the bounded load step says
+        complete = True  # update's records hold every changed point (kernels.update)
+        if sweep is not None:
+            p, m, n_clip, n_add, pen, how, backtracked = sweep.step(
+                p, u, r, t, h, m, d, tau, found, idx_buf, val_buf, counts
+            )
+        elif bounded_load:
+            n_clip, n_add, pen, backtracked = bounded_load_step(
+                p, u, h, m, t, p_max, d, tau, target
+            )
+            # the step rescaled the free points only: u is taken afresh
+            conv(p, u)
+            how = "full: bounded load"
+        else:
+            psum, pen, _, complete = _k.update(
+                p, p, u, r, t, h, m, p_max, bounded, sigma, d, tau,
+                violators, idx_buf, val_buf, counts, False, not split, vidx, vg,
+                sparse_max if sparse_ok else -1,
+            )  # fmt: skip
+            n_clip = int(counts[:, 0].sum())
+            n_add = int(counts[:, 1].sum())
+            backtracked = False
+        if backtracked:
+            delta = 0.0
+            resets += 1
+        elif n_add:
+            if n_add > reset_fraction * nc:
                 delta = 0.0
                 resets += 1
             else:
                 delta = 1.0
         else:
             delta = 1.0
-        nc += ol.size - clipped.size
-        s = 1.0
-        if load_control:
-            s = load / (pixel_area * p_new.sum())
-            p_new *= s
-        changes = clipped.size + ol.size
-        if since_fresh >= refresh or (changes and not (sparse_ok and changes <= SPARSE_MAX)):
-            conv(p_new, u)
+        nc_start = nc
+        nc += n_add - n_clip
+        sigma_old = sigma
+        if load_control and not bounded_load:
+            sigma = load / (pixel_area * psum)
+        changes = n_clip + n_add
+        # a chunk with more events than its records hold: u cannot follow by point
+        # responses either
+        too_many = changes > sparse_max or not complete
+        if how is not None:
+            # the bounded load step brought u to K*p itself (sigma stays 1)
+            if how.startswith("full"):
+                since_fresh = 0
+            elif since_fresh >= refresh:
+                conv(p, u)
+                since_fresh = 0
+                sweep.forget_bound_displacement()
+                how = "full: refresh"
+            else:
+                since_fresh += 1
+            updates[how] += 1
+        elif since_fresh >= refresh or (changes and (too_many or not sparse_ok)):
+            conv(p, u)
             since_fresh = 0
+            updates["full: changes" if too_many else "full: refresh"] += 1
         else:
-            # linearity: K*(s (p - τ t + c)) = s (u - τ K*t + K*c), c the few pressures set
-            # by projection and violators: no convolution needed
-            _axpy(r, u, a=-tau)
+            updates["point responses" if changes else "linear"] += 1
+            if split:
+                # the inverse the step skipped: u -= τ/σ K*t
+                base_op.inverse(r.reshape(shape))
+                forward_only -= 1
+                calls += 1
+                _k.subtract_scaled(u, r, tau / sigma_old)
             if changes:
-                idx = np.concatenate([clipped, ol])
-                vals = np.concatenate([c_clip if clipped.size else _EMPTY_F, -tau * g[ol]])
-                operator.add_point_responses(u.reshape(shape), idx, vals)
-            u *= s
+                # u (stored, scale sigma_old) += K*c / sigma_old; u = K*p holds for the stored
+                # pair whatever their common scale, so the new scale needs no pass
+                idx, vals = _k.changed_points(counts, idx_buf, val_buf)
+                if green is None:
+                    green = base_op.real_space_kernel()
+                _k.add_point_responses(u.reshape(shape), green, idx, vals / sigma_old)
+                if winkler:
+                    # a point clipped and re-added appears twice: add.at sums both
+                    np.add.at(u, idx, compliance[idx] * vals / sigma_old)
             since_fresh += 1
-        p, p_new = p_new, p
-        # complementarity of the *previous* p, free from this iteration's numbers: the rms
-        # gap on the free set and the worst penetration off it
-        pen = float(np.abs(g[ol]).max()) if ol.size else 0.0
-        comp = max(np.sqrt(big_g / nc_prev(nc, ol, clipped)), pen) / h_scale
+        comp = max(np.sqrt(big_g / max(nc_start, 1)), pen) / h_scale
         residual = comp
-        if comp < tol:
-            # only now pay for the relative pressure change (3 passes) and a fresh check
-            np.subtract(p, p_new, out=tmp)
-            np.abs(tmp, out=tmp)
-            psum = p.sum()
-            change = float(tmp.sum() / psum) if psum > 0 else 0.0
+        if comp < tol and rms_ok:
+            change, psum_true = _k.relative_change(p, sigma, p_old, sigma_old)
+            change = float(change / psum_true) if psum_true > 0 else 0.0
             residual = max(change, comp)
             if change < tol:
+                # settle the scale into the fields (two passes, only here)
+                p *= sigma
                 if since_fresh:
                     conv(p, u)
                     since_fresh = 0
-                comp_now, d_now = _final_complementarity(
-                    u, h, p, d, load_control, constraint, m, g, gm, bwork
+                else:
+                    u *= sigma
+                sigma = 1.0
+                comp_now, d_now, nc = _final_complementarity(
+                    u, h, p, d, load_control, m, t, p_max, bounded
                 )
                 comp_now /= h_scale
                 residual = max(change, comp_now)
                 if comp_now < tol:
                     d = d_now
                     converged = True
-                # the fresh mask replaces the sparsely maintained one
-                nc = int(m.sum())
-                np.multiply(t, m, out=t)
+                t *= m  # the fresh mask replaces the sparsely maintained one
         history.append(residual)
         if converged:
             break
+    if sigma != 1.0:
+        p *= sigma
+        u *= sigma
     if since_fresh:
         conv(p, u)
-    return _finish(
-        constraint,
-        tol,
-        raise_on_failure,
-        pixel_area,
+    return finish(
         p=p,
         u=u,
         h=h,
@@ -539,10 +611,61 @@ def polonsky_keer(
         it=it,
         residual=residual,
         history=history,
-        calls=calls,
+        # a forward transform whose inverse was skipped is half a convolution's FFT work
+        calls=calls + 0.5 * forward_only,
         resets=resets,
+        extra={
+            "moment_recentres": recentres,
+            "u_updates": updates,
+            "forward_only_transforms": forward_only,
+        },
         shape=shape,
     )
+
+
+def _copy(src, dst):
+    np.copyto(dst, src)
+    return dst
+
+
+def conv_t(base_op, t, r, shape):
+    """``r = K*t`` with the plain convolution (a Winkler term is added by ``step_dots``)."""
+    base_op(t.reshape(shape), out=r.reshape(shape))
+
+
+def _centred_moments(u, sigma, h, m, t, d_old, nc):
+    """Load control: the approach ``d`` (m, the mean of ``sigma·u - h`` on the free set),
+    ``G = Σ_Ic g²`` (m²) and ``Σ g·t`` with ``g`` centred on it, ``Σ t`` (m), and whether a
+    second pass was needed.
+
+    One pass takes the moments about the previous approach; when that is far from the new
+    one (the first iteration, a warm start), ``G = Σa² - (Σa)²/nc`` would cancel
+    catastrophically (relative error ~ 1e-16 · Σa²/G), so the moments are taken again about
+    the new approach whenever ``Σa² > RECENTRE · G``: G is then good to ~1e-13.
+    """
+    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d_old)
+    mean = s1 / nc
+    d = d_old + mean
+    big_g = max(s2 - s1 * mean, 0.0)
+    if s2 <= RECENTRE * big_g:
+        return d, big_g, st - mean * tsum, tsum, 0
+    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d)
+    mean = s1 / nc
+    return d + mean, max(s2 - s1 * mean, 0.0), st - mean * tsum, tsum, 1
+
+
+def _final_complementarity(u, h, p, d, load_control, m, t, p_max, bounded):
+    """Complementarity (m), approach (m) and free-set size for the final ``p`` (fresh mask)."""
+    nc = int(_k.free_mask(p, m, p_max, bounded))
+    if load_control and nc:
+        s1, _, _, _ = _k.gap_moments(u, 1.0, h, m, t, 0.0)
+        d = s1 / nc
+    elif load_control:
+        d = fully_bound_approach(u, h, p, d)
+    s1, s2, _, _ = _k.gap_moments(u, 1.0, h, m, t, d)
+    rms = np.sqrt(max(s2, 0.0) / nc) if nc else 0.0
+    pen = _k.worst_violation(p, u, h, d, m, p_max, bounded)
+    return max(rms, pen), d, nc
 
 
 def _kernel_threads(operator, threads):
@@ -555,7 +678,7 @@ def _kernel_threads(operator, threads):
     return int(threads)
 
 
-def _finish(
+def finish_outcome(
     constraint,
     tol,
     raise_on_failure,
@@ -576,21 +699,16 @@ def _finish(
     shape,
     extra=None,
 ):
-    """The CGOutcome of a finished loop (``p`` Pa and ``u = K*p`` m, flat and fresh);
-    raises ConvergenceError on failure when ``raise_on_failure``. ``p`` and ``u`` are the
-    loop's own arrays, allocated for this solve: the outcome holds them without a copy (at
-    2048² two copies and a temporary cost ~0.2 s of fresh pages per solve)."""
+    """The :class:`~.result.Outcome` of a finished loop (``p`` Pa and ``u = K*p`` m, flat
+    and fresh); raises ConvergenceError on failure when ``raise_on_failure``. ``p`` and
+    ``u`` are the loop's own arrays, allocated for this solve: the outcome holds them
+    without a copy."""
     gap = np.subtract(u, h)
     if load_control and p.sum() > 0:
         m = np.empty(p.size)
         nc = constraint.free_mask(p, m, np.empty(p.size, dtype=bool))
-        if nc:
-            d = float(np.dot(gap, m) / nc)
-        else:
-            # bounded, every loaded point at the bound: the force does not fix d
-            from .bounded_load import fully_bound_approach
-
-            d = fully_bound_approach(u, h, p, d)
+        # bounded, every loaded point at the bound (nc = 0): the force does not fix d
+        d = float(np.dot(gap, m) / nc) if nc else fully_bound_approach(u, h, p, d)
     gap -= d
     hist = np.asarray(history)
     status, message = _status_message(converged, stalled, it, residual, tol, shape, p)
@@ -603,18 +721,20 @@ def _finish(
             residual_history=hist,
             status=status,
         )
-    return CGOutcome(
+    return Outcome(
         pressure=p.reshape(shape),
-        displacement_field=u.reshape(shape),
         gap=gap.reshape(shape),
-        rigid_displacement=float(d),
+        elastic_displacement=u.reshape(shape),
+        plastic_displacement=None,
+        displacement=float(d),
         iterations=it,
         residual=float(residual),
         history=hist,
+        convolutions=calls,
         status=status,
         message=message,
-        convolutions=calls,
-        info={"steepest_descent_resets": resets, **(extra or {})},
+        resets=resets,
+        info=dict(extra or {}),
     )
 
 
@@ -632,22 +752,3 @@ def _status_message(converged, stalled, it, residual, tol, shape, p):
         f"{residual:.3e} > tol {tol:.1e} (grid {shape[0]}x{shape[1]}, "
         f"{int(np.count_nonzero(p))} contact pixels)"
     )
-
-
-def nc_prev(nc, ol, clipped):
-    """Size of the free set at the start of the iteration (for the rms gap)."""
-    return max(nc - ol.size + clipped.size, 1)
-
-
-def _final_complementarity(u, h, p, d, load_control, constraint, m, g, gm, bwork):
-    """Complementarity measure (m) and rigid-body approach for the final ``p``."""
-    np.subtract(u, h, out=g)
-    nc = constraint.free_mask(p, m, bwork)
-    if load_control and nc:
-        d = float(np.dot(g, m)) / nc
-    g -= d
-    np.multiply(g, m, out=gm)
-    rms = np.sqrt(float(np.dot(gm, gm)) / nc) if nc else 0.0
-    ol = constraint.violators(p, g, m)
-    pen = float(np.abs(g[ol]).max()) if ol.size else 0.0
-    return max(rms, pen), d

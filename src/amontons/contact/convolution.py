@@ -39,8 +39,8 @@ from functools import lru_cache
 import numpy as np
 
 from . import fft as _fft
-from . import kernels as _kernels
-from .greens import hockney_multiplier, periodic_multiplier
+from . import spectrum as _spectrum
+from .greens import hockney_multiplier, love_square, periodic_multiplier
 
 
 def _scaled(mult, scale):
@@ -59,13 +59,11 @@ def fast_padded_shape(shape) -> tuple[int, int]:
 
 class _MultiplierMixin:
     def _multiply(self) -> None:
-        """``spec *= multiplier`` on the operator's threads, by the numba kernel: numpy's
-        complex-by-real product casts the multiplier to complex through a buffer and runs
-        at 2.3x the kernel's time on one thread (1.1 against 0.5 ms at 1024², 4.1 against
-        1.8 ms at 2048²; benchmarks/README.md, benchmark 1), the same bits (the imaginary
-        part of the cast is an exact zero)."""
-        with _kernels.kernel_threads(self.threads):
-            _kernels.multiply_spectrum(self._spec, self._mult_scaled)
+        """``spec *= multiplier`` on the operator's threads, by the numba kernel of
+        :mod:`.spectrum` (the same bits as numpy's complex-by-real product, which is slower:
+        benchmarks/README.md, benchmark 1)."""
+        with _spectrum.spectrum_threads(self.threads):
+            _spectrum.multiply_spectrum(self._spec, self._mult_scaled)
 
     @property
     def multiplier(self) -> np.ndarray:
@@ -169,7 +167,7 @@ class PeriodicConvolution(_MultiplierMixin):
 
         With :meth:`multiply_energy` and :meth:`inverse` this is ``__call__`` taken apart, so
         that the CG step can have ``Σ p·(K*p)`` from the spectrum and skip the inverse when
-        the displacement is taken afresh anyway (:mod:`.fused`). pyfftw backend only.
+        the displacement is taken afresh anyway (:mod:`.cg`). pyfftw backend only.
         """
         if _fft.aligned(p, self.shape):
             self._fwd.update_arrays(p, self._spec)
@@ -181,8 +179,8 @@ class PeriodicConvolution(_MultiplierMixin):
     def multiply_energy(self) -> float:
         """Second half: the work spectrum times the kernel's; returns ``Σ p·(K*p)``
         (m·Pa) of the field last given to :meth:`forward`, by Parseval."""
-        with _kernels.kernel_threads(self.threads):
-            return _kernels.multiply_spectrum_energy(
+        with _spectrum.spectrum_threads(self.threads):
+            return _spectrum.multiply_spectrum_energy(
                 self._spec, self._mult_scaled, self.shape[1] % 2 == 0
             )
 
@@ -346,8 +344,8 @@ class NonPeriodicConvolution(_MultiplierMixin):
     def multiply_energy(self) -> float:
         """The work spectrum times the kernel's; returns ``Σ p·(K*p)`` (m·Pa) over the
         window by Parseval on the padded grid (``p`` is zero on the padding)."""
-        with _kernels.kernel_threads(self.threads):
-            return _kernels.multiply_spectrum_energy(
+        with _spectrum.spectrum_threads(self.threads):
+            return _spectrum.multiply_spectrum_energy(
                 self._spec, self._mult_scaled, self.padded_shape[1] % 2 == 0
             )
 
@@ -442,6 +440,20 @@ def get_operator(
     )
 
 
+def operator_for(opts, shape, spacing, e_star):
+    """The cached operator of a grid of ``shape`` (spacing m, E* Pa) under a solve's
+    :class:`~.options.SolveOptions` (boundary, backend, threads, planner effort)."""
+    return get_operator(
+        shape,
+        spacing,
+        e_star,
+        periodic=opts.periodic,
+        backend=opts.backend,
+        threads=opts.threads,
+        planner_effort=opts.planner_effort,
+    )
+
+
 def direct_convolution(p: np.ndarray, spacing: float, e_star: float, *, periodic: bool):
     """Brute-force O(N⁴) convolution, for testing on tiny grids only.
 
@@ -464,8 +476,6 @@ def direct_convolution(p: np.ndarray, spacing: float, e_star: float, *, periodic
         uh = ph * mult
         u = (e0.conj().T @ uh @ e1.conj()).real / (n0 * n1)
         return u
-    from .greens import love_square
-
     half = spacing / 2
     for i in range(n0):
         for j in range(n1):

@@ -12,89 +12,31 @@ choice is written to FFTW wisdom on disk (:mod:`amontons.contact.wisdom`), which
 later process on the machine imports, so the plan, the round-off and the output bytes are
 the same from run to run, and planning is paid once per transform and machine (0.3 s for
 a 1024² pair). ``FFTW_ESTIMATE`` picks plans by heuristics without timing anything or
-touching the disk; at one thread its pairs took 1.1-1.4× (1024²) and 1.6-1.7× (2048²) the measured
-ones here (benchmarks/README.md, "FFTW planner effort"). ``FFTW_PATIENT`` and
-``FFTW_EXHAUSTIVE`` time more candidates (20 s and 150 s of planning for a 1024² and a
-2048² pair).
+touching the disk; its pairs are slower (benchmarks/README.md, "FFTW planner effort").
+``FFTW_PATIENT`` and ``FFTW_EXHAUSTIVE`` time more candidates (minutes of planning at 2048²).
 """
 
 from __future__ import annotations
 
 import contextlib
-import os
 
-# pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
-# kernels (.kernels). libgomp's default lets idle workers spin after each parallel region;
-# on a 2-core machine those spinning threads take the cores from the next region's: a 1024²
-# FFT pair on 2 threads took 48-780 ms instead of 11 ms (benchmarks/README.md, "A second
-# core"). PASSIVE makes idle workers sleep. libgomp reads it when it is loaded, so it is
-# set before pyfftw is imported; a value the user has set is kept.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+import numpy as np
 
-import numpy as np  # noqa: E402
+from .options import (  # noqa: F401 - re-exported: the backend's names, where users look
+    BACKENDS,
+    DEFAULT_PLANNER_EFFORT,
+    HAVE_PYFFTW,
+    PLANNER_EFFORTS,
+    check_planner_effort,
+    resolve_backend,
+    resolve_planner_effort,
+)
+from .wisdom import shared_wisdom
 
-from .result import ContactInputError  # noqa: E402
-from .wisdom import shared_wisdom  # noqa: E402
-
-try:  # pyfftw is optional: numpy.fft is the fallback
+if HAVE_PYFFTW:
     import pyfftw
-
-    HAVE_PYFFTW = True
-except ImportError:  # pragma: no cover - depends on the environment
+else:  # pragma: no cover - depends on the environment
     pyfftw = None
-    HAVE_PYFFTW = False
-
-BACKENDS = ("pyfftw", "numpy")
-
-# FFTW planner flags, cheapest first.
-PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
-# The planner effort of a solve when none is given, on any number of threads: measured plans
-# (kept on disk, so reproducible) were 1.1-1.7x faster than FFTW_ESTIMATE's on one thread
-# and, unlike ESTIMATE's, use a second thread (1024² pair: 8.50 ms on 1 thread, 8.35 ms on
-# 2 with ESTIMATE, 5.38 ms on 2 with MEASURE; benchmarks/README.md, "A second core").
-DEFAULT_PLANNER_EFFORT = "FFTW_MEASURE"
-
-
-def resolve_backend(backend: str | None) -> str:
-    """Return the backend name to use: ``"pyfftw"`` if available, else ``"numpy"``.
-
-    Raises
-    ------
-    ContactInputError
-        (a ValueError) For an unknown name, or ``"pyfftw"`` requested but not importable.
-    """
-    if backend is None:
-        return "pyfftw" if HAVE_PYFFTW else "numpy"
-    if backend not in BACKENDS:
-        raise ContactInputError(
-            f"unknown FFT backend {backend!r}; expected one of {BACKENDS} or None"
-        )
-    if backend == "pyfftw" and not HAVE_PYFFTW:
-        raise ContactInputError("FFT backend 'pyfftw' requested but pyfftw is not importable")
-    return backend
-
-
-def check_planner_effort(planner_effort: str) -> str:
-    """Return ``planner_effort`` if it is one of :data:`PLANNER_EFFORTS`.
-
-    Raises
-    ------
-    ContactInputError
-        (a ValueError) Naming the allowed values.
-    """
-    if not isinstance(planner_effort, str) or planner_effort not in PLANNER_EFFORTS:
-        raise ContactInputError(
-            f"planner_effort must be one of {PLANNER_EFFORTS}, got {planner_effort!r}"
-        )
-    return planner_effort
-
-
-def resolve_planner_effort(planner_effort: str | None) -> str:
-    """The planner effort of a solve: ``planner_effort`` if given (checked), else
-    :data:`DEFAULT_PLANNER_EFFORT` (numpy.fft does not plan; its operators ignore it)."""
-    if planner_effort is not None:
-        return check_planner_effort(planner_effort)
-    return DEFAULT_PLANNER_EFFORT
 
 
 def empty(shape, dtype, backend: str) -> np.ndarray:
@@ -195,21 +137,10 @@ class RealFFT2Pair:
             self.real[...] = np.fft.irfft2(self.spec, s=self.shape)
 
 
-# FFT lengths of the Hockney-padded operator (contact.convolution). FFTW has hard-coded
-# codelets for small factors and uses slower general-purpose algorithms for a large prime
-# factor; its manual (fftw.org/fftw3_doc, "Complex One-Dimensional DFTs") says it is best
-# at sizes 2^a 3^b 5^c 7^d 11^e 13^f with e + f = 0 or 1. Even sizes, because convolutions
-# on odd sizes were 20-40 % slower here (below). Time of one pruned padded convolution,
-# NonPeriodicConvolution(padded_shape=(m, m)), one thread, FFTW_ESTIMATE, 2026-11-23
-# (benchmarks/README.md, "Fast FFT lengths", "Choice of the rule"):
-#   n = 428:  34 ms on 856 = 2³·107,  7.0 ms on 864 = 2⁵·3³,  9.7 ms on 875 = 5³·7 (odd);
-#   n = 461:  29 ms on 922 = 2·461,   8.3 ms on 924 = 2²·3·7·11,  7.6 ms on 936 = 2³·3²·13,
-#             10.7 ms on 945 = 3³·5·7 (odd);
-#   n = 308:  2.9 ms on 616 = 2³·7·11, 3.7 ms on 625 = 5⁴ (odd);
-#   n = 1844: 500 ms on 3688 = 2³·461, 209 ms on 3696 = 2⁴·3·7·11, 237 ms on 3750 = 2·3·5⁴.
-# A 5-smooth length (scipy.fft.next_fast_len) pads further; it was no faster under the
-# solver's default FFTW_ESTIMATE (n = 461: 8.0 ms on 960 = 2⁶·3·5 against 8.3 ms on 924) and
-# faster under FFTW_MEASURE (5.2 against 7.3 ms); both are far from the 2n cost (23-29 ms).
+# FFT lengths of the Hockney-padded operator (contact.convolution): FFTW has hard-coded
+# codelets for small factors and is best at sizes 2^a 3^b 5^c 7^d 11^e 13^f with e + f = 0
+# or 1 (its manual, "Complex One-Dimensional DFTs"); even sizes only (odd ones were slower).
+# Measurements and the choice of the rule: benchmarks/README.md, "Fast FFT lengths".
 FAST_PRIMES = (2, 3, 5, 7)
 FAST_EXTRA = (1, 11, 13)  # at most one factor 11 or 13
 

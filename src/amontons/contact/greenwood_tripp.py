@@ -28,7 +28,7 @@ import numpy as np
 from scipy import integrate, interpolate, optimize, special
 from threadpoolctl import threadpool_limits
 
-from .result import ContactError, ContactInputError
+from .errors import ContactError, ContactInputError
 
 _H_MIN, _H_MAX = -12.0, 10.0
 

@@ -1,16 +1,14 @@
 """Fused element-wise kernels of one Polonsky–Keer CG iteration (numba).
 
-The numpy path of :func:`amontons.contact.cg.polonsky_keer` spends ~40 passes over the grid
-per iteration on masks, axpys, reductions, the projection and the violator search. These
-kernels do the same arithmetic in three or four sweeps (docs/models.md §2.2 gives the
-algorithm, :mod:`.fused` the order):
+The kernel set of :func:`amontons.contact.cg.polonsky_keer`: the element-wise work of one
+iteration (masks, reductions, the projection, the violator search, the displacement's
+share of the step) in three or four sweeps over the grid (docs/models.md §2.2 gives the
+algorithm, :mod:`.cg` the order; a plain numpy loop, the tests' reference, takes ~40):
 
 ``gap_moments``   moments of the gap on the free set (approach, ``G``, ``Σ g t_old``,
                   ``Σ t_old``);
 ``direction``     the conjugate direction ``t = m·(g + β t - shift)``, its violator count
                   per chunk, and the violators of chunks with few of them;
-``multiply_spectrum_energy``  the spectrum multiply of ``r = K*t`` with ``Σ t·(K*t)``
-                  (Parseval), so the step needs no real-space ``r``;
 ``step_dots``     ``Σ r t`` and ``Σ_Ic r`` from a real-space ``r`` (and the Winkler term
                   ``r += t/k``, so a hardening solve needs no extra pass);
 ``update``        pressure step, projection onto ``0 <= p <= p_max``, violators, free-set
@@ -25,42 +23,38 @@ Arrays are flat float64 (the free set ``m`` is uint8). Sums are taken over fixed
 for bit whatever the number of threads (``threads`` only decides who computes which
 chunk). Kernels are compiled with ``parallel=True`` and cached on disk (``cache=True``),
 and every process runs them from that cache: on a cold one the first call compiles them in
-a child process first (25-45 s, :mod:`.kernel_cache` says why). The thread count is set per
+a child process first (25-45 s, :mod:`.jit` says why). The thread count is set per
 call through :func:`numba.set_num_threads` (see :func:`kernel_threads`).
 
 Units: pressures in Pa, lengths in m; ``sigma`` is the dimensionless scale of the stored
 pressure and displacement (true value = ``sigma`` × stored), which lets load control rescale
-the field without a pass (see :mod:`amontons.contact.fused`).
+the field without a pass (see :mod:`amontons.contact.cg`).
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 
 import numba
 import numpy as np
 from numba import prange
 
-from . import kernel_cache as _kernel_cache
+from . import jit
+from .spectrum import ENTRY_POINTS as SPECTRUM_ENTRY_POINTS
 
 # Points per chunk of a reduction: fixed, so partial sums (and results) do not depend on the
 # thread count; small enough to balance 2-8 threads from 512² on, large enough that the
 # per-chunk overhead vanishes.
 CHUNK = 16384
-# Changed points (clipped + added) recorded per chunk. The fused solver applies changes as
-# point responses only when there are at most this many in total (.fused.SPARSE_MAX), so a
-# chunk never needs more slots than that.
+# Changed points (clipped + added) recorded per chunk. The solver applies changes as point
+# responses only when there are at most this many in total (.cg.SPARSE_MAX_PERIODIC,
+# SPARSE_MAX_PADDED), so a chunk never needs more slots than that.
 SLOTS = 64
 # Points per block of update's search for clipped points and direction's for violators in a
 # chunk with a few: blocks without one are passed over after a vectorised test.
 SCAN = 256
 
-# fastmath "reassoc" only: it lets LLVM vectorise the reductions (several partial sums per
-# chunk instead of one serial chain, ~4x faster here); the summation order is then fixed by
-# the compiled code, the same on every call and thread count. No "contract" (FMA) or
-# "nnan": results stay those of plain IEEE products and sums, and NaN propagates.
-_JIT = {"cache": True, "parallel": True, "nogil": True, "fastmath": {"reassoc", "nsz"}}
+_JIT = jit.JIT
 
 
 def n_chunks(n: int) -> int:
@@ -68,22 +62,14 @@ def n_chunks(n: int) -> int:
     return (n + CHUNK - 1) // CHUNK
 
 
-@contextlib.contextmanager
 def kernel_threads(threads: int):
-    """Run the kernels on ``threads`` threads (clipped to numba's pool) within the block;
-    the first call of a process first makes sure they run from numba's disk cache
-    (:mod:`.kernel_cache`)."""
-    _kernel_cache.ensure_cached(ENTRY_POINTS)
-    old = numba.get_num_threads()
-    numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
-    try:
-        yield
-    finally:
-        numba.set_num_threads(old)
+    """Context: run the kernels on ``threads`` threads (clipped to numba's pool); the first
+    call of a process first makes sure they run from numba's disk cache
+    (:func:`.jit.kernel_threads`)."""
+    return jit.kernel_threads(threads, ENTRY_POINTS)
 
 
-_FM = {"reassoc", "nsz"}
-_INNER = {"cache": True, "fastmath": _FM, "inline": "always"}
+_INNER = jit.INNER
 
 
 # Each kernel is a prange over fixed chunks calling an inner loop on the chunk's slices:
@@ -180,7 +166,7 @@ def direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, v
     """``t ← m·(sigma·u - h - d + beta·t - shift)`` in place (m); returns ``Σ t``.
 
     Load control passes ``shift = beta·Σ t_old / nc``, which keeps ``Σ t = 0`` on the free
-    set (:mod:`.fused`); displacement control passes 0.
+    set (:mod:`.cg`); displacement control passes 0.
 
     Also counts, per chunk into ``violators``, the constrained points that should be free
     (the violator test of ``update``, which does not depend on the step: ``t = 0`` there).
@@ -319,7 +305,7 @@ def update(
     and :class:`~amontons.contact.cg.BoundedWall`. With ``with_u``, ``u`` gets
     ``-tau/sigma·r`` in place; without, ``u`` is not written (the gaps of the points that
     may join are still read from it) and ``r`` is not read: the caller brings ``u`` to the
-    new pressure itself (:mod:`.fused`).
+    new pressure itself (:mod:`.cg`).
 
     ``p_max`` (Pa) has one entry per point when ``bounded`` is 1, else one entry, ignored
     (no upper bound). Changed points are recorded per chunk in ``idx[c, :]`` (flat index)
@@ -957,56 +943,6 @@ def _add_scaled(y, x, v):
 
 
 @numba.njit(**_JIT)
-def multiply_spectrum(spec, multiplier):
-    """``spec *= multiplier`` in place (complex half-spectrum times the real kernel spectrum,
-    m/Pa), rows in parallel: the one step of a convolution outside FFTW. numpy runs it on
-    one thread, and even there at 2.3x this time (it casts the multiplier to complex)."""
-    for i in prange(spec.shape[0]):
-        row = spec[i]
-        mrow = multiplier[i]
-        for j in range(row.size):
-            row[j] = row[j] * mrow[j]
-
-
-@numba.njit(**_JIT)
-def multiply_spectrum_energy(spec, multiplier, nyquist):
-    """``spec *= multiplier`` in place, as :func:`multiply_spectrum`, and return
-    ``Σ w·multiplier·|spec|²`` taken before the product: with ``spec`` the rfft2 half-spectrum
-    of a real field ``x`` and ``multiplier`` the kernel spectrum over the number of grid
-    points, that is ``Σ x·(K*x)`` (Parseval), the CG step's denominator, without the inverse
-    transform. ``nyquist``: the last column is the Nyquist one (even full length) and is
-    counted once, like column 0. Rows are summed in order: the same bits on any thread
-    count."""
-    n0, m1 = spec.shape
-    part = np.zeros(n0)
-    last = m1 - 1
-    for i in prange(n0):
-        row = spec[i]
-        mrow = multiplier[i]
-        z0 = row[0]
-        e0 = mrow[0] * (z0.real * z0.real + z0.imag * z0.imag)
-        zl = row[last]
-        el = mrow[last] * (zl.real * zl.real + zl.imag * zl.imag) if nyquist and last else 0.0
-        part[i] = 2.0 * _row_product_energy(row, mrow) - e0 - el
-    total = 0.0
-    for i in range(n0):
-        total += part[i]
-    return total
-
-
-@numba.njit(**_INNER)
-def _row_product_energy(row, mrow):
-    """``row *= mrow`` in place; returns ``Σ_j mrow_j |row_j|²`` taken before."""
-    acc = 0.0
-    for j in range(row.size):
-        z = row[j]
-        k = mrow[j]
-        acc += k * (z.real * z.real + z.imag * z.imag)
-        row[j] = z * k
-    return acc
-
-
-@numba.njit(**_JIT)
 def subtract_scaled(u, r, step):
     """``u -= step·r`` in place (the displacement's share of a CG step, m)."""
     for i in prange(u.size):
@@ -1036,7 +972,6 @@ ENTRY_POINTS = (
     free_mask,
     worst_violation,
     add_point_responses,
-    multiply_spectrum,
-    multiply_spectrum_energy,
     subtract_scaled,
+    *SPECTRUM_ENTRY_POINTS,
 )

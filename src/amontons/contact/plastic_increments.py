@@ -50,3 +50,20 @@ def volume_conserving_increment(gap: np.ndarray, periodic: bool) -> np.ndarray:
     """Eq. B.3 as a redistribution: Δh_pl = G − (sum of the four neighbours' G)/4."""
     g = penetration(gap)
     return g - 0.25 * _neighbour_sum(g, periodic)
+
+
+def increment(gap, increment: str, periodic: bool):
+    """The plastic increment (m) of ``gap`` (m): local (eq. B.2) or volume-conserving
+    (eq. B.3, ``increment="volume"``)."""
+    if increment == "local":
+        return local_increment(gap)
+    return volume_conserving_increment(gap, periodic)
+
+
+def penetration_at_bound(pressure, gap, p_max):
+    """The negative gap (m) where the pressure is at its bound ``p_max`` (Pa), 0 elsewhere.
+
+    Only points at the bound yield (appendix: "where p = p_Y the material deforms
+    plastically"); a free point's gap is the elastic solver's residual, not flow. BoundedWall
+    clips to the bound exactly, so ``>=`` is ``==`` there."""
+    return np.where((pressure >= p_max) & (gap < 0.0), gap, 0.0)

@@ -1,101 +1,100 @@
-"""Result objects, status codes, warnings and exceptions of the contact solver.
+"""What a solve returns: :class:`ContactResult` (public) with its :class:`SolveInfo` and
+:class:`CoarseLevel`, and :class:`Outcome`, the one internal outcome every route returns and
+the public result is built from.
 
 All fields are in SI units: pressures in Pa, lengths in m, forces in N, areas in m².
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
 
 import numpy as np
 
-if TYPE_CHECKING:  # pragma: no cover - annotations only
-    from .plasticity import ContactHardening, PenetrationHardness
+from .errors import (
+    CONVERGED,
+    ITERATION_CAP,
+    STALLED,
+    STATUS_NAMES,
+    ContactError,
+    ContactInputError,
+    ConvergenceError,
+    FreeBoundaryError,
+    IgnoredOptionWarning,
+)
+from .laws import ContactHardening, PenetrationHardness
 
-# Status codes of a solve (ContactResult.status, ConvergenceError.status).
-CONVERGED = 0  # every convergence criterion below tol
-ITERATION_CAP = 1  # stopped at max_iter (CG) or max_outer (plastic updates, active-set rounds)
-STALLED = 2  # stopped for another reason: residual stalled, singular problem, failed root find
+__all__ = [
+    "CONVERGED",
+    "ITERATION_CAP",
+    "STALLED",
+    "STATUS_NAMES",
+    "CoarseLevel",
+    "ContactError",
+    "ContactInputError",
+    "ContactResult",
+    "ConvergenceError",
+    "FreeBoundaryError",
+    "IgnoredOptionWarning",
+    "Outcome",
+    "SolveInfo",
+    "Tally",
+]
 
-STATUS_NAMES = {CONVERGED: "converged", ITERATION_CAP: "iteration cap reached", STALLED: "stalled"}
 
-ROUTES = ("elastic", "winkler", "appendix")
+@dataclass
+class Outcome:
+    """What a route (or one Polonsky–Keer solve) hands up: the last iterate and how it ended.
 
-
-class ContactError(Exception):
-    """Base class of every error raised by :mod:`amontons.contact`."""
-
-
-class ContactInputError(ContactError, ValueError):
-    """An input value is invalid (NaN heights, non-positive load, wrong shape, ...)."""
-
-
-class ConvergenceError(ContactError, RuntimeError):
-    """A solve did not converge (raised unless ``raise_on_failure=False``).
-
-    Attributes
-    ----------
-    iterations : int
-        Conjugate-gradient iterations performed.
-    residual : float
-        Last value of the convergence measure (dimensionless).
-    tol : float
-        Requested tolerance.
-    residual_history : numpy.ndarray
-        Convergence measure after every iteration.
-    status : int
-        The status a returned result would carry: 1 (iteration cap reached) or 2 (stalled
-        or other failure; see :class:`ContactResult`).
+    Arrays on the solver grid: ``pressure`` (Pa), ``gap``, ``elastic_displacement`` (m) and
+    ``plastic_displacement`` (m; None for a CG solve, which knows no plasticity);
+    ``displacement`` is the rigid-body approach (m). ``iterations``, ``convolutions`` and
+    ``resets`` (steepest-descent restarts) are summed over the CG solves behind it,
+    ``outer_iterations`` counts plastic updates or active-set rounds (0: none), ``history``
+    holds the residual after every CG iteration (dimensionless), ``coarse_levels`` the
+    :class:`CoarseLevel` solves of a coarse-to-fine start. ``status`` is 0 (converged),
+    1 (iteration cap) or 2 (stalled), with ``message`` saying why; ``info`` holds a CG
+    solve's counters for benchmarks (how ``u`` followed each step, forward-only transforms).
     """
 
-    def __init__(
-        self,
-        message: str,
-        *,
-        iterations: int,
-        residual: float,
-        tol: float,
-        residual_history: np.ndarray,
-        status: int = STALLED,
-    ):
-        super().__init__(message)
-        self.iterations = iterations
-        self.residual = residual
-        self.tol = tol
-        self.residual_history = residual_history
-        self.status = status
+    pressure: np.ndarray
+    gap: np.ndarray
+    elastic_displacement: np.ndarray
+    plastic_displacement: np.ndarray | None
+    displacement: float
+    iterations: int
+    residual: float
+    history: np.ndarray
+    convolutions: float
+    status: int = CONVERGED
+    message: str = ""
+    outer_iterations: int = 0
+    resets: int = 0
+    coarse_levels: tuple = ()
+    info: dict = field(default_factory=dict)
+
+    @property
+    def converged(self) -> bool:
+        """True when ``status == 0``."""
+        return self.status == CONVERGED
 
 
-class FreeBoundaryError(ContactError, RuntimeError):
-    """Non-periodic solve: pressure on the outermost ring of the window.
+@dataclass
+class Tally:
+    """Work summed over the conjugate-gradient solves of one step (iterations, convolutions,
+    steepest-descent restarts and the residual history of each :class:`Outcome` added)."""
 
-    The Hockney-padded solution is only the solution of the real (infinite half-space)
-    problem if the pressure vanishes outside the window; contact reaching the window edge
-    means the window is too small for the load.
+    iterations: int = 0
+    convolutions: float = 0.0
+    resets: int = 0
+    history: list = field(default_factory=list)
 
-    Attributes
-    ----------
-    edge_pixels : int
-        Number of pixels on the outermost ring that carry pressure.
-    edge_force : float
-        Force carried by those pixels, N.
-    """
-
-    def __init__(self, message: str, *, edge_pixels: int, edge_force: float):
-        super().__init__(message)
-        self.edge_pixels = edge_pixels
-        self.edge_force = edge_force
-
-
-class IgnoredOptionWarning(UserWarning):
-    """An option was given that has no effect on this solve and is ignored.
-
-    Issued (``warnings.warn``) by :func:`~amontons.contact.solve` and
-    :func:`~amontons.contact.solve_load_series`, once per call; the message names the option
-    and why it has no effect. Options that cannot be honoured at all raise
-    :class:`ContactInputError` instead.
-    """
+    def add(self, out: Outcome) -> None:
+        """Add the work of one CG solve."""
+        self.iterations += out.iterations
+        self.convolutions += out.convolutions
+        self.resets += out.resets
+        self.history.extend(out.history)
 
 
 @dataclass(frozen=True)
@@ -132,7 +131,7 @@ class SolveInfo:
         plastic increment, repeat, with a root find on the approach under load control).
     convolutions : float
         Convolutions on the finest grid, in FFT pairs: a forward transform whose inverse the
-        solver skipped counts 0.5 (:mod:`amontons.contact.fused`). Plastic routes under load
+        solver skipped counts 0.5 (:mod:`amontons.contact.cg`). Plastic routes under load
         control: those of the final approach only (the root find's trial approaches are not
         counted).
     steepest_descent_resets : int

@@ -1,5 +1,5 @@
-"""Stall detection of the conjugate-gradient loops (cg.polonsky_keer and its fused twin,
-fused.fused_polonsky_keer): a solve whose residual has stopped falling ends early, status
+"""Stall detection of the conjugate-gradient loop (cg.polonsky_keer): a solve whose
+residual has stopped falling ends early, status
 stalled, instead of running to max_iter (docs/models.md §2.2)."""
 
 from __future__ import annotations

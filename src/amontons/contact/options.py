@@ -1,8 +1,10 @@
-"""Validation of the inputs of :func:`~amontons.contact.solve` and
-:func:`~amontons.contact.solve_load_series`.
+"""The options of a solve, validated once into one frozen :class:`SolveOptions` that is
+passed down to every floor, and the validation of a solve's inputs.
 
 Every check raises :class:`~amontons.contact.ContactInputError` naming the value, its unit
-and what was expected, and returns the value in the form the solver uses.
+and what was expected, and returns the value in the form the solver uses. The option values
+live here too: FFT backends and planner efforts (the operators plan with them), plastic
+routes (the route table of :mod:`.routes` runs them) and the outer-loop caps.
 """
 
 from __future__ import annotations
@@ -11,17 +13,140 @@ import math
 import os
 from dataclasses import dataclass
 
-import numpy as np
+# pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
+# kernels (.kernels). libgomp's default lets idle workers spin after each parallel region;
+# on a 2-core machine those spinning threads take the cores from the next region's
+# (benchmarks/README.md, "A second core"). PASSIVE makes idle workers sleep. libgomp reads
+# it when it is loaded, so it is set before pyfftw is imported; a value the user has set is
+# kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-from .fft import resolve_backend, resolve_planner_effort
-from .plasticity import (
-    ContactHardening,
-    PenetrationHardness,
-    check_method,
-    default_max_outer,
-    resolve_route,
-)
-from .result import ContactInputError
+import numpy as np  # noqa: E402
+
+from .errors import ContactInputError  # noqa: E402
+from .laws import ContactHardening, PenetrationHardness  # noqa: E402
+
+try:  # pyfftw is optional: numpy.fft is the fallback
+    import pyfftw
+
+    HAVE_PYFFTW = True
+except ImportError:  # pragma: no cover - depends on the environment
+    pyfftw = None
+    HAVE_PYFFTW = False
+
+BACKENDS = ("pyfftw", "numpy")
+
+# FFTW planner flags, cheapest first.
+PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
+# The planner effort of a solve when none is given, on any number of threads: measured plans
+# (kept on disk, so reproducible) are faster than FFTW_ESTIMATE's and, unlike them, use a
+# second thread (benchmarks/README.md, "FFTW planner effort", "A second core").
+DEFAULT_PLANNER_EFFORT = "FFTW_MEASURE"
+
+
+def resolve_backend(backend: str | None) -> str:
+    """Return the backend name to use: ``"pyfftw"`` if available, else ``"numpy"``.
+
+    Raises
+    ------
+    ContactInputError
+        (a ValueError) For an unknown name, or ``"pyfftw"`` requested but not importable.
+    """
+    if backend is None:
+        return "pyfftw" if HAVE_PYFFTW else "numpy"
+    if backend not in BACKENDS:
+        raise ContactInputError(
+            f"unknown FFT backend {backend!r}; expected one of {BACKENDS} or None"
+        )
+    if backend == "pyfftw" and not HAVE_PYFFTW:
+        raise ContactInputError("FFT backend 'pyfftw' requested but pyfftw is not importable")
+    return backend
+
+
+def check_planner_effort(planner_effort: str) -> str:
+    """Return ``planner_effort`` if it is one of :data:`PLANNER_EFFORTS`.
+
+    Raises
+    ------
+    ContactInputError
+        (a ValueError) Naming the allowed values.
+    """
+    if not isinstance(planner_effort, str) or planner_effort not in PLANNER_EFFORTS:
+        raise ContactInputError(
+            f"planner_effort must be one of {PLANNER_EFFORTS}, got {planner_effort!r}"
+        )
+    return planner_effort
+
+
+def resolve_planner_effort(planner_effort: str | None) -> str:
+    """The planner effort of a solve: ``planner_effort`` if given (checked), else
+    :data:`DEFAULT_PLANNER_EFFORT` (numpy.fft does not plan; its operators ignore it)."""
+    if planner_effort is not None:
+        return check_planner_effort(planner_effort)
+    return DEFAULT_PLANNER_EFFORT
+
+
+METHODS = ("winkler", "bounded", "appendix")
+
+# Default caps on the outer loop (max_outer=None): plastic updates per approach of the
+# appendix scheme, and active-set rounds of the Winkler route.
+MAX_PLASTIC_UPDATES = 200
+MAX_ACTIVE_SET_ROUNDS = 50
+
+
+def check_method(method) -> None:
+    """Raise ContactInputError unless ``method`` is None or one of :data:`METHODS`."""
+    if method is not None and (not isinstance(method, str) or method not in METHODS):
+        raise ContactInputError(
+            f"method must be one of {METHODS} (or None: the law's default), got {method!r}"
+        )
+
+
+def resolve_route(law, method) -> str:
+    """The route of a plastic solve, ``"winkler"``, ``"bounded"`` or ``"appendix"``.
+
+    ``method=None`` picks the law's default: ``"winkler"`` for contact hardening with local
+    increments (exact), ``"bounded"`` for penetration hardness with local increments (one
+    bounded CG, exact), ``"appendix"`` otherwise (the only route there).
+
+    Raises
+    ------
+    ContactInputError
+        An unknown method; ``"winkler"`` or ``"bounded"`` for a law it cannot solve;
+        ``"appendix"`` for contact hardening with ``alpha = 1``.
+    """
+    check_method(method)
+    winkler_ok = isinstance(law, ContactHardening) and law.increment == "local"
+    bounded_ok = isinstance(law, PenetrationHardness) and law.increment == "local"
+    if method is None:
+        method = "winkler" if winkler_ok else "bounded" if bounded_ok else "appendix"
+    if method == "winkler" and not winkler_ok:
+        raise ContactInputError(
+            "method='winkler' (the exact elastic-plus-Winkler route) only solves "
+            f"ContactHardening with local increments, not {law!r}; use method='appendix' or "
+            "None"
+        )
+    if method == "bounded" and not bounded_ok:
+        raise ContactInputError(
+            "method='bounded' (one bounded CG under the force constraint) only solves "
+            f"PenetrationHardness with local increments, not {law!r}; use "
+            "method='appendix' or None"
+        )
+    if method == "appendix" and isinstance(law, ContactHardening) and law.alpha == 1:
+        # with p_Y = k|h_pl| and α = 1 the first update closes every gap at zero pressure,
+        # a fixed point of the scheme that is not the hardening state
+        raise ContactInputError(
+            "the iterative contact-hardening scheme needs over-relaxation alpha < 1; got 1"
+        )
+    return method
+
+
+def default_max_outer(route: str) -> int | None:
+    """Cap on the outer loop of a route when ``max_outer`` is None (None: the route has no
+    outer loop)."""
+    if route == "bounded":
+        return None
+    return MAX_ACTIVE_SET_ROUNDS if route == "winkler" else MAX_PLASTIC_UPDATES
 
 
 @dataclass(frozen=True)
@@ -30,7 +155,10 @@ class SolveOptions:
 
     ``max_iter`` is resolved from the grid; ``route`` is ``"elastic"`` without a law, else
     the plastic route; ``max_outer`` is resolved for plastic solves and None for elastic ones
-    and the ``"bounded"`` route (no outer loop).
+    and the ``"bounded"`` route (no outer loop). ``bounded_load_sweep``: the kernel set of
+    bounded load control, the fused sweep (True, the only one :func:`solve_options` gives)
+    or the numpy step with a convolution per step (False: the reference the tests select
+    with :func:`dataclasses.replace`).
     """
 
     periodic: bool
@@ -43,6 +171,21 @@ class SolveOptions:
     route: str
     max_outer: int | None
     raise_on_failure: bool
+    bounded_load_sweep: bool = True
+
+
+@dataclass(frozen=True)
+class LoadStep:
+    """What one solve is asked, beside the options: exactly one of ``load`` (N) and
+    ``displacement`` (m), a starting pressure ``warm_start`` (Pa) or None, the plastic
+    displacement left by earlier loading ``plastic_prev`` (m; None for elastic solves), and
+    whether an elastic solve starts coarse-to-fine. Validated by :func:`.api.solve`."""
+
+    load: float | None
+    displacement: float | None
+    warm_start: np.ndarray | None = None
+    plastic_prev: np.ndarray | None = None
+    coarse_to_fine: bool = False
 
 
 def solve_options(
