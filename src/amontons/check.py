@@ -162,10 +162,7 @@ def scene_coverage(run: WorkflowRun, sphere: str, side_um: float) -> dict[str, d
         cut = geometry.frame_in_scan(scene, spec, frame, side_um * 1e-6)
         coverage[scene] = {
             "simulated_mn": [f * 1e3 for f in cut.frame.loads_n],
-            "outside_scan": [
-                {"load_mn": load.load_n * 1e3, "window_um": load.window_m * 1e6}
-                for load in cut.left_out
-            ],
+            "outside_scan": [load.to_record() for load in cut.left_out],
         }
     return coverage
 

@@ -98,6 +98,10 @@ class LeftOutLoad(NamedTuple):
     load_n: float
     window_m: float
 
+    def to_record(self) -> dict:
+        """JSON-ready: the load (mN) and the window it needs (µm)."""
+        return {"load_mn": self.load_n * 1e3, "window_um": self.window_m * 1e6}
+
 
 class InScan(NamedTuple):
     """A scene's frame cut to the loads an AFM scan holds, the loads left out, and the window

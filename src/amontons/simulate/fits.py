@@ -11,6 +11,8 @@ from amontons.fits import fit_power_law
 
 # fit_power_law's standard errors need three points: a scene with fewer loads is not fitted.
 MIN_FIT_LOADS = 3
+# The exponent columns of a scene that was not fitted: empty, with left_out saying why.
+_NO_EXPONENT = {"estimate": None, "ci_low": None, "ci_high": None}
 
 
 def scene_area_fits(
@@ -106,10 +108,6 @@ def scene_table_rows(
             }
         )
     return rows
-
-
-# The exponent columns of a scene that was not fitted: empty, with left_out saying why.
-_NO_EXPONENT = {"estimate": None, "ci_low": None, "ci_high": None}
 
 
 def _exponent_columns(exponent: Mapping, measured: Mapping) -> dict:

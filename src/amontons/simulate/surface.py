@@ -185,10 +185,7 @@ class ScanCoverage:
         return {
             "scan_um": [s * 1e6 for s in self.scan_m],
             "largest_window_in_scan_um": self.largest_window_m * 1e6,
-            "outside_scan": [
-                {"load_mn": load.load_n * 1e3, "window_um": load.window_m * 1e6}
-                for load in self.left_out
-            ],
+            "outside_scan": [load.to_record() for load in self.left_out],
         }
 
 
