@@ -33,6 +33,7 @@ from threadpoolctl import threadpool_limits
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import NonPeriodicConvolution
 from amontons.contact.fft import DEFAULT_PLANNER_EFFORT
+from amontons.contact.options import CGOptions
 
 
 def factorise(m: int) -> str:
@@ -59,14 +60,11 @@ def solve_time(op, h, load, iterations, threads):
         out = polonsky_keer(
             op,
             h,
+            CGOptions(tol=1e-8, max_iter=iterations, raise_on_failure=False, threads=threads),
             pixel_area=1.0,
             h_scale=h.std(),
             p_init=np.ones_like(h),
             load=load,
-            tol=1e-8,
-            max_iter=iterations,
-            raise_on_failure=False,
-            threads=threads,
         )
     return (time.perf_counter() - t0) / out.iterations, out
 

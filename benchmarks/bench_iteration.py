@@ -52,6 +52,7 @@ from threadpoolctl import threadpool_limits
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
 from amontons.contact.fft import RealFFT2Pair, resolve_planner_effort
+from amontons.contact.options import CGOptions
 
 _ORACLE = Path(__file__).resolve().parents[1] / "tests" / "contact" / "numpy_oracle.py"
 
@@ -106,17 +107,9 @@ def solve_once(op, h, load, kernels, threads):
     t0 = time.perf_counter()
     with threadpool_limits(limits=1):
         loop = polonsky_keer if kernels else numpy_polonsky_keer
-        extra = {"threads": threads} if kernels else {}
+        options = CGOptions(tol=1e-8, max_iter=5000, threads=threads)  # the numpy loop: no threads
         out = loop(
-            timed,
-            h,
-            pixel_area=1.0,
-            h_scale=h.std(),
-            p_init=np.ones_like(h),
-            load=load,
-            tol=1e-8,
-            max_iter=5000,
-            **extra,
+            timed, h, options, pixel_area=1.0, h_scale=h.std(), p_init=np.ones_like(h), load=load
         )
     return time.perf_counter() - t0, timed.seconds, out
 

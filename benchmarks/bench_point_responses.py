@@ -27,6 +27,7 @@ from threadpoolctl import threadpool_limits
 from amontons.contact import kernels
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
+from amontons.contact.options import CGOptions
 
 BINS = ((0, 0), (1, 12), (13, 20), (21, 32), (33, 64), (65, np.inf))
 
@@ -75,8 +76,8 @@ def changes_per_iteration(n):
     try:
         with threadpool_limits(1):
             polonsky_keer(
-                op, h, pixel_area=1.0, h_scale=h.std(), p_init=np.ones_like(h), load=load,
-                tol=1e-8, max_iter=2000,
+                op, h, CGOptions(tol=1e-8, max_iter=2000), pixel_area=1.0, h_scale=h.std(),
+                p_init=np.ones_like(h), load=load,
             )  # fmt: skip
     finally:
         kernels.update = update

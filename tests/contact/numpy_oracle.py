@@ -30,20 +30,22 @@ RESET_FRACTION = 0.01
 def numpy_polonsky_keer(
     operator,
     heights,
+    options,
     *,
     pixel_area,
     h_scale,
     p_init,
     load=None,
     displacement=None,
-    tol=1e-8,
-    max_iter=1000,
-    refresh=100,
     constraint=None,
-    raise_on_failure=True,
 ):
     """:func:`amontons.contact.cg.polonsky_keer`'s algorithm in numpy passes (same
-    arguments, same outcome type; pressures Pa, lengths m)."""
+    arguments, same outcome type; pressures Pa, lengths m). Of ``options``
+    (:class:`~amontons.contact.options.CGOptions`) it reads ``tol``, ``max_iter``,
+    ``refresh`` and ``raise_on_failure``: it has no kernels to thread and no bounded
+    load control."""
+    tol, max_iter, refresh = options.tol, options.max_iter, options.refresh
+    raise_on_failure = options.raise_on_failure
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint

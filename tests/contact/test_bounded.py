@@ -8,6 +8,7 @@ import pytest
 
 from amontons.contact.cg import BoundedWall, HardWall, polonsky_keer
 from amontons.contact.convolution import get_operator
+from amontons.contact.options import CGOptions
 from amontons.contact.surfaces import self_affine
 
 
@@ -29,8 +30,8 @@ def problem():
     n = 64
     h = self_affine((n, n), 1.0, 0.8, rms_slope=0.1, rng=2)
     op = get_operator((n, n), 1.0, 1.0, periodic=True)
-    kw = {"pixel_area": 1.0, "h_scale": h.std(), "displacement": -1.0 * h.std(), "tol": 1e-10}
-    return op, h, kw
+    kw = {"pixel_area": 1.0, "h_scale": h.std(), "displacement": -1.0 * h.std()}
+    return op, h, {"options": CGOptions(tol=1e-10), **kw}
 
 
 def test_infinite_bound_is_hard_wall(problem):

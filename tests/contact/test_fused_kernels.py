@@ -10,6 +10,7 @@ tolerance or changes the iteration path.
 """
 
 import importlib.util
+from dataclasses import replace
 from pathlib import Path
 
 import numba
@@ -21,6 +22,7 @@ from amontons.contact import kernels as K
 from amontons.contact import self_affine, sphere
 from amontons.contact.cg import BoundedWall, polonsky_keer
 from amontons.contact.convolution import get_operator
+from amontons.contact.options import CGOptions
 from amontons.contact.winkler import WinklerOperator
 
 
@@ -39,11 +41,12 @@ numpy_polonsky_keer = _load_oracle()
 
 def _pair(op, h, **kw):
     """(numpy reference, fused) outcomes of the same solve."""
-    base = {"pixel_area": 1.0, "h_scale": float(h.std()), "tol": 1e-9, "max_iter": 2000}
+    options = CGOptions(tol=1e-9, max_iter=2000)
+    base = {"pixel_area": 1.0, "h_scale": float(h.std())}
     base.update(kw)
     with threadpool_limits(limits=1):  # as solve() runs it: no spinning BLAS threads
-        ref = numpy_polonsky_keer(op, h, **base)
-        new = polonsky_keer(op, h, **base)
+        ref = numpy_polonsky_keer(op, h, options, **base)
+        new = polonsky_keer(op, h, options, **base)
     return ref, new
 
 
@@ -124,16 +127,16 @@ def test_kernels_give_the_same_bits_on_one_and_two_threads(case):
     n = 600
     h = self_affine((n, n), 1.0, 0.8, rms_slope=0.1, rng=5)
     op = get_operator(h.shape, 1.0, 1.0, periodic=True)
-    kw = {"pixel_area": 1.0, "h_scale": float(h.std()), "tol": 1e-30, "max_iter": 15}
-    kw.update(raise_on_failure=False, p_init=np.ones_like(h))
+    options = CGOptions(tol=1e-30, max_iter=15, raise_on_failure=False)
+    kw = {"pixel_area": 1.0, "h_scale": float(h.std()), "p_init": np.ones_like(h)}
     if case == "bounded":
         kw.update(displacement=-1.0 * h.std(), constraint=BoundedWall(0.02))
     else:
         kw.update(load=0.005 * n * n)
     if case == "winkler":
         op = WinklerOperator(op, np.full(h.shape, 1.0 / 0.05))
-    one = polonsky_keer(op, h, threads=1, **kw)
-    two = polonsky_keer(op, h, threads=2, **kw)
+    one = polonsky_keer(op, h, replace(options, threads=1), **kw)
+    two = polonsky_keer(op, h, replace(options, threads=2), **kw)
     assert np.array_equal(one.pressure, two.pressure)
     assert np.array_equal(one.history, two.history)
 
@@ -160,7 +163,13 @@ def test_bad_thread_count_is_refused(rough):
     op = get_operator(h.shape, 1.0, 1.0, periodic=True)
     with pytest.raises(ValueError, match="threads must be a positive integer, got 0"):
         polonsky_keer(
-            op, h, pixel_area=1.0, h_scale=1.0, p_init=np.ones_like(h), load=load, threads=0
+            op,
+            h,
+            CGOptions(threads=0),
+            pixel_area=1.0,
+            h_scale=1.0,
+            p_init=np.ones_like(h),
+            load=load,
         )
 
 
@@ -217,10 +226,10 @@ def test_skipping_the_inverse_keeps_the_iterates(rough, periodic):
         h = sphere((n, n), 1.0, 4.0 * n)
         load = 4 * (n / 5) ** 3 / (3 * 4.0 * n)
     op = get_operator(h.shape, 1.0, 1.0, periodic=periodic)
-    kw = {"pixel_area": 1.0, "h_scale": float(h.std()), "tol": 1e-9, "max_iter": 2000}
-    kw.update(p_init=np.ones_like(h), load=load)
-    halves = polonsky_keer(op, h, **kw)
-    whole = polonsky_keer(_Whole(op), h, **kw)
+    options = CGOptions(tol=1e-9, max_iter=2000)
+    kw = {"pixel_area": 1.0, "h_scale": float(h.std()), "p_init": np.ones_like(h), "load": load}
+    halves = polonsky_keer(op, h, options, **kw)
+    whole = polonsky_keer(_Whole(op), h, options, **kw)
     assert halves.iterations == whole.iterations
     scale = whole.pressure.max()
     assert np.abs(halves.pressure - whole.pressure).max() <= 1e-10 * scale

@@ -31,8 +31,7 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
     approach that carries ``load`` (N). An :class:`~.result.Outcome`, converged or not."""
     pixel_area = spacing**2
     h_scale = float(np.std(heights)) or spacing
-    tol, max_iter, max_outer = opts.tol, opts.max_iter, opts.max_outer
-    periodic = opts.periodic
+    cg_options, max_outer, periodic = opts.cg, opts.max_outer, opts.periodic
     bound = _bound(law, heights.shape)
 
     def at(d, p_start):
@@ -44,12 +43,11 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
             bound,
             plastic_prev,
             d,
+            cg_options,
             increment=law.increment,
             alpha=law.alpha,
             periodic=periodic,
             p_init=p_start,
-            tol=tol,
-            max_iter=max_iter,
             max_outer=max_outer,
         )
 
@@ -77,11 +75,10 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
             h_scale,
             law.k,
             plastic_prev,
+            cg_options,
             load=load,
             displacement=None,
             p_init=p_init,
-            tol=tol,
-            max_iter=max_iter,
         )
         if not guess.converged:
             return replace(guess, message=f"starting approach (Winkler solve): {guess.message}")
@@ -90,13 +87,11 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
         elastic = polonsky_keer(
             operator,
             heights + plastic_prev,
+            cg_options,
             pixel_area=pixel_area,
             h_scale=h_scale,
             p_init=p_init,
             load=load,
-            tol=tol,
-            max_iter=max_iter,
-            raise_on_failure=False,
         )
         if not elastic.converged or np.all(elastic.pressure <= bound(plastic_prev)):
             # the bound is never reached: the elastic solution is the answer
@@ -110,7 +105,9 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
         d_guess = max(elastic.displacement, d_bearing)
     # a fully plastic contact's load is a near-staircase in d: one pixel's worth is allowed
     pixel_worth = float(np.max(bound(plastic_prev))) * pixel_area
-    return find_approach(evaluate, load, d_guess, 1e-3 * span, load_tol=tol, load_atol=pixel_worth)
+    return find_approach(
+        evaluate, load, d_guess, 1e-3 * span, load_tol=opts.tol, load_atol=pixel_worth
+    )
 
 
 def _bound(law, shape):
@@ -135,18 +132,18 @@ def plastic_iteration(
     bound,
     plastic_prev,
     displacement,
+    cg_options,
     *,
     increment,
     alpha,
     periodic,
     p_init,
-    tol,
-    max_iter,
     max_outer,
 ):
-    """Appendix scheme at a fixed approach: bounded CG on h + h_pl, then h_pl += α·Δh_pl,
-    until no yielding point penetrates by more than tol·h_scale. ``bound(h_pl)`` gives
-    p_max per pixel (Pa)."""
+    """Appendix scheme at a fixed approach: bounded CG on h + h_pl (run with ``cg_options``,
+    :class:`~.options.CGOptions`), then h_pl += α·Δh_pl, until no yielding point penetrates
+    by more than tol·h_scale. ``bound(h_pl)`` gives p_max per pixel (Pa)."""
+    tol = cg_options.tol
     h_pl = plastic_prev.copy()
     p = p_init
     tally = Tally()
@@ -155,14 +152,12 @@ def plastic_iteration(
         out = polonsky_keer(
             operator,
             heights + h_pl,
+            cg_options,
             pixel_area=pixel_area,
             h_scale=h_scale,
             p_init=p,
             displacement=displacement,
-            tol=tol,
-            max_iter=max_iter,
             constraint=BoundedWall(p_max),
-            raise_on_failure=False,
         )
         p = out.pressure
         tally.add(out)

@@ -19,7 +19,8 @@ from .result import Outcome
 def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_prev, p_init):
     """One load step of ``law`` (PenetrationHardness, local increments) from the plastic
     state ``plastic_prev`` (m), starting from ``p_init`` (Pa); an :class:`~.result.Outcome`,
-    converged or not. ``opts.bounded_load_sweep`` picks the kernel set of load control."""
+    converged or not. ``opts.bounded_load_sweep`` picks the kernel set of load control
+    (through :attr:`~.options.SolveOptions.cg`)."""
     return hardness_bounded(
         operator,
         heights,
@@ -27,12 +28,10 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
         float(np.std(heights)) or spacing,
         np.broadcast_to(np.asarray(law.p_y, dtype=float), heights.shape),
         plastic_prev,
+        opts.cg,
         load=load,
         displacement=displacement,
         p_init=p_init,
-        tol=opts.tol,
-        max_iter=opts.max_iter,
-        bounded_load_sweep=opts.bounded_load_sweep,
     )
 
 
@@ -43,13 +42,11 @@ def hardness_bounded(
     h_scale,
     p_y,
     plastic_prev,
+    cg_options,
     *,
     load,
     displacement,
     p_init,
-    tol,
-    max_iter,
-    bounded_load_sweep=True,
 ):
     """Penetration hardness with local increments (eq. B.2) in one bounded CG.
 
@@ -61,21 +58,19 @@ def hardness_bounded(
     multiplier of the force (bounded_load.impose_bounded_load), instead of a root find on the
     approach; then ``h_pl = h_pl,prev + g·θ(−g)`` where ``p = p_Y`` (m) and the gap there
     closes to ``max(g, 0)``. The plastic history enters only through the heights. Units:
-    heights, gaps, ``h_pl`` in m; ``p_y`` (per pixel) in Pa.
+    heights, gaps, ``h_pl`` in m; ``p_y`` (per pixel) in Pa. The CG runs with
+    ``cg_options`` (:class:`~.options.CGOptions`).
     """
     out = polonsky_keer(
         operator,
         heights + plastic_prev,
+        cg_options,
         pixel_area=pixel_area,
         h_scale=h_scale,
         p_init=p_init,
         load=load,
         displacement=displacement,
-        tol=tol,
-        max_iter=max_iter,
         constraint=BoundedWall(p_y),
-        raise_on_failure=False,
-        bounded_load_sweep=bounded_load_sweep,
     )
     flow = penetration_at_bound(out.pressure, out.gap, p_y)
     plastic = plastic_prev + local_increment(flow)

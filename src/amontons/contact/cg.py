@@ -60,8 +60,6 @@ positive-definite linear callable ``op(x, out=...)``, with an optional Winkler c
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 
 from . import fft as _fft
@@ -73,6 +71,7 @@ from .bounded_load import (
     impose_bounded_load,
 )
 from .errors import CONVERGED, ITERATION_CAP, STALLED, ConvergenceError
+from .options import CGOptions
 from .result import Outcome
 from .stall import StallMonitor
 
@@ -183,19 +182,14 @@ RECENTRE = 1e3
 def polonsky_keer(
     operator,
     heights,
+    options: CGOptions,
     *,
     pixel_area,
     h_scale,
     p_init,
     load=None,
     displacement=None,
-    tol=1e-8,
-    max_iter=1000,
-    refresh=100,
     constraint=None,
-    raise_on_failure=True,
-    threads=None,
-    bounded_load_sweep=True,
 ) -> Outcome:
     """Solve the contact problem by constrained conjugate gradients.
 
@@ -206,6 +200,17 @@ def polonsky_keer(
         pressure (Pa) to displacement (m) on the grid of ``heights``.
     heights : ndarray
         Rigid indenter heights, m (larger = closer to the substrate).
+    options : CGOptions
+        ``tol`` (on the residual, dimensionless), ``max_iter``, ``refresh`` (``u = K*p``
+        recomputed from scratch at least every ``refresh`` iterations, a safeguard against
+        drift of the incremental update; convergence is always declared on a fresh ``u``),
+        ``raise_on_failure`` (raise :class:`ConvergenceError` when the solve stops without
+        converging, status 1 or 2; else return the last iterate with that status),
+        ``threads`` of the kernels (None: the operator's FFTW ``threads``, else 1) and
+        ``bounded_load_sweep`` (bounded load control: True takes the fused step that keeps
+        ``u = K*p`` without a convolution, :class:`.bounded_load.BoundedLoadSweep`; False
+        the numpy step and a convolution per step, :func:`.bounded_load.bounded_load_step`,
+        the reference the tests compare with). A route's are :attr:`.SolveOptions.cg`.
     pixel_area : float
         Area of one grid cell, m².
     h_scale : float
@@ -216,48 +221,23 @@ def polonsky_keer(
         Total force W, N (load control).
     displacement : float, optional
         Rigid-body approach d, m (displacement control).
-    tol : float
-        Tolerance on the residual (dimensionless).
-    max_iter : int
-        Iteration cap.
-    refresh : int
-        Recompute ``u = K*p`` from scratch at least every ``refresh`` iterations (a
-        safeguard against drift of the incremental update; convergence is always declared
-        on a fresh ``u``).
     constraint : HardWall, optional
         The inequality constraint (default: hard wall).
-    raise_on_failure : bool
-        Raise :class:`ConvergenceError` when the solve stops without converging (status 1
-        or 2); else return the last iterate with that status.
-    threads : int, optional
-        Threads of the kernels (default: the operator's FFTW ``threads``, else 1).
-    bounded_load_sweep : bool
-        Bounded load control: True (default) takes the fused step that keeps ``u = K*p``
-        without a convolution (:class:`.bounded_load.BoundedLoadSweep`); False the numpy
-        step and a convolution per step (:func:`.bounded_load.bounded_load_step`), the
-        reference the tests compare with.
     """
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
-    with _k.kernel_threads(_kernel_threads(operator, threads)):
+    with _k.kernel_threads(_kernel_threads(operator, options.threads)):
         return _loop(
             operator,
             heights,
+            options,
             pixel_area=pixel_area,
             h_scale=h_scale,
             p_init=p_init,
             load=load,
             displacement=displacement,
-            tol=tol,
-            max_iter=max_iter,
-            refresh=refresh,
             constraint=constraint,
-            raise_on_failure=raise_on_failure,
-            sparse_max=None,
-            reset_fraction=RESET_FRACTION,
-            bounded_load_sweep=bounded_load_sweep,
-            finish=partial(finish_outcome, constraint, tol, raise_on_failure, pixel_area),
         )
 
 
@@ -284,22 +264,18 @@ def _bound_array(constraint, n):
 def _loop(
     operator,
     heights,
+    options,
     *,
     pixel_area,
     h_scale,
     p_init,
     load,
     displacement,
-    tol,
-    max_iter,
-    refresh,
     constraint,
-    raise_on_failure,
-    sparse_max,
-    reset_fraction,
-    bounded_load_sweep,
-    finish,
 ):
+    tol, max_iter, refresh = options.tol, options.max_iter, options.refresh
+    raise_on_failure = options.raise_on_failure
+    reset_fraction = RESET_FRACTION  # read per solve (benchmarks/bench_convergence.py sets it)
     load_control = load is not None
     shape = heights.shape
     n = heights.size
@@ -377,10 +353,7 @@ def _loop(
     singular_full = getattr(operator, "periodic", False) and not load_control
     # every operator of .convolution offers its real-space kernel; a custom one may not
     sparse_ok = hasattr(base_op, "real_space_kernel")
-    if sparse_max is None:
-        sparse_max = (
-            SPARSE_MAX_PERIODIC if getattr(base_op, "periodic", False) else SPARSE_MAX_PADDED
-        )
+    sparse_max = SPARSE_MAX_PERIODIC if getattr(base_op, "periodic", False) else SPARSE_MAX_PADDED
     green = None
     sweep = None
     # the convolution r = K*t taken in halves (operator.forward, .multiply_energy, .inverse):
@@ -388,7 +361,7 @@ def _loop(
     # Winkler term needs r in real space (step_dots); the bounded load step updates u itself
     split = getattr(base_op, "splits", False) and not winkler and not bounded_load
     forward_only = 0  # forward transforms whose inverse was skipped
-    if bounded_load and bounded_load_sweep and not winkler:
+    if bounded_load and options.bounded_load_sweep and not winkler:
         sweep = BoundedLoadSweep(base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf)
     monitor = StallMonitor()
     while it < max_iter:
@@ -600,7 +573,11 @@ def _loop(
         u *= sigma
     if since_fresh:
         conv(p, u)
-    return finish(
+    return finish_outcome(
+        constraint,
+        tol,
+        raise_on_failure,
+        pixel_area,
         p=p,
         u=u,
         h=h,

@@ -10,6 +10,7 @@ N.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -40,20 +41,20 @@ def solve(h, spacing, e_star, opts, step):
         spacing,
         e_star,
         opts,
+        opts.cg,
         load=step.load,
         displacement=step.displacement,
         p_init=p_init,
-        tol=opts.tol,
-        max_iter=opts.max_iter,
     )
     out.plastic_displacement = np.zeros_like(out.pressure)
     out.coarse_levels = tuple(levels)
     return out
 
 
-def run_cg(h, spacing, e_star, opts, *, load, displacement, p_init, tol, max_iter):
-    """One Polonsky–Keer solve of the hard-wall problem; returns its outcome, never raises
-    on non-convergence."""
+def run_cg(h, spacing, e_star, opts, cg_options, *, load, displacement, p_init):
+    """One Polonsky–Keer solve of the hard-wall problem on the operator of ``opts``
+    (:class:`~.options.SolveOptions`), run with ``cg_options``
+    (:class:`~.options.CGOptions`; a route's never raise): its outcome."""
     h_scale = float(np.std(h))
     if not np.ptp(h) > 0:
         # a flat indenter: any length works, the gap is round-off. (np.std of a constant
@@ -63,14 +64,12 @@ def run_cg(h, spacing, e_star, opts, *, load, displacement, p_init, tol, max_ite
     return polonsky_keer(
         operator_for(opts, h.shape, spacing, e_star),
         h,
+        cg_options,
         pixel_area=spacing**2,
         h_scale=h_scale,
         p_init=p_init,
         load=load,
         displacement=displacement,
-        tol=tol,
-        max_iter=max_iter,
-        raise_on_failure=False,
     )
 
 
@@ -121,16 +120,10 @@ def coarse_start(h, spacing, e_star, load, displacement, opts, levels=()):
     start, levels = coarse_start(hc, 2 * spacing, e_star, load, displacement, opts, levels)
     if start is None:
         start = start_pressure(hc, 2 * spacing, e_star, load, displacement)
+    # coarse levels are solved loosely, to their own grid's iteration cap
+    coarse = replace(opts.cg, tol=COARSE_TOL, max_iter=default_max_iter(hc.shape))
     out = run_cg(
-        hc,
-        2 * spacing,
-        e_star,
-        opts,
-        load=load,
-        displacement=displacement,
-        p_init=start,
-        tol=COARSE_TOL,
-        max_iter=default_max_iter(hc.shape),
+        hc, 2 * spacing, e_star, opts, coarse, load=load, displacement=displacement, p_init=start
     )
     if out.status == STALLED or not finite(out) or not out.pressure.any():
         return None, levels

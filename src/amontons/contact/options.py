@@ -150,6 +150,23 @@ def default_max_outer(route: str) -> int | None:
 
 
 @dataclass(frozen=True)
+class CGOptions:
+    """What one Polonsky–Keer solve (:func:`.cg.polonsky_keer`) is run with, beside the
+    problem: the residual ``tol`` (dimensionless), the iteration cap ``max_iter``, a fresh
+    ``u = K*p`` at least every ``refresh`` iterations, whether a solve that stops unconverged
+    raises (``raise_on_failure``; else its outcome carries the status), the kernels'
+    ``threads`` (None: the operator's FFTW threads, else 1) and the kernel set of bounded
+    load control (``bounded_load_sweep``, as :class:`SolveOptions`'s)."""
+
+    tol: float = 1e-8
+    max_iter: int = 1000
+    refresh: int = 100
+    raise_on_failure: bool = True
+    threads: int | None = None
+    bounded_load_sweep: bool = True
+
+
+@dataclass(frozen=True)
 class SolveOptions:
     """Validated options shared by every load step of a solve (SI units).
 
@@ -172,6 +189,18 @@ class SolveOptions:
     max_outer: int | None
     raise_on_failure: bool
     bounded_load_sweep: bool = True
+
+    @property
+    def cg(self) -> CGOptions:
+        """The options of every CG solve a route runs for this solve: its ``tol``,
+        ``max_iter`` and ``bounded_load_sweep``; never raising (a route returns the
+        outcome, converged or not, and :mod:`.api` decides), on the operator's threads."""
+        return CGOptions(
+            tol=self.tol,
+            max_iter=self.max_iter,
+            raise_on_failure=False,
+            bounded_load_sweep=self.bounded_load_sweep,
+        )
 
 
 @dataclass(frozen=True)

@@ -40,11 +40,10 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
         float(np.std(heights)) or spacing,
         law.k,
         plastic_prev,
+        opts.cg,
         load=load,
         displacement=displacement,
         p_init=p_init,
-        tol=opts.tol,
-        max_iter=opts.max_iter,
         max_rounds=opts.max_outer,
     )
 
@@ -69,15 +68,15 @@ def hardening_winkler(
     h_scale,
     k,
     plastic_prev,
+    cg_options,
     *,
     load,
     displacement,
     p_init,
-    tol,
-    max_iter,
     max_rounds=MAX_ACTIVE_SET_ROUNDS,
 ):
-    """Contact hardening with local increments, exact for any load history (module doc)."""
+    """Contact hardening with local increments, exact for any load history (module doc);
+    each active-set round one CG run with ``cg_options`` (:class:`~.options.CGOptions`)."""
     floor = np.maximum(-plastic_prev, 0.0)  # plastic depth already reached, m
     flowing = np.ones(heights.shape, dtype=bool)
     p = p_init
@@ -88,14 +87,12 @@ def hardening_winkler(
         out = polonsky_keer(
             WinklerOperator(operator, compliance),
             effective,
+            cg_options,
             pixel_area=pixel_area,
             h_scale=h_scale,
             p_init=p,
             load=load,
             displacement=displacement,
-            tol=tol,
-            max_iter=max_iter,
-            raise_on_failure=False,
         )
         p = out.pressure
         tally.add(out)
@@ -108,7 +105,7 @@ def hardening_winkler(
                 state,
                 message=f"elastic-plus-Winkler solve converged in {rounds} active-set "
                 f"round(s), {tally.iterations} CG iterations: residual {out.residual:.3e} < "
-                f"tol {tol:.1e}",
+                f"tol {cg_options.tol:.1e}",
             )
         switching = int(np.count_nonzero(now_flowing != flowing))
         flowing = now_flowing
