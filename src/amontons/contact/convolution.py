@@ -10,10 +10,9 @@ displacement (m) on the same grid:
     Free-space convolution with the Love kernel through Hockney padding to an ``m0 × m1``
     grid, ``m = fast_length(2n)``: the smallest FFTW-friendly even length ``>= 2n`` on each
     axis (:func:`amontons.contact.fft.fast_length`). Any ``m >= 2n`` gives the same
-    free-space result (:func:`.greens.hockney_kernel`), and a ``2n`` with a large prime
-    factor made FFTW 2.4-5× slower per call than the next fast length (3688 = 2³·461
-    against 3696 = 2⁴·3·7·11, 856 = 2³·107 against 864 = 2⁵·3³; benchmarks/README.md,
-    "Fast FFT lengths"). At least three quarters of the padded pressure are zero and only
+    free-space result (:func:`.greens.hockney_kernel`), and FFTW is several times slower on
+    a ``2n`` with a large prime factor (benchmarks/README.md, "Fast FFT lengths"). At least
+    three quarters of the padded pressure are zero and only
     one quarter of the padded displacement is wanted, so the default *pruned* transform
     skips that work:
 
@@ -283,8 +282,9 @@ class NonPeriodicConvolution(_MultiplierMixin):
         if self.pruned:
             # _rows: real rows; the right half is the padding and stays zero forever.
             # _spec: one complex work array for every stage. All column transforms run in
-            # place: FFTW's in-place strided column transforms measured ~30 % faster than
-            # out-of-place ones here, which is worth re-zeroing the lower half per call.
+            # place: FFTW's in-place strided column transforms are faster than out-of-place
+            # ones, which is worth re-zeroing the lower half per call (benchmarks/README.md,
+            # §2 "Design note").
             self._rows = _fft.empty((n0, m1), np.float64, be)
             self._spec = _fft.empty(spec_shape, np.complex128, be)
             self._out = _fft.empty((n0, m1), np.float64, be)

@@ -10,8 +10,8 @@ Planner effort is an explicit argument (no environment variable). The default,
 ``FFTW_MEASURE``, times candidate algorithms while planning and keeps the fastest; its
 choice is written to FFTW wisdom on disk (:mod:`amontons.contact.wisdom`), which every
 later process on the machine imports, so the plan, the round-off and the output bytes are
-the same from run to run, and planning is paid once per transform and machine (0.3 s for
-a 1024² pair). ``FFTW_ESTIMATE`` picks plans by heuristics without timing anything or
+the same from run to run, and planning is paid once per transform and machine.
+``FFTW_ESTIMATE`` picks plans by heuristics without timing anything or
 touching the disk; its pairs are slower (benchmarks/README.md, "FFTW planner effort").
 ``FFTW_PATIENT`` and ``FFTW_EXHAUSTIVE`` time more candidates (minutes of planning at 2048²).
 """
@@ -139,8 +139,8 @@ class RealFFT2Pair:
 
 # FFT lengths of the Hockney-padded operator (contact.convolution): FFTW has hard-coded
 # codelets for small factors and is best at sizes 2^a 3^b 5^c 7^d 11^e 13^f with e + f = 0
-# or 1 (its manual, "Complex One-Dimensional DFTs"); even sizes only (odd ones were slower).
-# Measurements and the choice of the rule: benchmarks/README.md, "Fast FFT lengths".
+# or 1 (its manual, "Complex One-Dimensional DFTs"); even sizes only. Measurements and the
+# choice of the rule, odd sizes included: benchmarks/README.md, "Fast FFT lengths".
 FAST_PRIMES = (2, 3, 5, 7)
 FAST_EXTRA = (1, 11, 13)  # at most one factor 11 or 13
 

@@ -23,7 +23,8 @@ import warnings
 import numba
 
 # fastmath "reassoc" only: it lets LLVM vectorise the reductions (several partial sums per
-# chunk instead of one serial chain, ~4x faster here); the summation order is then fixed by
+# chunk instead of one serial chain; benchmarks/README.md, "Why the kernels are written as
+# they are"); the summation order is then fixed by
 # the compiled code, the same on every call and thread count. No "contract" (FMA) or
 # "nnan": results stay those of plain IEEE products and sums, and NaN propagates.
 FASTMATH = {"reassoc", "nsz"}

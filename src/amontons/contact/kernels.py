@@ -23,8 +23,9 @@ Arrays are flat float64 (the free set ``m`` is uint8). Sums are taken over fixed
 for bit whatever the number of threads (``threads`` only decides who computes which
 chunk). Kernels are compiled with ``parallel=True`` and cached on disk (``cache=True``),
 and every process runs them from that cache: on a cold one the first call compiles them in
-a child process first (25-45 s, :mod:`.jit` says why). The thread count is set per
-call through :func:`numba.set_num_threads` (see :func:`kernel_threads`).
+a child process first (:mod:`.jit` says why; the time it takes: benchmarks/README.md,
+"Fused kernels"). The thread count is set per call through :func:`numba.set_num_threads`
+(see :func:`kernel_threads`).
 
 Units: pressures in Pa, lengths in m; ``sigma`` is the dimensionless scale of the stored
 pressure and displacement (true value = ``sigma`` × stored), which lets load control rescale
@@ -74,7 +75,8 @@ _INNER = jit.INNER
 
 # Each kernel is a prange over fixed chunks calling an inner loop on the chunk's slices:
 # a loop over a slice's own range vectorises, one over ``range(lo, hi)`` of the whole array
-# did not (measured 5x slower: LLVM cannot prove the indices non-negative).
+# does not, LLVM cannot prove the indices non-negative (benchmarks/README.md, "Why the
+# kernels are written as they are").
 
 
 @numba.njit(**_INNER)
@@ -200,10 +202,9 @@ def direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, v
 def _direction_chunk(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, lo, vidx, vg):
     """One chunk of :func:`direction`, block by block (``SCAN`` points): a block's
     vectorised sweep, then, while the chunk has at most ``SLOTS`` violators, the recording
-    of the block's own from L1. Recording the chunk after its sweep read it all again, point
-    by point, for every block with a violator: 3.3 ms became 9.5 ms at 2048² when a few
-    thousand points were violators. Returns ``(Σ t, violators)`` as ``direction`` states
-    them."""
+    of the block's own from L1, not from a second read of the chunk (benchmarks/README.md,
+    "Why the kernels are written as they are"). Returns ``(Σ t, violators)`` as
+    ``direction`` states them."""
     n = u.size
     acc = 0.0
     k = 0
@@ -342,8 +343,8 @@ def update(
     part = np.zeros((nch, 3))
     incomplete = np.zeros(nch, dtype=np.int64)
     # in place (p_new is p, the fused loop): the chunk's step is given the same slice twice,
-    # so that LLVM sees one array; two arguments that overlap at run time made it fall back
-    # to scalar loops (a heavy 2048² step: 38 ms in place against 7 ms into another array)
+    # so that LLVM sees one array; two arguments that overlap at run time make it fall back
+    # to scalar loops (benchmarks/README.md, "Why the kernels are written as they are")
     inplace = p.ctypes.data == p_new.ctypes.data
     for c in prange(nch):
         lo = c * CHUNK
@@ -441,16 +442,15 @@ def _chunk_step_events(
     ``vidx``, ``vg``), in one pass, block by block (``SCAN`` points): the block's vectorised
     step counts its clipped points; a block with one, or with a recorded violator, then
     gets ``_point_event`` for those points from L1, merged in index order, and its sums
-    taken again. Counting the clipped points in a pass of their own before the step cost
-    a read of ``p``, ``t`` and ``m`` per iteration (~1 ms at 2048²). Records past the slots
-    are dropped (the caller knows from the counts).
+    taken again; no pass of its own counts the clipped points before the step. Records past
+    the slots are dropped (the caller knows from the counts).
 
     Once a block takes the chunk's events past ``limit`` its records are of no use (the
     caller follows the step by a convolution), so under the hard wall (without
     ``keep_mask`` or ``with_u``) that block's and every later block's clipped points are
-    handled branch-free (``_block_clips_hard``): visited one by one, a chunk with thousands
-    took 4× the old count-then-sweep. Returns ``(Σ p_new, Σ p_new at p_max, max |g| of the
-    joining points, clipped, joined)``."""
+    handled branch-free (``_block_clips_hard``), not visited one by one
+    (benchmarks/README.md, "Why the kernels are written as they are"). Returns
+    ``(Σ p_new, Σ p_new at p_max, max |g| of the joining points, clipped, joined)``."""
     step = tau / sigma
     n = p.size
     ev = np.zeros(2, dtype=np.int64)
@@ -555,10 +555,10 @@ def _chunk_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau):
     ``u`` left alone, without records: ``_point_event``'s rules written branch-free for the
     vectoriser (a constrained point has ``p = 0`` under the hard wall: points leave the
     free set only by clipping to 0), block by block (``SCAN`` points). A running maximum of
-    the penetration kept LLVM from vectorising the sweep (3.2 against 1.7 ns per point on a
-    cached chunk here), so each block writes its points' penetrations to a small buffer
-    that stays in L1, and the maximum is taken over it afterwards. Returns as
-    ``_chunk_step_events``."""
+    the penetration keeps LLVM from vectorising the sweep, so each block writes its points'
+    penetrations to a small buffer that stays in L1, and the maximum is taken over it
+    afterwards (benchmarks/README.md, "Why the kernels are written as they are"). Returns
+    as ``_chunk_step_events``."""
     step = tau / sigma
     buf = np.empty(SCAN)
     acc = 0.0
@@ -587,8 +587,8 @@ def _block_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau, step, pens):
     acc = 0.0
     nclip = 0
     nadd = 0
-    # boolean lanes and a select for the joining value: 1.0 against 1.9 ns per point on a
-    # cached chunk for 0/1 float factors (from memory both run at the bandwidth)
+    # boolean lanes and a select for the joining value, not 0/1 float factors
+    # (benchmarks/README.md, "Why the kernels are written as they are")
     for i in range(p.size):
         free = m[i] != 0
         q = p[i] - step * t[i]
@@ -611,8 +611,7 @@ def _block_bulk_hard(p, p_new, u, t, h, m, sigma, d, tau, step, pens):
 @numba.njit(**_INNER)
 def _max_from_zero(x):
     """``max(0, max(x))`` in four independent running maxima (a single chain waits on each
-    compare: 0.6 against 0.3 ns per point here); NaN entries are passed over, as by
-    ``max(a, nan)``."""
+    compare); NaN entries are passed over, as by ``max(a, nan)``."""
     a0 = a1 = a2 = a3 = 0.0
     n4 = x.size - x.size % 4
     for i in range(0, n4, 4):
@@ -929,8 +928,8 @@ def add_point_responses(u, green, idx, values):
             v = values[k]
             g = green[(i - a) % big0]
             # columns j >= b read g[j - b]; columns j < b wrap to g[big1 - b + j]. On
-            # slices: a loop indexing g[j - b] did not vectorise (LLVM cannot prove the
-            # index non-negative), 4.4 against 1.8 ms per point at 2048²
+            # slices: a loop indexing g[j - b] does not vectorise (LLVM cannot prove the
+            # index non-negative; benchmarks/README.md, §1)
             _add_scaled(row[b:], g[: n1 - b], v)
             _add_scaled(row[:b], g[big1 - b : big1], v)
 

@@ -1,7 +1,7 @@
 """The spectrum multiply of a convolution, on the operator's threads (numba kernels).
 
 ``multiply_spectrum``         ``spec *= multiplier``: the one step of a convolution outside
-                              FFTW (numpy runs it on one thread, at 2.3x this time);
+                              FFTW, on the operator's threads;
 ``multiply_spectrum_energy``  the same, returning ``Σ x·(K*x)`` (Parseval) taken before the
                               product, so a CG step needs no inverse transform.
 
@@ -24,8 +24,9 @@ _INNER = jit.INNER
 @numba.njit(**_JIT)
 def multiply_spectrum(spec, multiplier):
     """``spec *= multiplier`` in place (complex half-spectrum times the real kernel spectrum,
-    m/Pa), rows in parallel: the one step of a convolution outside FFTW. numpy runs it on
-    one thread, and even there at 2.3x this time (it casts the multiplier to complex)."""
+    m/Pa), rows in parallel: the one step of a convolution outside FFTW. Not numpy's product,
+    which runs on one thread and casts the multiplier to complex (benchmarks/README.md, "Why
+    the kernels are written as they are")."""
     for i in prange(spec.shape[0]):
         row = spec[i]
         mrow = multiplier[i]

@@ -7,10 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 # A solve has stalled when its best residual has not fallen by STALL_FACTOR in STALL_WINDOW
-# iterations. Conservative by design: over the 3781 convergent CG solves of the test suite
-# and rough periodic, free and plastic solves up to 1024² (rms slope 0.1-1, 1e-4 to 5 % of
-# E* h'), the longest stretch without a 2x fall of the best residual was 26 iterations
-# (without a 10x fall, 36); 200 is 8x that, and a fifth of the smallest default max_iter.
+# iterations. Conservative by design: well above the longest such stretch seen in converging
+# solves (benchmarks/README.md, "Stall window"), and a fifth of the smallest default max_iter.
 STALL_WINDOW = 200
 STALL_FACTOR = 2.0
 
