@@ -23,22 +23,35 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _imports(path: Path) -> set[str]:
-    """Every amontons module ``path`` imports (relative imports resolved)."""
+def _import_pairs(path: Path) -> list[tuple[str, str | None]]:
+    """Every import in ``path``, at any depth, as ``(module, name)``: ``(x.y, None)`` for
+    ``import x.y``, ``(base, name)`` for ``from base import name`` with relative bases
+    resolved (``from . import kernels`` in amontons/contact/cg.py is
+    ``("amontons.contact", "kernels")``)."""
     tree = ast.parse(path.read_text(), filename=str(path))
     here = _module_name(path).split(".")
     if path.name != "__init__.py":
         here = here[:-1]
-    found = set()
+    pairs = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
-            found.update(alias.name for alias in node.names)
+            pairs += [(alias.name, None) for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
             base = node.module or ""
             if node.level:
                 base = ".".join(here[: len(here) - node.level + 1] + ([base] if base else []))
-            found.add(base)
-            found.update(f"{base}.{alias.name}" for alias in node.names)
+            pairs += [(base, alias.name) for alias in node.names]
+    return pairs
+
+
+def _imports(path: Path) -> set[str]:
+    """Every amontons module ``path`` imports (relative imports resolved): for ``from base
+    import name`` both ``base`` and ``base.name``."""
+    found = set()
+    for base, name in _import_pairs(path):
+        found.add(base)
+        if name is not None:
+            found.add(f"{base}.{name}")
     return {name for name in found if name == "amontons" or name.startswith("amontons.")}
 
 
@@ -214,21 +227,10 @@ def _contact_imports(path: Path) -> set[str]:
     """The amontons.contact modules ``path`` imports: a name imported from a package is that
     module if it is one, else the package (``from . import kernels`` is kernels,
     ``from amontons.contact import solve`` is the package's __init__)."""
-    tree = ast.parse(path.read_text(), filename=str(path))
-    here = _module_name(path).split(".")
-    if path.name != "__init__.py":
-        here = here[:-1]
     found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            found.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                base = ".".join(here[: len(here) - node.level + 1] + ([base] if base else []))
-            for alias in node.names:
-                full = f"{base}.{alias.name}"
-                found.add(full if full in IMPORTS else base)
+    for base, name in _import_pairs(path):
+        full = base if name is None else f"{base}.{name}"
+        found.add(full if full in IMPORTS else base)
     return {n for n in found if n == CONTACT or n.startswith(CONTACT + ".")}
 
 
