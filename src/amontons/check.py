@@ -180,6 +180,7 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
         "loads_mn": run.spheres.loads_mn(sphere),
         "outputs": outputs,
         "left_out": run.spheres.left_out(sphere) + run.scenes.left_out(sphere),
+        "failed": run.spheres.failed_lines(sphere),
         "files": [],
         "errors": [],
     }
@@ -245,6 +246,7 @@ def report(plans: list[dict]) -> str:
         lines.append(f"  will make {len(plan['outputs'])} files:")
         lines += [f"    {path}" for path in plan["outputs"]]
         lines += [f"  will not make: {line}" for line in plan["left_out"]]
+        lines += [f"  held out: {line}" for line in plan["failed"]]
         for scene, coverage in plan["scenes"].items():
             lines += _outside_scan_lines(scene, coverage, plan["scan_side_um"])
     return "\n".join(lines)
