@@ -27,6 +27,7 @@ from amontons.io.layout import (
     confocal_file,
     flim_file,
     fluorescence_images,
+    folder_files,
     rheometer_files,
 )
 from amontons.io.pixel_probe import states_pixel_size
@@ -304,7 +305,7 @@ class Spheres:
         digest = hashlib.sha256(salt.encode())
         digest.update(json.dumps(self.records[sphere], sort_keys=True, default=str).encode())
         shared = [self.records[sphere].get(column) for column in SHARED_FILE_COLUMNS.values()]
-        for path in _files_below(self.raw_dir(sphere)) + [p for p in shared if p]:
+        for path in folder_files(self.raw_dir(sphere)) + [p for p in shared if p]:
             if os.path.isfile(path):
                 stat = os.stat(path)
                 digest.update(f"{path}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
@@ -375,11 +376,6 @@ def _states_pixel(path: str) -> bool:
         return states_pixel_size(path)
     except RawDataError:
         return True
-
-
-def _files_below(folder: str) -> list[str]:
-    """Every file below ``folder``, sorted (none where it is not there)."""
-    return sorted(os.path.join(root, name) for root, _, names in os.walk(folder) for name in names)
 
 
 def names_pattern(names) -> str:
