@@ -4,6 +4,7 @@ less the file the case is about, so that every output it still makes can be comp
 the complete copy's, made in the same run."""
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -369,18 +370,20 @@ def test_a_scan_that_holds_no_load_gets_a_record_and_no_failed_job(lab_run):
     assert len(json.loads((gt / "solve.json").read_text())["loads"]) == 5
 
 
-def test_the_check_predicts_the_loads_outside_the_scan(lab_run):
+def test_the_check_and_the_dry_run_predict_the_loads_outside_the_scan(lab_run):
     """The check reads each scan's size and, with the apex at its centre, names the loads the
-    run then leaves out."""
-    project, _, check, _ = lab_run
+    run then leaves out; so does the dry run, from the TIFF scans' headers."""
+    project, dry, check, _ = lab_run
     plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
+    said = dry.stdout + dry.stderr
     for sphere in (*CUT_SCANS, COMPLETE):
         predicted = plans[sphere]["scenes"]["elastic"]
         solve = _scene_record(project, sphere, "solve.json")
         assert predicted["simulated_mn"] == solve["loads_mn"], sphere
-        assert [r["load_mn"] for r in predicted["outside_scan"]] == [
-            r["load_mn"] for r in solve["outside_scan"]
-        ], sphere
+        left_out = [r["load_mn"] for r in solve["outside_scan"]]
+        assert [r["load_mn"] for r in predicted["outside_scan"]] == left_out, sphere
+        named = re.findall(rf"sphere {sphere} \(PS\): scene elastic: (\S+) mN outside_scan", said)
+        assert [float(load) for load in named] == left_out, sphere
 
 
 def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_run, tmp_path):

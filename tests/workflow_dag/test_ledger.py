@@ -7,40 +7,15 @@ import os
 import shutil
 from pathlib import Path
 
-import pandas as pd
-import pytest
-
 from amontons.workflow.failures import FAILED_JOBS, FailedJob, read_failed_jobs
 from amontons.workflow.ledger import merged, record_failures, settle_ledger, write_ledger
 from amontons.workflow.paths import RunPaths
-
-from .conftest import build_run
 
 DATA = Path(__file__).parent / "data"
 RUN_LOG = DATA / "failed_run.snakemake.log"
 PATHS = RunPaths("small")
 AREA = "results/small/PS/PS/measure/contact_area.csv"
 LEDGER = Path("results/small") / FAILED_JOBS
-
-
-@pytest.fixture
-def lab_project(repo, tmp_path, monkeypatch):
-    """A project folder (the working directory) whose sheet makes PS a measured sphere in
-    lab/PS; returns a function that builds the run as the DAG does."""
-    monkeypatch.chdir(tmp_path)
-    lab = tmp_path / "lab" / "PS"
-    for name in ("reflection.tif", "bead.tif", "absorbance.csv", "afm_before.tif"):
-        (lab / name).parent.mkdir(parents=True, exist_ok=True)
-        (lab / name).write_text("")  # found, never read: the DAG only looks for them
-    (lab / "rheometer").mkdir()
-    sheet = pd.read_csv(repo / "config" / "materials.tsv", sep="\t", dtype=str)
-    sheet.loc[sheet["sphere"] == "PS", "data_source"] = str(lab)
-    sheet.to_csv(tmp_path / "sheet.tsv", sep="\t", index=False)
-
-    def edit(config):
-        config.update(materials_sheet=str(tmp_path / "sheet.tsv"))
-
-    return lambda: build_run(repo, edit=edit)
 
 
 def _ledger_of_ps(run, outputs=AREA, stamp=None):
@@ -58,13 +33,13 @@ def _ledger_of_ps(run, outputs=AREA, stamp=None):
     return job
 
 
-def test_a_sphere_with_a_failed_job_is_held_out_of_its_tables_and_its_job_retried(lab_project):
-    before = lab_project()
+def test_a_sphere_with_a_failed_job_is_held_out_of_its_tables_and_its_job_retried(measured_ps):
+    before = measured_ps()
     assert before.spheres.of("PS") == ["PS"] and not before.spheres.held_out
     figures = before.targets.figures(["PS"])
     assert any(path.startswith("results/small/PS/load_area.") for path in figures)
     job = _ledger_of_ps(before)
-    run = lab_project()
+    run = measured_ps()
     assert list(run.spheres.held_out) == ["PS"]
     assert run.spheres.of("PS") == []
     # no PS table or figure is asked for; the failed job is, so the run fails while it does
@@ -81,27 +56,27 @@ def test_a_sphere_with_a_failed_job_is_held_out_of_its_tables_and_its_job_retrie
     assert run.spheres.of("glass") == before.spheres.of("glass") == ["glass"]
 
 
-def test_changed_data_or_config_let_the_sphere_back(lab_project, tmp_path):
-    run = lab_project()
+def test_changed_data_or_config_let_the_sphere_back(measured_ps, tmp_path):
+    run = measured_ps()
     _ledger_of_ps(run)
-    assert lab_project().spheres.held_out
+    assert measured_ps().spheres.held_out
     image = tmp_path / "lab" / "PS" / "bead.tif"
     image.write_text("a new bead image")
-    assert not lab_project().spheres.held_out
-    _ledger_of_ps(lab_project())
-    assert lab_project().spheres.held_out
+    assert not measured_ps().spheres.held_out
+    _ledger_of_ps(measured_ps())
+    assert measured_ps().spheres.held_out
     stat = image.stat()
     os.utime(image, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1_000_000_000))  # re-saved
-    assert not lab_project().spheres.held_out
+    assert not measured_ps().spheres.held_out
     _ledger_of_ps(run, stamp="a stamp under another config")
-    assert not lab_project().spheres.held_out
+    assert not measured_ps().spheres.held_out
 
 
-def test_a_job_that_has_made_its_outputs_holds_nothing_out(lab_project):
-    _ledger_of_ps(lab_project())
+def test_a_job_that_has_made_its_outputs_holds_nothing_out(measured_ps):
+    _ledger_of_ps(measured_ps())
     Path(AREA).parent.mkdir(parents=True)
     Path(AREA).write_text("sphere,load_mn\n")
-    assert not lab_project().spheres.held_out
+    assert not measured_ps().spheres.held_out
     assert settle_ledger(PATHS, held=["PS"]) == [
         "sphere PS: its failed jobs now succeed; this run's tables were made without it, run "
         "again to put it back"
@@ -109,10 +84,10 @@ def test_a_job_that_has_made_its_outputs_holds_nothing_out(lab_project):
     assert not LEDGER.exists()  # no entry left: no ledger
 
 
-def test_a_failed_run_stamps_its_jobs_and_says_what_a_rerun_does(lab_project):
+def test_a_failed_run_stamps_its_jobs_and_says_what_a_rerun_does(measured_ps):
     """As Snakefile's onerror calls it, on the real log of the corrupt-file run (sphere
     PS-corrupt of material PS); the earlier entry of another sphere, still pending, stays."""
-    run = lab_project()
+    run = measured_ps()
     earlier = _ledger_of_ps(run)
     stamps = {"PS-corrupt": "stamp of PS-corrupt"}
     lines = record_failures([str(RUN_LOG)], PATHS, stamps.get, held=[])

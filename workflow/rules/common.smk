@@ -59,6 +59,9 @@ MATERIALS = RUN.materials
 # A sphere's missing optional file removes only what needs it: say so before any job.
 for _line in RUN.left_out():
     logger.warning(_line)
+# ... and the loads an AFM scan too small for them leaves out, where its header gives its size.
+for _line in RUN.outside_scan():
+    logger.warning(_line)
 # A sphere whose job failed in an earlier run is held out of the tables: say so, and why.
 for _line in RUN.failed():
     logger.warning(_line)

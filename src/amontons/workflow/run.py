@@ -96,6 +96,15 @@ class WorkflowRun:
             for line in self.spheres.left_out(sphere) + self.scenes.left_out(sphere)
         ]
 
+    def outside_scan(self) -> list[str]:
+        """Per measured sphere whose AFM scan's size its header gives, the loads each scene
+        will leave outside the scan (amontons.workflow.scenes)."""
+        return [
+            f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
+            for sphere in self.spheres
+            for line in self.scenes.predicted_outside_scan(sphere)
+        ]
+
     def failed(self) -> list[str]:
         """Per sphere held out by an earlier run's failure, each failed job and what the
         sphere is held out of (amontons.workflow.ledger)."""
