@@ -35,10 +35,18 @@ include: "workflow/rules/summary.smk"
 
 
 # A failed run names, per sphere, each step that failed and its error, and keeps them in
-# results/<run>/failed_jobs.csv (docs/workflow.md, "When a job fails").
+# results/<run>/failed_jobs.csv, which the next run reads to make the tables without the
+# failed spheres (docs/workflow.md, "When a job fails"; amontons.workflow.ledger).
 onerror:
-    for line in report_failed_jobs(log, RUN.paths):
+    for line in record_failures(
+        log, RUN.paths, RUN.data_stamp, RUN.spheres.held_out
+    ):
         logger.error(line)
+
+
+onsuccess:
+    for line in settle_ledger(RUN.paths, RUN.spheres.held_out):
+        logger.warning(line)
 
 
 # Default target: every output of every selected material.

@@ -29,8 +29,10 @@ def main(
     data_label: str,
     confidence: float,
     left_out: list[str],
+    failed: list[str],
 ) -> None:
-    """``left_out``: per sphere, what its data did not allow and why (the dry run's lines)."""
+    """``left_out``: per sphere, what its data did not allow and why (the dry run's lines);
+    ``failed``: per sphere held out by an earlier run's failure, its failed jobs."""
     verdict = None if layout["verdict"] is None else pd.read_csv(layout["verdict"])
     amontons = {m: pd.read_csv(p) for m, p in layout["amontons"].items()}
     headlines = []
@@ -53,6 +55,7 @@ def main(
         layout["verdict"],
         headlines,
         left_out,
+        failed,
     )
     with atomic_path(summary_path) as tmp:
         tmp.write_text(text, encoding="utf-8")
@@ -70,4 +73,5 @@ if __name__ == "__main__":
         data_label=sm.params.data_label,
         confidence=sm.params.confidence,
         left_out=sm.params.left_out,
+        failed=sm.params.failed,
     )

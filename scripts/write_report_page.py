@@ -20,8 +20,10 @@ def main(
     data_label: str,
     confidence: float,
     left_out: list[str],
+    failed: list[str],
 ) -> None:
-    """``left_out``: per sphere, what its data did not allow and why (the dry run's lines)."""
+    """``left_out``: per sphere, what its data did not allow and why (the dry run's lines);
+    ``failed``: per sphere held out by an earlier run's failure, its failed jobs."""
     page = report_page(
         pd.read_csv(verdict_path),
         [ReportFigure(png, caption) for png, caption in figures.items()],
@@ -30,6 +32,7 @@ def main(
         sources,
         verdict_path,
         left_out,
+        failed,
     )
     with atomic_path(page_path) as tmp:
         tmp.write_text(page, encoding="utf-8")
@@ -48,4 +51,5 @@ if __name__ == "__main__":
         data_label=sm.params.data_label,
         confidence=sm.params.confidence,
         left_out=sm.params.left_out,
+        failed=sm.params.failed,
     )

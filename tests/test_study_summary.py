@@ -173,3 +173,22 @@ def test_the_first_page_and_the_summary_say_what_the_data_did_not_allow():
     )
     text = summary_markdown("small", "measured data", None, None, [], [reason])
     assert text.endswith(f"## What the data did not allow\n\n- {reason}\n")
+
+
+def test_a_failed_sphere_is_named_on_the_first_page_and_in_the_summary():
+    """A sphere held out by a failed job is marked failed, with its step and error, before
+    what the data did not allow: valid reStructuredText, and its own section of summary.md."""
+    verdict = pd.DataFrame(verdict_rows(models_table(), "PS", "models.csv"))
+    failed = (
+        "sphere PS-2 (PS): failed in an earlier run: measure_contact_area: RawDataError: "
+        "lab/PS-2/fluorescence/100.tif: not a readable TIFF [logs/x.log]"
+    )
+    reason = "sphere PS-3 (PS): no rheometer/ folder in lab/PS-3: the friction will not be made"
+    page = report_page(verdict, [], 0.95, "measured data", ["m.csv"], "v.csv", [reason], [failed])
+    html = publish_parts(page, writer="html", settings_overrides={"report_level": 1})["html_body"]
+    assert "System Message" not in html
+    assert html.index("Failed: held out of every table") < html.index("not a readable TIFF")
+    assert html.index("not a readable TIFF") < html.index("What the data did not allow")
+    text = summary_markdown("small", "measured data", None, None, [], [reason], [failed])
+    assert f"## Failed: held out of every table and figure\n\n- {failed}\n\n## What" in text
+    assert "Failed" not in summary_markdown("small", "measured data", None, None, [], [reason])

@@ -18,7 +18,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from amontons.config import ConfigError, geometry, read_config
+from amontons.config import ConfigError, read_config
 from amontons.io.absorbance import read_absorbance_csv
 from amontons.io.confocal import ImageChoice, read_confocal
 from amontons.io.heightmap import read_heights
@@ -27,6 +27,7 @@ from amontons.io.rheometer import read_rheometer_csv
 from amontons.io.tiff import read_tiff
 from amontons.workflow.params import image_choice
 from amontons.workflow.run import WorkflowRun
+from amontons.workflow.scenes import outside_scan_lines
 from amontons.workflow.spheres import AFM_AFTER, AFM_BEFORE, RHEOMETER, Spheres
 
 # The workflow folder of a clone or an editable install (schemas, measured resources).
@@ -147,26 +148,6 @@ def scan_side_um(files: list[dict], afm_before: str) -> float | None:
     return min(record["shape"]) * record["pixel_nm"] * 1e-3
 
 
-def scene_coverage(run: WorkflowRun, sphere: str, side_um: float) -> dict[str, dict]:
-    """Per scene that solves on the sphere's map: the loads (mN) its window keeps inside an
-    AFM scan of ``side_um`` and those left out (``outside_scan``), with the apex taken at the
-    scan's centre. The run fits the apex; one off centre holds a smaller window, so the run
-    may leave out more (amontons.simulate.surface.afm_scene)."""
-    record = run.spheres.scene_record(sphere)
-    coverage = {}
-    for scene in run.scenes.runnable(sphere):
-        spec = run.scenes.config(scene)
-        if spec["model"] == "greenwood_tripp":
-            continue  # mean-field: no window on the map
-        frame = geometry.sphere_frame(spec, record)
-        cut = geometry.frame_in_scan(scene, spec, frame, side_um * 1e-6)
-        coverage[scene] = {
-            "simulated_mn": [f * 1e3 for f in cut.frame.loads_n],
-            "outside_scan": [load.to_record() for load in cut.left_out],
-        }
-    return coverage
-
-
 def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
     """What the run makes of one sphere and what it cannot, and why."""
     material = run.spheres.material_of(sphere)
@@ -180,6 +161,7 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
         "loads_mn": run.spheres.loads_mn(sphere),
         "outputs": outputs,
         "left_out": run.spheres.left_out(sphere) + run.scenes.left_out(sphere),
+        "failed": run.spheres.failed_lines(sphere),
         "files": [],
         "errors": [],
     }
@@ -192,7 +174,7 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
     if run.spheres.has(sphere, AFM_BEFORE):
         side_um = scan_side_um(record["files"], run.spheres.afm_path(sphere, AFM_BEFORE))
     record["scan_side_um"] = side_um
-    record["scenes"] = {} if side_um is None else scene_coverage(run, sphere, side_um)
+    record["scenes"] = {} if side_um is None else run.scenes.scan_coverage(sphere, side_um)
     return record
 
 
@@ -220,18 +202,6 @@ def _file_line(record: dict) -> str:
     return f"    {record['path']} [{record['format']}]: {', '.join(details)}"
 
 
-def _outside_scan_lines(scene: str, coverage: dict, side_um: float) -> list[str]:
-    lines = []
-    for row in coverage["outside_scan"]:
-        lines.append(
-            f"  scene {scene}: {row['load_mn']:g} mN outside_scan (its window of "
-            f"{row['window_um']:.1f} µm exceeds the {side_um:.1f} µm scan)"
-        )
-    if not coverage["simulated_mn"]:
-        lines.append(f"  scene {scene}: the AFM scan holds no load's window; nothing simulated")
-    return lines
-
-
 def report(plans: list[dict]) -> str:
     """The plans as text, a block per sphere."""
     lines = []
@@ -245,8 +215,11 @@ def report(plans: list[dict]) -> str:
         lines.append(f"  will make {len(plan['outputs'])} files:")
         lines += [f"    {path}" for path in plan["outputs"]]
         lines += [f"  will not make: {line}" for line in plan["left_out"]]
+        lines += [f"  held out: {line}" for line in plan["failed"]]
         for scene, coverage in plan["scenes"].items():
-            lines += _outside_scan_lines(scene, coverage, plan["scan_side_um"])
+            lines += [
+                f"  {line}" for line in outside_scan_lines(scene, coverage, plan["scan_side_um"])
+            ]
     return "\n".join(lines)
 
 

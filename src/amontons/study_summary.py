@@ -51,6 +51,8 @@ MODEL_TABLE_COLUMNS = (
 )
 # verdict.csv's column stem of a scanned parameter.
 PARAMETER_STEMS = {"k_mpa_per_nm": "k", "p_y_mpa": "p_y"}
+# The section of the summary and the report that names the spheres a failed job holds out.
+FAILED_TITLE = "Failed: held out of every table and figure"
 
 
 class SummaryError(ValueError):
@@ -278,12 +280,14 @@ def report_page(
     sources: Sequence[str],
     verdict_path: str,
     left_out: Sequence[str] = (),
+    failed: Sequence[str] = (),
 ) -> str:
     """The report's first page (reStructuredText, included by workflow/report/workflow.rst):
     the verdict table (``verdict``, read from ``verdict_path``, made from the model tables
-    ``sources``), what the spheres' data did not allow (``left_out``, one line each, so that
-    a missing row or figure is never a silent gap), then ``figures`` (Fig. B.13 and each
-    sphere's Fig. B.12)."""
+    ``sources``), the spheres held out because a job of theirs failed (``failed``) and what
+    the spheres' data did not allow (``left_out``; one line each, so that a missing row or
+    figure is never a silent gap), then ``figures`` (Fig. B.13 and each sphere's Fig.
+    B.12)."""
     title = f"The answer ({data_label})"
     parts = [
         title,
@@ -298,6 +302,9 @@ def report_page(
         list_table(display_rows(verdict, confidence), "Verdict per sphere"),
         "",
     ]
+    if failed:
+        parts += [f"{FAILED_TITLE}:", ""]
+        parts += [f"- {line}" for line in failed] + [""]
     if left_out:
         parts += ["What the data did not allow:", ""]
         parts += [f"- {line}" for line in left_out] + [""]
@@ -413,10 +420,12 @@ def summary_markdown(
     verdict_path: str | None,
     headlines: Sequence[Headline],
     left_out: Sequence[str] = (),
+    failed: Sequence[str] = (),
 ) -> str:
     """results/<run>/summary.md: the verdict table (None: the run has no scans, so no
-    verdict), the headline numbers, each with the file (and key) it is read from, and what
-    the spheres' data did not allow (``left_out``, one line each), so that no gap is silent."""
+    verdict), the headline numbers, each with the file (and key) it is read from, the spheres
+    held out because a job of theirs failed (``failed``, one line per job), and what the
+    spheres' data did not allow (``left_out``, one line each), so that no gap is silent."""
     lines = [f"# amontons: run `{run}` ({data_label})", ""]
     if verdict_lines is None:
         lines += ["No scans ran (`run_scans: []`), so no model is judged.", ""]
@@ -429,6 +438,9 @@ def summary_markdown(
         ]
     lines += ["## Headline numbers", "", "Each number names the file it is read from.", ""]
     lines += [f"- **{h.what}**: {h.value}. Source: {h.source}." for h in headlines]
+    if failed:
+        lines += ["", f"## {FAILED_TITLE}", ""]
+        lines += [f"- {line}" for line in failed]
     if left_out:
         lines += ["", "## What the data did not allow", ""]
         lines += [f"- {line}" for line in left_out]

@@ -11,8 +11,8 @@ import tifffile
 from amontons.io.confocal import ImageChoice, read_confocal
 from amontons.io.confocal_writers import write_confocal
 from amontons.io.layout import RawDataError
-from amontons.io.pixel_probe import states_pixel_size
-from amontons.io.tiff import ImageError
+from amontons.io.pixel_probe import states_pixel_size, tiff_scan_side_m
+from amontons.io.tiff import ImageError, read_tiff, write_image
 
 DATA = np.arange(1, 65, dtype=np.uint16).reshape(8, 8)
 
@@ -72,3 +72,39 @@ def test_a_file_that_is_not_its_format_is_named(tmp_path, name):
     (tmp_path / name).write_bytes(b"GIF89a not an image at all")
     with pytest.raises(RawDataError, match=rf"{name}: not a"):
         states_pixel_size(tmp_path / name)
+
+
+SCAN = np.zeros((300, 200), dtype=np.float32)  # rows × columns: the shorter side is 200 px
+
+
+@pytest.mark.parametrize(
+    "write, sheet_pixel_m, side_px",
+    [
+        (lambda p: write_image(p, SCAN, 40e-9), None, 200),  # the virtual experiment's maps
+        (lambda p: write_image(p, SCAN, 40e-9), 40e-9, 200),  # a sheet pixel agreeing
+        (lambda p: tifffile.imwrite(p, SCAN, bigtiff=True, resolution=(2.5e5, 2.5e5),
+                                    resolutionunit="CENTIMETER"), None, 200),
+        (lambda p: tifffile.imwrite(p, SCAN.T), 40e-9, 200),  # no unit: the sheet's pixel
+    ],
+)  # fmt: skip
+def test_a_tiff_scans_size_is_read_from_its_header_as_the_reader_reads_it(
+    tmp_path, write, sheet_pixel_m, side_px
+):
+    """To the reader's pixel (the same rational resolution tags, 1e-12 relative for the one
+    rounding of a division), times the header's width and length."""
+    path = tmp_path / "afm_before.tif"
+    write(path)
+    pixel_m = read_tiff(path).pixel_x_m or sheet_pixel_m
+    assert tiff_scan_side_m(path, sheet_pixel_m) == pytest.approx(side_px * pixel_m, rel=1e-12)
+
+
+def test_a_tiff_scan_without_a_pixel_or_a_readable_header_has_no_size(tmp_path):
+    """None: the job that reads the map then names the file or the missing pixel."""
+    untagged = tmp_path / "untagged.tif"
+    tifffile.imwrite(untagged, SCAN)
+    truncated = tmp_path / "truncated.tif"
+    write_image(truncated, SCAN, 40e-9)
+    truncated.write_bytes(truncated.read_bytes()[:6])
+    assert tiff_scan_side_m(untagged) is None
+    assert tiff_scan_side_m(truncated, 40e-9) is None
+    assert tiff_scan_side_m(tmp_path / "absent.tif", 40e-9) is None

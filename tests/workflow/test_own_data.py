@@ -4,6 +4,7 @@ less the file the case is about, so that every output it still makes can be comp
 the complete copy's, made in the same run."""
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -254,12 +255,19 @@ def test_the_material_tables_hold_the_spheres_that_have_their_inputs(lab_run):
     assert set(scenes["sphere"]) == {COMPLETE, *CASES, *CUT_SCANS} - {"PS-noafm"}
 
 
-def test_one_corrupt_file_stops_only_its_sphere(small_run, tmp_path):
+def _spheres_in(project, table: str) -> set[str]:
+    return set(pd.read_csv(project / "results" / SMALL / "PS" / table)["sphere"])
+
+
+def test_one_corrupt_file_stops_only_its_sphere_until_it_is_fixed(small_run, tmp_path):
     """Two spheres, one with a truncated fluorescence image: every output of the other is
-    made, and the run exits non-zero naming the file."""
+    made, and the run exits non-zero naming the file. A rerun makes PS's tables and the
+    summary without the failed sphere, marked failed, and still exits non-zero; once the file
+    is fixed, the next run puts the sphere back and exits 0 (amontons.workflow.ledger)."""
     project = _project(tmp_path, small_run, {COMPLETE: [], "PS-corrupt": []})
     image = tmp_path / "lab" / "PS-corrupt" / "fluorescence" / "100.tif"
-    image.write_bytes(image.read_bytes()[:2000])
+    intact = image.read_bytes()
+    image.write_bytes(intact[:2000])
     run = _snakemake(project, "--cores", "2")
     assert run.returncode != 0
     assert str(image) in run.stderr
@@ -269,12 +277,45 @@ def test_one_corrupt_file_stops_only_its_sphere(small_run, tmp_path):
         assert (project / path).is_file(), path
     errors = [f["error"] for f in plans["PS-corrupt"]["files"] if "error" in f]
     assert errors and str(image) in errors[0]
+    # the check reads the run's record too: the next run holds the sphere out
+    assert plans[COMPLETE]["failed"] == [] and str(image) in plans["PS-corrupt"]["failed"][0]
     # the failure, per sphere, with its error, in the run's record and at the end of its log
-    failed = pd.read_csv(project / "results" / SMALL / "failed_jobs.csv")
+    record = project / "results" / SMALL / "failed_jobs.csv"
+    failed = pd.read_csv(record)
     assert set(failed["sphere"]) == {"PS-corrupt"} and set(failed["material"]) == {"PS"}
     assert failed["error"].str.contains(str(image), regex=False).all()
     assert all((project / log).is_file() for log in failed["log"])
     assert f"sphere PS-corrupt (PS): {failed['rule'].iloc[0]} failed:" in run.stderr
+    # PS's tables read every sphere, so this run could not make them; it says what a rerun does
+    summary = project / "results" / SMALL / "summary.md"
+    assert not (project / "results" / SMALL / "PS" / "load_area.csv").exists()
+    assert "run again to make PS's tables, figures, summary and report without PS-corrupt" in (
+        run.stderr
+    )
+
+    rerun = _snakemake(project, "--cores", "2")
+    assert rerun.returncode != 0  # the failed jobs ran again, and failed again
+    assert "sphere PS-corrupt (PS): failed in an earlier run: " in rerun.stderr
+    assert _spheres_in(project, "load_area.csv") == _spheres_in(project, "scenes.csv") == {COMPLETE}
+    text = summary.read_text()
+    held = text[text.index("## Failed: held out of every table and figure") :]
+    assert "sphere PS-corrupt (PS): failed in an earlier run: measure_contact_area: " in held
+    assert str(image) in held
+    assert set(pd.read_csv(record)["sphere"]) == {"PS-corrupt"}
+
+    image.write_bytes(intact)  # the file fixed: the sphere's data stamp changes
+    fixed = _snakemake(project, "--cores", "2")
+    assert fixed.returncode == 0, fixed.stderr[-3000:]
+    assert (
+        _spheres_in(project, "load_area.csv")
+        == _spheres_in(project, "scenes.csv")
+        == {
+            COMPLETE,
+            "PS-corrupt",
+        }
+    )
+    assert "Failed" not in summary.read_text()
+    assert not record.exists()
 
 
 def _scene_record(project, sphere, name):
@@ -329,18 +370,20 @@ def test_a_scan_that_holds_no_load_gets_a_record_and_no_failed_job(lab_run):
     assert len(json.loads((gt / "solve.json").read_text())["loads"]) == 5
 
 
-def test_the_check_predicts_the_loads_outside_the_scan(lab_run):
+def test_the_check_and_the_dry_run_predict_the_loads_outside_the_scan(lab_run):
     """The check reads each scan's size and, with the apex at its centre, names the loads the
-    run then leaves out."""
-    project, _, check, _ = lab_run
+    run then leaves out; so does the dry run, from the TIFF scans' headers."""
+    project, dry, check, _ = lab_run
     plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
+    said = dry.stdout + dry.stderr
     for sphere in (*CUT_SCANS, COMPLETE):
         predicted = plans[sphere]["scenes"]["elastic"]
         solve = _scene_record(project, sphere, "solve.json")
         assert predicted["simulated_mn"] == solve["loads_mn"], sphere
-        assert [r["load_mn"] for r in predicted["outside_scan"]] == [
-            r["load_mn"] for r in solve["outside_scan"]
-        ], sphere
+        left_out = [r["load_mn"] for r in solve["outside_scan"]]
+        assert [r["load_mn"] for r in predicted["outside_scan"]] == left_out, sphere
+        named = re.findall(rf"sphere {sphere} \(PS\): scene elastic: (\S+) mN outside_scan", said)
+        assert [float(load) for load in named] == left_out, sphere
 
 
 def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_run, tmp_path):

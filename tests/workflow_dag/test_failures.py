@@ -7,13 +7,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from amontons.workflow.failures import (
-    FAILED_JOBS,
-    failed_jobs,
-    failure_lines,
-    last_error,
-    report_failed_jobs,
-)
+from amontons.workflow.failures import FAILED_JOBS, failed_jobs, failure_lines, last_error
+from amontons.workflow.ledger import record_failures
 from amontons.workflow.paths import RunPaths
 
 DATA = Path(__file__).parent / "data"
@@ -52,10 +47,11 @@ def test_the_report_writes_the_run_record_and_reads_logs_from_a_list(tmp_path, m
     job_log = tmp_path / JOB_LOG
     job_log.parent.mkdir(parents=True)
     shutil.copy(DATA / "measure_contact_area.log", job_log)
-    lines = report_failed_jobs([str(RUN_LOG)], RunPaths("small"))
+    lines = record_failures([str(RUN_LOG)], RunPaths("small"), lambda sphere: "stamp", [])
     table = pd.read_csv(tmp_path / "results" / "small" / FAILED_JOBS, keep_default_na=False)
-    assert table.columns.tolist() == ["rule", "material", "sphere", "log", "error"]
-    assert len(table) == len(lines) == 3
+    columns = ["rule", "material", "sphere", "log", "error", "outputs", "data_stamp"]
+    assert table.columns.tolist() == columns
+    assert len(table) == len(lines) - 1 == 3  # and the line that says what a rerun does
     assert "100.tif: not a readable TIFF" in table["error"].iloc[0]
     assert table["error"].iloc[1] == ""  # that job's log is not there
     assert "100.tif: not a readable TIFF" in lines[0]

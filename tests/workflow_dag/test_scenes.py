@@ -4,9 +4,12 @@ shipped small config: only what a scene names, one job per scan value."""
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
+import tifffile
 
 from amontons.config.scenes import SCAN_COLUMNS
+from amontons.io.tiff import write_image
 from amontons.simulate.scan_grid import scan_values, value_label
 
 
@@ -149,3 +152,30 @@ def test_a_scan_without_a_prior_runs_over_its_dimensionless_range(make_run, tmp_
         "scan k runs over its prior-free range (k·Δx/E* 0.01 to 100" in line for line in lines
     )
     assert any("scene hardening (k_mpa_per_nm null" in line for line in lines)
+
+
+def test_the_dag_reads_a_tiff_scans_size_and_names_the_loads_it_leaves_out(measured_ps, tmp_path):
+    """A 50 µm TIFF scan of the PS sphere (the size of test_own_data's cut scan): the dry run's
+    lines are the loads whose window exceeds the scan, the same as the check command's
+    coverage of that side (apex at the centre); a scan that holds every load names none, and
+    a map whose header gives no pixel (nor the sheet) is left to its job."""
+    afm = tmp_path / "lab" / "PS" / "afm_before.tif"
+    write_image(afm, np.zeros((1250, 1250), dtype=np.float32), 40e-9)  # 50 µm
+    run = measured_ps()
+    assert run.scenes.header_scan_side_um("PS") == pytest.approx(50.0, rel=1e-12)
+    coverage = run.scenes.scan_coverage("PS", 50.0)
+    left_out = {s: [r["load_mn"] for r in c["outside_scan"]] for s, c in coverage.items()}
+    assert left_out["elastic"] and coverage["elastic"]["simulated_mn"]  # some out, some kept
+    for scene, entry in coverage.items():
+        assert all(row["window_um"] > 50.0 for row in entry["outside_scan"]), scene
+    lines = run.outside_scan()
+    assert len(lines) == sum(map(len, left_out.values()))
+    for line in lines:
+        assert line.startswith("sphere PS (PS): scene ") and "µm exceeds the 50.0 µm scan" in line
+    assert any(
+        line.startswith("sphere PS (PS): scene elastic: 300 mN outside_scan") for line in lines
+    )
+    write_image(afm, np.zeros((5000, 5000), dtype=np.float32), 40e-9)  # 200 µm
+    assert measured_ps().outside_scan() == []
+    tifffile.imwrite(afm, np.zeros((1250, 1250), dtype=np.float32))  # no pixel stated
+    assert measured_ps().scenes.header_scan_side_um("PS") is None

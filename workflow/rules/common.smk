@@ -5,7 +5,7 @@ from functools import partial
 
 from snakemake.logging import logger
 
-from amontons.workflow.failures import report_failed_jobs
+from amontons.workflow.ledger import record_failures, settle_ledger
 from amontons.workflow.params import (
     afm_reading,
     config_slice as _config_slice,
@@ -58,6 +58,12 @@ RUN = WorkflowRun.from_config(
 MATERIALS = RUN.materials
 # A sphere's missing optional file removes only what needs it: say so before any job.
 for _line in RUN.left_out():
+    logger.warning(_line)
+# ... and the loads an AFM scan too small for them leaves out, where its header gives its size.
+for _line in RUN.outside_scan():
+    logger.warning(_line)
+# A sphere whose job failed in an earlier run is held out of the tables: say so, and why.
+for _line in RUN.failed():
     logger.warning(_line)
 
 # Folders of the run (amontons.workflow.paths): patterns with their wildcards.

@@ -55,6 +55,7 @@ rule summarise_study:
         data_label=data_label(SPHERES),
         confidence=config["load_area"]["confidence"],
         left_out=RUN.left_out(),
+        failed=RUN.failed(),
     script:
         "../../scripts/summarise_study.py"
 
@@ -81,5 +82,6 @@ rule write_report_page:
         data_label=data_label(SPHERES),
         confidence=config["load_area"]["confidence"],
         left_out=RUN.left_out(),
+        failed=RUN.failed(),
     script:
         "../../scripts/write_report_page.py"

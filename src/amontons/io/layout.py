@@ -22,6 +22,7 @@ Every lookup raises RawDataError naming the folder and what was expected.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -104,6 +105,12 @@ def load_of(path: Path) -> float | None:
         return float(stem)
     except ValueError:
         return None
+
+
+def folder_files(folder: str | Path) -> list[str]:
+    """Every file below a sphere's raw-data folder, sorted (none where it is not there): what
+    the stamp of its data covers (amontons.workflow.spheres.Spheres.data_stamp)."""
+    return sorted(os.path.join(root, name) for root, _, names in os.walk(folder) for name in names)
 
 
 def files_by_load(

@@ -1,7 +1,9 @@
-"""Whether a confocal image's file states its pixel size, read from its header alone with the
-standard library: the workflow asks this when it builds the DAG (amontons.workflow.spheres),
-so that a measured sphere whose images carry no pixel size, and whose sheet row gives none,
-stops the run before any job, naming the sphere and the file.
+"""Whether a confocal image's file states its pixel size, and how large a TIFF AFM scan is,
+read from the header alone with the standard library: the workflow asks these when it builds
+the DAG (amontons.workflow.spheres, amontons.workflow.scenes), so that a measured sphere whose
+images carry no pixel size, and whose sheet row gives none, stops the run before any job,
+naming the sphere and the file, and so that the dry run says which loads a scene will leave
+outside a small scan.
 
 The readers (amontons.io.confocal, amontons.io.tiff) take the pixel from the same places:
 
@@ -22,9 +24,12 @@ from pathlib import Path
 
 from amontons.io.layout import RawDataError, confocal_suffix
 
-_IMAGE_DESCRIPTION, _X_RESOLUTION, _RESOLUTION_UNIT = 270, 282, 296
+_WIDTH, _LENGTH, _IMAGE_DESCRIPTION, _X_RESOLUTION, _RESOLUTION_UNIT = 256, 257, 270, 282, 296
+_Y_RESOLUTION = 283
 _CENTIMETRE, _INCH = 3, 2
+_METRES_PER_UNIT = {_INCH: 0.0254, _CENTIMETRE: 0.01}
 _DISPLAY_DPI_MAX = 1200.0  # amontons.io.tiff: an inch resolution up to this is a display default
+_TAGS = (_WIDTH, _LENGTH, _IMAGE_DESCRIPTION, _X_RESOLUTION, _Y_RESOLUTION, _RESOLUTION_UNIT)
 # TIFF field types: byte size of one value
 _TYPE_SIZES = {1: 1, 2: 1, 3: 2, 4: 4, 5: 8, 6: 1, 7: 1, 8: 2, 9: 4, 10: 8, 11: 4, 12: 8, 16: 8}
 _CZI_MAGIC = b"ZISRAWFILE"
@@ -34,8 +39,9 @@ _CZI_XML_START = 32 + 256  # metadata segment: header, then sizes and spare, the
 
 
 def _tiff_tags(path: Path) -> dict[int, object]:
-    """The ImageDescription, XResolution and ResolutionUnit of a TIFF's (or BigTIFF's) first
-    page, as text, (numerator, denominator) and int."""
+    """The ImageWidth, ImageLength, ImageDescription, X- and YResolution and ResolutionUnit of
+    a TIFF's (or BigTIFF's) first page, as int, int, text, (numerator, denominator) twice and
+    int."""
     with open(path, "rb") as stream:
         head = stream.read(16)
         order = {b"II": "<", b"MM": ">"}.get(head[:2])
@@ -52,7 +58,7 @@ def _tiff_tags(path: Path) -> dict[int, object]:
         for i in range(count):
             entry = entries[i * entry_size : (i + 1) * entry_size]
             code, kind = struct.unpack(order + "HH", entry[:4])
-            if code not in (_IMAGE_DESCRIPTION, _X_RESOLUTION, _RESOLUTION_UNIT):
+            if code not in _TAGS:
                 continue
             n = struct.unpack(order + ("Q" if big else "I"), entry[4:12] if big else entry[4:8])[0]
             inline = entry[12:20] if big else entry[8:12]
@@ -64,11 +70,42 @@ def _tiff_tags(path: Path) -> dict[int, object]:
                 value = stream.read(size)
             if code == _IMAGE_DESCRIPTION:
                 tags[code] = value.rstrip(b"\0").decode("utf-8", "replace")
-            elif code == _X_RESOLUTION:
+            elif code in (_X_RESOLUTION, _Y_RESOLUTION):
                 tags[code] = struct.unpack(order + "II", value[:8])
-            else:
-                tags[code] = struct.unpack(order + "H", value[:2])[0]
+            else:  # SHORT (3) or LONG (4)
+                tags[code] = struct.unpack(order + ("I" if kind == 4 else "H"), value[:size])[0]
     return tags
+
+
+def _tag_pixel_m(tags: dict[int, object], code: int) -> float | None:
+    """The pixel (m) a resolution tag states with a physical unit, as amontons.io.tiff reads
+    it; None without a unit or at a display default."""
+    numerator, denominator = tags.get(code, (0, 0))
+    unit = tags.get(_RESOLUTION_UNIT)
+    if numerator <= 0 or denominator <= 0 or unit not in _METRES_PER_UNIT:
+        return None
+    per_unit = numerator / denominator
+    if unit == _INCH and per_unit <= _DISPLAY_DPI_MAX:
+        return None
+    return _METRES_PER_UNIT[unit] / per_unit
+
+
+def tiff_scan_side_m(path: str | Path, sheet_pixel_m: float | None = None) -> float | None:
+    """The shorter side (m) of a TIFF height map's scan: its width and length in pixels times
+    the pixel its resolution tags state (amontons.io.tiff's rules), else ``sheet_pixel_m``;
+    None where neither gives a pixel, or where the header cannot be read (the job that reads
+    the map then names the file)."""
+    try:
+        tags = _tiff_tags(Path(path))
+    except (OSError, struct.error, ValueError, RawDataError):
+        return None
+    if _WIDTH not in tags or _LENGTH not in tags:
+        return None
+    pixel_x = _tag_pixel_m(tags, _X_RESOLUTION) or sheet_pixel_m
+    pixel_y = _tag_pixel_m(tags, _Y_RESOLUTION) or pixel_x
+    if pixel_x is None:
+        return None
+    return min(tags[_WIDTH] * pixel_x, tags[_LENGTH] * pixel_y)
 
 
 def _tiff_states_pixel(path: Path) -> bool:
@@ -82,9 +119,7 @@ def _tiff_states_pixel(path: Path) -> bool:
     if description.startswith("ImageJ="):
         unit = re.search(r"^unit=(.*)$", description, re.MULTILINE)
         return unit is not None and unit[1].strip() not in ("pixel", "pixels")
-    unit = tags.get(_RESOLUTION_UNIT)
-    per_unit = numerator / denominator
-    return unit == _CENTIMETRE or (unit == _INCH and per_unit > _DISPLAY_DPI_MAX)
+    return _tag_pixel_m(tags, _X_RESOLUTION) is not None
 
 
 def _czi_states_pixel(path: Path) -> bool:

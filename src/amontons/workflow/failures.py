@@ -5,7 +5,8 @@ a failure names the sphere, the step and the error, not only a job number (docs/
 
 Snakemake logs each failed job as an ``Error in rule <name>:`` block whose indented lines give
 its output and log files. A job's sphere and material come from those paths (the run's layout,
-amontons.workflow.paths); its error is the last exception line of its own log.
+amontons.workflow.paths); its error is the last exception line of its own log. What the next
+run does with the record is amontons.workflow.ledger's.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import re
 from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 
+from amontons.io.files import atomic_path
 from amontons.workflow.paths import RunPaths
 
 _BLOCK = re.compile(r"^Error in rule (?P<rule>\S+):\n(?P<body>(?:[ \t]+\S.*\n?)*)", re.MULTILINE)
@@ -24,16 +26,28 @@ _EXCEPTION = re.compile(r"^(?:[\w.]+\.)?\w*(?:Error|Exception)\b.*$")
 FAILED_JOBS = "failed_jobs.csv"
 
 
+# Snakemake's log lists a job's output files with this between them; the record keeps them so.
+OUTPUT_SEPARATOR = ", "
+
+
 @dataclass(frozen=True)
 class FailedJob:
     """One job that failed: its rule, the sphere and material its files belong to ('' for a
-    run-wide job), its log file and the error its log ends with."""
+    run-wide job), its log file, the error its log ends with, its output files (joined by
+    :data:`OUTPUT_SEPARATOR`) and the stamp of its sphere's data when it failed
+    (amontons.workflow.ledger; '' before it is stamped)."""
 
     rule: str
     material: str
     sphere: str
     log: str
     error: str
+    outputs: str = ""
+    data_stamp: str = ""
+
+    @property
+    def output_files(self) -> list[str]:
+        return [path for path in self.outputs.split(OUTPUT_SEPARATOR) if path]
 
 
 def _entries(body: str) -> dict[str, str]:
@@ -63,22 +77,31 @@ def failed_jobs(snakemake_log: str, paths: RunPaths, workdir: Path = Path(".")) 
     jobs = []
     for block in _BLOCK.finditer(snakemake_log):
         entries = _entries(block["body"])
-        log = entries.get("log", "").split(" (check log")[0].split(", ")[0]
-        outputs = entries.get("output", "").split(", ")
-        material, sphere = _owner([*outputs, log], paths.results)
+        log = entries.get("log", "").split(" (check log")[0].split(OUTPUT_SEPARATOR)[0]
+        outputs = entries.get("output", "")
+        material, sphere = _owner([*outputs.split(OUTPUT_SEPARATOR), log], paths.results)
         if not sphere:
             material, sphere = _owner([log], paths.logs)
         job_log = workdir / log if log else None
         error = last_error(job_log.read_text()) if job_log and job_log.is_file() else ""
-        jobs.append(FailedJob(block["rule"], material, sphere, log, error))
+        jobs.append(FailedJob(block["rule"], material, sphere, log, error, outputs))
     return jobs
 
 
-def write_failed_jobs(path: str | Path, jobs: list[FailedJob]) -> None:
-    """The failed jobs as CSV, one row per job (columns: FailedJob's fields)."""
+def read_failed_jobs(path: str | Path) -> list[FailedJob]:
+    """The jobs of a record written by :func:`write_failed_jobs` (none where there is no
+    record). A record of an older layout, without outputs or stamps, reads with them empty."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as stream:
+    if not path.is_file():
+        return []
+    with open(path, newline="") as stream:
+        return [FailedJob(**row) for row in csv.DictReader(stream)]
+
+
+def write_failed_jobs(path: str | Path, jobs: list[FailedJob]) -> None:
+    """The failed jobs as CSV, one row per job (columns: FailedJob's fields), written whole or
+    not at all."""
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as stream:
         writer = csv.writer(stream)
         writer.writerow([f.name for f in fields(FailedJob)])
         writer.writerows(astuple(job) for job in jobs)
@@ -91,14 +114,3 @@ def failure_lines(jobs: list[FailedJob]) -> list[str]:
         where = f"sphere {job.sphere} ({job.material})" if job.sphere else "run"
         lines.append(f"{where}: {job.rule} failed: {job.error or 'see its log'} [{job.log}]")
     return lines
-
-
-def report_failed_jobs(snakemake_logs: str | Path | list, paths: RunPaths) -> list[str]:
-    """Read the run's Snakemake log (the ``log`` of Snakefile's onerror: one path, or a list
-    of them as Snakemake 9 gives), write ``failed_jobs.csv`` in its results folder and return
-    the lines to print."""
-    logs = [snakemake_logs] if isinstance(snakemake_logs, str | Path) else snakemake_logs
-    text = "".join(Path(log).read_text() for log in logs if Path(log).is_file())
-    jobs = failed_jobs(text, paths)
-    write_failed_jobs(f"{paths.results}/{FAILED_JOBS}", jobs)
-    return failure_lines(jobs)

@@ -4,6 +4,8 @@ built from it. workflow/rules/common.smk only binds these to the names the rules
 
 from __future__ import annotations
 
+import hashlib
+import json
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +26,7 @@ from amontons.config.sheet import (
 )
 from amontons.io.layout import IMAGE_FORMATS
 from amontons.workflow.accuracy import AccuracyStudy
+from amontons.workflow.ledger import read_held_out
 from amontons.workflow.paths import RunPaths
 from amontons.workflow.resources import SolveResources
 from amontons.workflow.scenes import Scenes
@@ -38,6 +41,12 @@ Locate = Callable[[str], str | Path]
 
 def _in_folder(folder: Path) -> Locate:
     return lambda name: folder / name
+
+
+def config_digest(config: Mapping) -> str:
+    """A digest of a run's config (resolved), for the stamp of a sphere's data: a changed
+    config lets a failed sphere back into the tables (amontons.workflow.ledger)."""
+    return hashlib.sha256(json.dumps(config, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def load_workflow_config(
@@ -87,6 +96,28 @@ class WorkflowRun:
             for line in self.spheres.left_out(sphere) + self.scenes.left_out(sphere)
         ]
 
+    def outside_scan(self) -> list[str]:
+        """Per measured sphere whose AFM scan's size its header gives, the loads each scene
+        will leave outside the scan (amontons.workflow.scenes)."""
+        return [
+            f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
+            for sphere in self.spheres
+            for line in self.scenes.predicted_outside_scan(sphere)
+        ]
+
+    def failed(self) -> list[str]:
+        """Per sphere held out by an earlier run's failure, each failed job and what the
+        sphere is held out of (amontons.workflow.ledger)."""
+        return [
+            f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
+            for sphere in self.spheres.held_out
+            for line in self.spheres.failed_lines(sphere)
+        ]
+
+    def data_stamp(self, sphere: str) -> str:
+        """The stamp of a sphere's data under this run's config (amontons.workflow.ledger)."""
+        return self.spheres.data_stamp(sphere, config_digest(self.config))
+
     @classmethod
     def from_config(
         cls, config: Mapping, workflow_dir: str | Path | Locate, source: str
@@ -111,6 +142,10 @@ class WorkflowRun:
             synthetic_images=IMAGE_FORMATS[config["virtual_experiment"]["formats"]["images"]],
         )
         spheres.check_pixel_sizes()
+        digest = config_digest(config)
+        spheres.hold_out(
+            read_held_out(paths, spheres, lambda sphere: spheres.data_stamp(sphere, digest))
+        )
         scenes = Scenes(config, spheres, paths)
         study = Study(config, spheres, scenes, paths)
         return cls(

@@ -9,14 +9,32 @@ from collections.abc import Mapping
 
 from amontons.config import geometry
 from amontons.config.scenes import SCAN_COLUMNS, sheet_prior
+from amontons.io.pixel_probe import tiff_scan_side_m
 from amontons.simulate.scan_grid import scan_values, value_label
 from amontons.workflow import paths as files
 from amontons.workflow.params import sorted_keys
 from amontons.workflow.paths import RunPaths
-from amontons.workflow.spheres import Spheres
+from amontons.workflow.spheres import AFM_BEFORE, Spheres
 
 # What a scan's prior-free range is a multiple of (config scans.<name>.prior_free_range).
 PRIOR_FREE_SCALES = {"p_y_mpa": "p_Y/E*", "k_mpa_per_nm": "k·Δx/E*"}
+
+
+# AFM formats whose scan size the DAG reads from the header (amontons.io.pixel_probe).
+HEADER_SIZED_AFM = (".tif", ".tiff")
+
+
+def outside_scan_lines(scene: str, coverage: dict, side_um: float) -> list[str]:
+    """What a scene leaves out of a scan of ``side_um`` (its :meth:`Scenes.scan_coverage`
+    entry), one line per load, or one line where it simulates none."""
+    lines = [
+        f"scene {scene}: {row['load_mn']:g} mN outside_scan (its window of "
+        f"{row['window_um']:.1f} µm exceeds the {side_um:.1f} µm scan)"
+        for row in coverage["outside_scan"]
+    ]
+    if not coverage["simulated_mn"]:
+        lines.append(f"scene {scene}: the AFM scan holds no load's window; nothing simulated")
+    return lines
 
 
 class Scenes:
@@ -99,6 +117,51 @@ class Scenes:
     def runnable_scans(self, sphere: str) -> list[str]:
         """The scans a sphere's data allow: each registers on a microscope scene."""
         return [scan for scan in self.scans if self.registration_scene(sphere, scan)]
+
+    def scan_coverage(self, sphere: str, side_um: float) -> dict[str, dict]:
+        """Per scene that solves on the sphere's map: the loads (mN) its window keeps inside
+        an AFM scan of ``side_um`` and those left out (``outside_scan``), with the apex taken
+        at the scan's centre. The run fits the apex; one off centre holds a smaller window, so
+        the run may leave out more (amontons.simulate.surface.afm_scene)."""
+        record = self.spheres.scene_record(sphere)
+        coverage = {}
+        for scene in self.runnable(sphere):
+            spec = self.scenes[scene]
+            if spec["model"] == "greenwood_tripp":
+                continue  # mean-field: no window on the map
+            frame = geometry.sphere_frame(spec, record)
+            cut = geometry.frame_in_scan(scene, spec, frame, side_um * 1e-6)
+            coverage[scene] = {
+                "simulated_mn": [f * 1e3 for f in cut.frame.loads_n],
+                "outside_scan": [load.to_record() for load in cut.left_out],
+            }
+        return coverage
+
+    def header_scan_side_um(self, sphere: str) -> float | None:
+        """The shorter side (µm) of a measured sphere's AFM scan where its header gives it
+        cheaply (a TIFF: amontons.io.pixel_probe; the sheet's afm_pixel_nm where the file
+        states no pixel); None otherwise, the job then reading the scan."""
+        if self.spheres.is_synthetic(sphere) or not self.spheres.can_simulate(sphere):
+            return None
+        path = self.spheres.afm_path(sphere, AFM_BEFORE)
+        if not path.lower().endswith(HEADER_SIZED_AFM):
+            return None
+        sheet_nm = self.spheres.value(sphere, "afm_pixel_nm")
+        side_m = tiff_scan_side_m(path, None if sheet_nm is None else sheet_nm * 1e-9)
+        return None if side_m is None else side_m * 1e6
+
+    def predicted_outside_scan(self, sphere: str) -> list[str]:
+        """The loads each scene will leave outside the sphere's AFM scan, where its size is
+        read at DAG time (:meth:`header_scan_side_um`), with the apex at the scan's centre."""
+        side_um = self.header_scan_side_um(sphere)
+        if side_um is None:
+            return []
+        coverage = self.scan_coverage(sphere, side_um)
+        return [
+            f"{line}; apex taken at the scan's centre"
+            for scene, entry in coverage.items()
+            for line in outside_scan_lines(scene, entry, side_um)
+        ]
 
     def left_out(self, sphere: str) -> list[str]:
         """What a sphere without a prior does not get (the scenes at the sheet's value), and

@@ -8,6 +8,8 @@ A measured sphere's per-load files are matched to its sheet loads here, at DAG t
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import re
 from collections.abc import Mapping
@@ -25,9 +27,11 @@ from amontons.io.layout import (
     confocal_file,
     flim_file,
     fluorescence_images,
+    folder_files,
     rheometer_files,
 )
 from amontons.io.pixel_probe import states_pixel_size
+from amontons.workflow.failures import FailedJob
 from amontons.workflow.paths import CONTACT_AREA, RunPaths
 
 # The sheet values a scene takes from its sphere.
@@ -84,6 +88,7 @@ class Spheres:
         self.synthetic_flim = synthetic_flim
         self.synthetic_images = synthetic_images
         self._missing: dict[str, dict[str, str]] = {}
+        self.held_out: dict[str, list[FailedJob]] = {}
 
     def __iter__(self):
         return iter(self.records)
@@ -92,12 +97,15 @@ class Spheres:
         return self.records[sphere]
 
     def of(self, material: str, having: str | None = None) -> list[str]:
-        """The spheres of ``material``, in sheet order; only those with the optional input
-        ``having`` where it is given."""
+        """The spheres of ``material`` whose results the run makes and its tables read, in
+        sheet order: not those held out by an earlier run's failure (:meth:`hold_out`), and
+        only those with the optional input ``having`` where it is given."""
         return [
             s
             for s, row in self.records.items()
-            if row["material"] == material and (having is None or self.has(s, having))
+            if row["material"] == material
+            and s not in self.held_out
+            and (having is None or self.has(s, having))
         ]
 
     def materials_with(self, materials, kind: str) -> list[str]:
@@ -270,6 +278,38 @@ class Spheres:
                 line += f"; {NO_PSF if self.psf_source(sphere) is None else STAND_IN_PSF}"
             lines.append(line)
         return lines
+
+    def hold_out(self, failed: Mapping[str, list[FailedJob]]) -> None:
+        """Hold spheres out of the run's results and tables, each with the failed jobs of an
+        earlier run that hold it out (amontons.workflow.ledger)."""
+        unknown = set(failed) - set(self.records)
+        if unknown:
+            raise ValueError(f"cannot hold out spheres not in the run: {sorted(unknown)}")
+        self.held_out = {sphere: list(jobs) for sphere, jobs in failed.items()}
+
+    def failed_lines(self, sphere: str) -> list[str]:
+        """Why a held-out sphere is out of its material's tables: one line per failed job,
+        with its error and log (none for a sphere not held out)."""
+        material = self.material_of(sphere)
+        return [
+            f"failed in an earlier run: {job.rule}: {job.error or 'see its log'} [{job.log}]; "
+            f"held out of {material}'s tables, figures, summary and report until its files, "
+            "its sheet row or the config change, or the job succeeds"
+            for job in self.held_out.get(sphere, [])
+        ]
+
+    def data_stamp(self, sphere: str, salt: str = "") -> str:
+        """A digest of what a sphere's jobs read from outside the run: its sheet row and, for
+        each file of its raw folder and each shared file its row names, the path, size and
+        modification time; ``salt`` is mixed in (the run's config digest)."""
+        digest = hashlib.sha256(salt.encode())
+        digest.update(json.dumps(self.records[sphere], sort_keys=True, default=str).encode())
+        shared = [self.records[sphere].get(column) for column in SHARED_FILE_COLUMNS.values()]
+        for path in folder_files(self.raw_dir(sphere)) + [p for p in shared if p]:
+            if os.path.isfile(path):
+                stat = os.stat(path)
+                digest.update(f"{path}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
+        return digest.hexdigest()
 
     def has(self, sphere: str, kind: str) -> bool:
         """Whether a sphere has the optional input ``kind``."""

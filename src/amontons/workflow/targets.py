@@ -129,13 +129,28 @@ class Targets:
         return self.sphere_outputs(materials, FIT_RESULTS)
 
     def figures(self, materials) -> list[str]:
-        """The per-material figures and tables: load-area and Amontons deviation."""
-        return self.material_figures(materials, ["load_area"]) + self.material_figures(
+        """The per-material figures and tables: load-area (of a material with a sphere not
+        held out) and Amontons deviation."""
+        return self.material_figures(
+            [m for m in materials if self.spheres.of(m)], ["load_area"]
+        ) + self.material_figures(
             self.spheres.materials_with(materials, RHEOMETER), [files.AMONTONS_FIGURE]
         )
 
+    def retries(self, materials) -> list[str]:
+        """The outputs of the failed jobs that hold spheres of ``materials`` out of the run
+        (amontons.workflow.ledger): those jobs run again, so the run fails while they do."""
+        return [
+            path
+            for sphere, jobs in self.spheres.held_out.items()
+            if self.spheres.material_of(sphere) in materials
+            for job in jobs
+            for path in job.output_files
+        ]
+
     def material(self, materials) -> list[str]:
-        """Everything a material's target builds: every measurement, fit, figure and table."""
+        """Everything a material's target builds: every measurement, fit, figure and table,
+        and the failed jobs of its held-out spheres, again."""
         everything = (
             self.optics(materials)
             + self.surface(materials)
@@ -145,6 +160,7 @@ class Targets:
             + self.scenes.outputs(materials)
             + self.scenes.scan_outputs(materials)
             + self.study.outputs(materials)
+            + self.retries(materials)
         )
         return list(dict.fromkeys(everything))  # once each, in order
 
