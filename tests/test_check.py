@@ -114,12 +114,12 @@ def test_a_load_series_file_is_listed_once_per_load_with_its_plane(project, repo
     assert "fluorescence.ome.tif series 2 = 100 mN [OME-TIFF]: 16×16 px, pixel 250 nm" in text
 
 
-def test_a_load_series_file_with_a_series_too_few_is_reported_per_load(project, repo):
+def test_a_load_series_file_with_a_series_too_few_stops_before_any_job(project, repo):
+    """Its header says it holds 4 series for 5 loads: the run would stop before any job."""
     _series_file(project, LOADS[:-1])
-    (plan,) = check(["config/own.yaml"], repo / "workflow")
-    series = [f for f in plan["files"] if f["path"].endswith("fluorescence.ome.tif")]
-    assert len(series) == len(LOADS)
-    assert all(
-        "it holds 4 series" in f["error"] and "expected exactly 5" in f["error"] for f in series
+    message = (
+        r"sphere PS: .*fluorescence\.ome\.tif: it holds 4 series \(its header says\), but "
+        r"optics\.images\.load_series puts the sheet's 5 loads .* expected exactly 5 series"
     )
-    assert "fluorescence.ome.tif series 0 = 25 mN: UNREADABLE: " in report([plan])
+    with pytest.raises(ValueError, match=message):
+        check(["config/own.yaml"], repo / "workflow")

@@ -10,8 +10,9 @@ import pylibCZIrw.czi as pyczi
 import pytest
 import tifffile
 
-from amontons.io.confocal import ImageChoice, LoadPlane, read_confocal
+from amontons.io.confocal import ImageChoice, LoadPlane, read_confocal, read_planes
 from amontons.io.layout import IN_LOAD_ORDER, RawDataError, load_axis_conflict, plane_loads
+from amontons.io.pixel_probe import load_plane_count
 from amontons.io.rawdata import fluorescence_planes, read_fluorescence_loads
 from amontons.io.tiff import ImageError, write_image
 
@@ -185,3 +186,22 @@ def test_the_file_pixel_is_held_to_the_sheets_within_1_percent(tmp_path):
     image = read_confocal(path, 252e-9, choice)  # 0.8 %: the file's
     assert image.pixel_m == PIXEL_M and image.pixel_source == "file"
     np.testing.assert_array_equal(image.data, PER_LOAD[2, 0])
+
+
+@pytest.mark.parametrize("kind", WRITERS)
+@pytest.mark.parametrize("planes", [1, 3, 4])
+def test_the_header_count_the_dag_checks_is_the_readers(tmp_path, kind, planes):
+    """The DAG counts a load-series file's planes from its header alone
+    (amontons.io.pixel_probe.load_plane_count); the count must be the one the jobs' reader
+    finds, along both axes."""
+    axis, write, name = WRITERS[kind]
+    path = write(tmp_path / name, np.concatenate([PER_LOAD, PER_LOAD[:1] + 1])[:planes])
+    read = read_planes(path)
+    assert load_plane_count(path, "series") == read.series_count
+    assert load_plane_count(path, "frames") == len(read.data)
+    assert load_plane_count(path, axis) == planes
+
+
+def test_the_header_count_of_a_plain_tiff_is_left_to_the_reader(tmp_path):
+    write_image(tmp_path / "all.tif", PER_LOAD[0, 0], PIXEL_M)
+    assert load_plane_count(tmp_path / "all.tif", "frames") is None

@@ -323,3 +323,18 @@ def test_the_config_accepts_a_mapping_and_the_rules_images_stay_as_they_were(mak
 
     with pytest.raises(ConfigError, match="load_series"):
         make_run(edit=bad)
+
+
+def test_a_load_series_file_with_a_plane_too_many_stops_the_run_naming_sphere_and_file(tmp_path):
+    spheres, lab = _series_spheres(tmp_path, {"axis": "frames", "planes": "in_load_order"})
+    spheres.check_load_series_files()  # three frames, three loads
+    spheres.records["lab"]["loads"] = [10.0, 20.0]
+    message = (
+        rf"sphere lab: {lab}/fluorescence\.ome\.tif: it holds 3 frames \(its header says\), "
+        r"but .* sheet's 2 loads \[10\.0, 20\.0\] mN along its frames, one each; expected exactly 2"
+    )
+    with pytest.raises(RawDataError, match=message):
+        spheres.check_load_series_files()
+    spheres.load_series["axis"] = "series"  # one series: as many as one load needs, not two
+    with pytest.raises(RawDataError, match=r"it holds 1 series \(its header says\)"):
+        spheres.check_load_series_files()

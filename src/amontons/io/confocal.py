@@ -31,7 +31,12 @@ import numpy as np
 import pylibCZIrw.czi as pyczi
 import tifffile
 
-from amontons.io.layout import confocal_suffix, load_axis_conflict, same_load
+from amontons.io.layout import (
+    confocal_suffix,
+    load_axis_conflict,
+    load_count_mismatch,
+    same_load,
+)
 from amontons.io.tiff import Image, ImageError, read_image, resolve_pixel
 
 log = logging.getLogger(__name__)
@@ -436,12 +441,7 @@ def read_confocal(
 
 
 def _load_count_error(path: Path, load: LoadPlane, described: str) -> ImageError:
-    loads = len(load.plane_loads_mn)
-    return ImageError(
-        f"{path}: {described}, but optics.images.load_series puts the sheet's {loads} loads "
-        f"{list(load.plane_loads_mn)} mN along its {load.axis}, one each; expected exactly "
-        f"{loads} {load.axis}"
-    )
+    return ImageError(load_count_mismatch(path, described, load.axis, load.plane_loads_mn))
 
 
 def _load_planes(path: Path, choice: ImageChoice) -> tuple[Planes, ImageChoice]:

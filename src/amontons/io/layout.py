@@ -199,6 +199,16 @@ def load_axis_conflict(axis: str, choice: dict) -> str | None:
     )
 
 
+def load_count_mismatch(path: str | Path, described: str, axis: str, plane_loads_mn) -> str:
+    """The message for a load-series file ``path`` whose planes along ``axis`` are not one per
+    load: ``described`` says what it holds (e.g. 'it holds 4 series')."""
+    loads = len(plane_loads_mn)
+    return (
+        f"{path}: {described}, but optics.images.load_series puts the sheet's {loads} loads "
+        f"{list(plane_loads_mn)} mN along its {axis}, one each; expected exactly {loads} {axis}"
+    )
+
+
 def plane_loads(loads_mn: Sequence[float], planes: str | Sequence[int], where: str) -> list[float]:
     """The load (mN) of each plane of a load-series file, in plane order, from the sheet's
     ``loads_mn`` and the config's ``planes`` (IN_LOAD_ORDER: plane i is the i-th load; or a

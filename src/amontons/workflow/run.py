@@ -127,6 +127,7 @@ class WorkflowRun:
             load_series=config["optics"]["images"]["load_series"],
         )
         spheres.check_pixel_sizes()
+        spheres.check_load_series_files(config["optics"]["images"]["series"])
         scenes = Scenes(config, spheres, paths)
         study = Study(config, spheres, scenes, paths)
         return cls(

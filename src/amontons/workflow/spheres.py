@@ -29,10 +29,11 @@ from amontons.io.layout import (
     confocal_file,
     flim_file,
     fluorescence_images,
+    load_count_mismatch,
     plane_loads,
     rheometer_files,
 )
-from amontons.io.pixel_probe import states_pixel_size
+from amontons.io.pixel_probe import load_plane_count, states_pixel_size
 from amontons.workflow.params import sorted_keys
 from amontons.workflow.paths import CONTACT_AREA, RunPaths
 
@@ -229,6 +230,28 @@ class Spheres:
             return dict(images)
         series = {"axis": self.load_series["axis"], "plane_loads_mn": planes}
         return sorted_keys({**images, "load_series": series})
+
+    def check_load_series_files(self, series: int = 0) -> None:
+        """Stop the run before any job where a sphere's load-series file does not hold one
+        plane per load along the load axis, as its header says (amontons.io.pixel_probe;
+        ``series``: optics.images.series, the series whose frames carry the loads):
+        RawDataError naming the sphere, the file, what it holds and the loads. A header that
+        does not say is left to the jobs' reader, which counts the planes again; a folder that
+        cannot be mapped at all, to the rules' input functions, which name it."""
+        for sphere in self.records:
+            try:
+                path, planes = self.load_series_file(sphere), self.plane_loads(sphere)
+            except RawDataError:
+                continue
+            if path is None:
+                continue
+            axis = self.load_series["axis"]
+            count = load_plane_count(path, axis, series)
+            if count is not None and count != len(planes):
+                described = f"it holds {count} {axis} (its header says)"
+                raise RawDataError(
+                    f"sphere {sphere}: {load_count_mismatch(path, described, axis, planes)}"
+                )
 
     def per_load_inputs(self, sphere: str, kind: str) -> str | list[str]:
         """The per-load raw files of a sphere, 'fluorescence' or 'rheometer', in load order.
