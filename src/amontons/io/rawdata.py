@@ -164,6 +164,7 @@ def fluorescence_planes(
     if series is None:
         paths = per_load_files(given, loads_mn, fluorescence_names)
         return paths, [ImageChoice(**images)] * len(paths)
+    # the one file, for every load (per_load_files checks that it is one file and there)
     (path,) = per_load_files(given, [series["plane_loads_mn"][0]], fluorescence_names)
     plane_loads = tuple(series["plane_loads_mn"])
     missing = [load for load in loads_mn if not any(same_load(load, f) for f in plane_loads)]
