@@ -5,11 +5,10 @@ import logging
 
 import pandas as pd
 
-from amontons.io.confocal import ImageChoice
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_json, write_table
-from amontons.io.layout import RawDataError, fluorescence_names, per_load_files
-from amontons.io.rawdata import read_fluorescence_series
+from amontons.io.layout import RawDataError
+from amontons.io.rawdata import read_fluorescence_loads
 from amontons.measure.area import OtsuSettings, image_contact_area, otsu_contact_area
 from amontons.plots import plot_scene_comparison
 from amontons.runlog import run_logged
@@ -44,10 +43,8 @@ def main(
     settings = OtsuSettings.from_config(otsu)
     fields, _, attrs = read_load_series(rendered_path)
     pixel_m = attrs["image_pixel_nm"] * 1e-9
-    images = read_fluorescence_series(
-        per_load_files(fluorescence, loads_mn, fluorescence_names),
-        None if pixel_nm is None else pixel_nm * 1e-9,
-        ImageChoice(**images),
+    images = read_fluorescence_loads(
+        fluorescence, loads_mn, None if pixel_nm is None else pixel_nm * 1e-9, images
     )
     if abs(images[0].pixel_m - pixel_m) > 1e-6 * pixel_m:
         raise RawDataError(

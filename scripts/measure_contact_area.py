@@ -2,10 +2,8 @@
 
 import logging
 
-from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_table
-from amontons.io.layout import fluorescence_names, per_load_files
-from amontons.io.rawdata import read_fluorescence_series
+from amontons.io.rawdata import read_fluorescence_loads
 from amontons.measure.area import OtsuSettings, contact_area_table, image_contact_area
 from amontons.plots import plot_contact_separation
 from amontons.runlog import run_logged
@@ -25,9 +23,9 @@ def main(
     sphere: str,
 ) -> None:
     settings = OtsuSettings.from_config(otsu)
-    paths = per_load_files(fluorescence, loads_mn, fluorescence_names)
-    choice = ImageChoice(**images)
-    images = read_fluorescence_series(paths, None if pixel_nm is None else pixel_nm * 1e-9, choice)
+    images = read_fluorescence_loads(
+        fluorescence, loads_mn, None if pixel_nm is None else pixel_nm * 1e-9, images
+    )
     areas = [image_contact_area(image, settings) for image in images]
     table = contact_area_table(loads_mn, images, areas)
     for row in table.itertuples():

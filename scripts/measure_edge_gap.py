@@ -4,7 +4,7 @@ import logging
 
 from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json
-from amontons.io.layout import fluorescence_names, per_load_files
+from amontons.io.rawdata import fluorescence_planes
 from amontons.measure.area import OtsuSettings
 from amontons.measure.edge_gap import measure_edge_gap, unmeasured_edge_gap_record
 from amontons.measure.errors import NotMeasurable
@@ -32,13 +32,13 @@ def main(
     e_star_gpa: float,
 ) -> None:
     title = f"{sphere}: Newton-ring gap at {reflection_load_mn:g} mN ({data_label})"
-    (image,) = per_load_files(fluorescence, [reflection_load_mn], fluorescence_names)
+    (image,), (choice,) = fluorescence_planes(fluorescence, [reflection_load_mn], images)
     try:
         result = measure_edge_gap(
             reflection_path,
             image,
             None if pixel_nm is None else pixel_nm * 1e-9,
-            choice=ImageChoice(**images),
+            choice=choice,
             reflection_choice=ImageChoice(**reflection_images),
             load_mn=reflection_load_mn,
             otsu=OtsuSettings.from_config(otsu),

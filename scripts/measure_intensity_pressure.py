@@ -2,9 +2,8 @@
 
 import logging
 
-from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json, write_table
-from amontons.io.layout import fluorescence_names, per_load_files
+from amontons.io.rawdata import fluorescence_planes
 from amontons.measure.area import OtsuSettings
 from amontons.measure.intensity import (
     intensity_pressure_record,
@@ -32,11 +31,12 @@ def main(
     data_label: str,
     sphere: str,
 ) -> None:
+    paths, choices = fluorescence_planes(fluorescence, loads_mn, images)
     result, backgrounds, excluded = measure_intensity_pressure(
-        per_load_files(fluorescence, loads_mn, fluorescence_names),
+        paths,
         loads_mn,
         None if pixel_nm is None else pixel_nm * 1e-9,
-        choice=ImageChoice(**images),
+        choice=choices,
         otsu=OtsuSettings.from_config(otsu),
         background_margin_px=background_margin_px,
         pressure_ref_pa=pressure_ref_mpa * 1e6,

@@ -7,11 +7,9 @@ import logging
 import numpy as np
 import pandas as pd
 
-from amontons.io.confocal import ImageChoice
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_table
-from amontons.io.layout import fluorescence_names, per_load_files
-from amontons.io.rawdata import read_fluorescence_series
+from amontons.io.rawdata import read_fluorescence_loads
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
 from amontons.simulate.register import Registration, warp_to_measured
@@ -32,10 +30,8 @@ def main(
     otsu: dict,
     label: str,
 ) -> None:
-    images = read_fluorescence_series(
-        per_load_files(fluorescence, loads_mn, fluorescence_names),
-        None if pixel_nm is None else pixel_nm * 1e-9,
-        ImageChoice(**images),
+    images = read_fluorescence_loads(
+        fluorescence, loads_mn, None if pixel_nm is None else pixel_nm * 1e-9, images
     )
     measured = images[-1]
     contact = image_contact_area(measured, OtsuSettings.from_config(otsu))

@@ -11,11 +11,9 @@ if "snakemake" in globals():
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
 from amontons.contact import FreeBoundaryError
-from amontons.io.confocal import ImageChoice
 from amontons.io.fields import write_load_series
 from amontons.io.files import read_json, write_json
-from amontons.io.layout import fluorescence_names, per_load_files
-from amontons.io.rawdata import read_fluorescence_series
+from amontons.io.rawdata import fluorescence_planes, read_fluorescence_series
 from amontons.measure.area import OtsuSettings, image_contact_area, image_pixel_m
 from amontons.runlog import run_logged
 from amontons.simulate.compare import compare_loads, sheet_load_index
@@ -89,11 +87,11 @@ def main(
     sheet_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
     simulated = [sheet_load_index(sheet_mn, f * 1e3) for f in scene.loads_n]
     loads_mn = [sheet_mn[i] for i in simulated]
-    files = per_load_files(fluorescence, sheet_mn, fluorescence_names)
+    files, choices = fluorescence_planes(fluorescence, sheet_mn, images)
     images = read_fluorescence_series(
         [files[i] for i in simulated],
         None if pixel_nm is None else pixel_nm * 1e-9,
-        ImageChoice(**images),
+        [choices[i] for i in simulated],
     )
     measured = [image_contact_area(image, settings) for image in images]
     rows = compare_loads(

@@ -83,3 +83,43 @@ def test_images_without_a_pixel_and_an_empty_sheet_cell_stop_before_any_job(proj
     _two_channel_ome(project / "lab" / "fluorescence" / "50mN.ome.tif", 50, None)
     with pytest.raises(ValueError, match=r"sphere PS: .*50mN\.ome\.tif; expected the sheet's"):
         check(["config/own.yaml"], repo / "workflow")
+
+
+def _series_file(project, loads):
+    """The per-load images of ``loads`` repacked into lab/fluorescence.ome.tif, one series
+    each (series i holds the i-th of ``loads``, its fluorescence channel filled with the load),
+    in place of the fluorescence/ folder; the overlay maps the series in the sheet's order."""
+    lab = project / "lab"
+    shutil.rmtree(lab / "fluorescence")
+    with tifffile.TiffWriter(lab / "fluorescence.ome.tif", ome=True) as tif:
+        for load in loads:
+            planes = np.stack([np.full((16, 16), load, np.uint16), np.full((16, 16), 7, np.uint16)])
+            metadata = {"axes": "CYX", "Channel": {"Name": CHANNELS}}
+            tif.write(planes, photometric="minisblack", metadata=metadata | {"PhysicalSizeX": 0.25})
+    overlay = yaml.safe_load((project / "config" / "own.yaml").read_text())
+    overlay["optics"]["images"]["load_series"] = {"axis": "series", "planes": "in_load_order"}
+    (project / "config" / "own.yaml").write_text(yaml.safe_dump(overlay))
+
+
+def test_a_load_series_file_is_listed_once_per_load_with_its_plane(project, repo):
+    _series_file(project, LOADS)
+    (plan,) = check(["config/own.yaml"], repo / "workflow")
+    assert plan["errors"] == []
+    series = [f for f in plan["files"] if f["path"].endswith("fluorescence.ome.tif")]
+    assert [(f["load_mn"], f["plane"]) for f in series] == [
+        (load, f"series {i}") for i, load in enumerate(LOADS)
+    ]
+    assert all(f["pixel_nm"] == 250.0 and f["pixel_from"] == "file" for f in series)
+    text = report([plan])
+    assert "fluorescence.ome.tif series 2 = 100 mN [OME-TIFF]: 16×16 px, pixel 250 nm" in text
+
+
+def test_a_load_series_file_with_a_series_too_few_stops_before_any_job(project, repo):
+    """Its header says it holds 4 series for 5 loads: the run would stop before any job."""
+    _series_file(project, LOADS[:-1])
+    message = (
+        r"sphere PS: .*fluorescence\.ome\.tif: it holds 4 series \(its header says\), but "
+        r"optics\.images\.load_series puts the sheet's 5 loads .* expected exactly 5 series"
+    )
+    with pytest.raises(ValueError, match=message):
+        check(["config/own.yaml"], repo / "workflow")

@@ -1,6 +1,7 @@
 """A data folder checked before a run (README, "Your own data"): per sphere, every raw file
 found with its format, shape and pixel size (from the file, else from the sheet), the loads
-matched, what the run will measure and simulate, and what it cannot, and why.
+matched (for a file holding every load, which plane is which load), what the run will measure
+and simulate, and what it cannot, and why.
 
     python -m amontons.check [--configfile config/mine.yaml ...] [--json]
 
@@ -16,13 +17,14 @@ import argparse
 import json
 import sys
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from amontons.config import ConfigError, read_config
 from amontons.io.absorbance import read_absorbance_csv
-from amontons.io.confocal import ImageChoice, read_confocal
+from amontons.io.confocal import ImageChoice, LoadPlane, read_confocal
 from amontons.io.heightmap import read_heights
-from amontons.io.layout import FLIM_NAME, RawDataError
+from amontons.io.layout import FLIM_NAME, PLANE_NOUN, RawDataError
 from amontons.io.rheometer import read_rheometer_csv
 from amontons.io.tiff import read_tiff
 from amontons.workflow.params import image_choice
@@ -99,6 +101,28 @@ def describe_file(path: str, read: Callable[[str], dict], sheet_pixel_nm: float 
     return record
 
 
+def fluorescence_files(
+    spheres: Spheres, sphere: str, choice: ImageChoice, sheet_pixel_nm: float | None
+) -> list[dict]:
+    """A measured sphere's fluorescence images described (:func:`describe_file`): one per
+    load, or for a file holding every load, that file once per load, with the load (mN) and
+    the plane it is read from (``plane``, e.g. 'series 2'). RawDataError where the folder
+    does not match the sheet's loads."""
+    images = spheres.per_load_inputs(sphere, "fluorescence")
+    plane_loads = spheres.plane_loads(sphere)
+    if plane_loads is None:
+        read = confocal_reader(choice, sheet_pixel_nm)
+        return [describe_file(path, read, sheet_pixel_nm) for path in images]
+    axis = spheres.load_series["axis"]
+    records = []
+    for load in spheres.loads_mn(sphere):
+        plane = LoadPlane(axis, tuple(plane_loads), load)
+        read = confocal_reader(replace(choice, load=plane), sheet_pixel_nm)
+        record = describe_file(images[0], read, sheet_pixel_nm)
+        records.append({**record, "load_mn": load, "plane": f"{PLANE_NOUN[axis]} {plane.index}"})
+    return records
+
+
 def sphere_files(
     spheres: Spheres, sphere: str, choices: tuple[ImageChoice, ImageChoice]
 ) -> tuple[list[dict], list[str]]:
@@ -110,11 +134,9 @@ def sphere_files(
     image = confocal_reader(choices[0], fluorescence_pixel)
     afm_pixel = spheres.value(sphere, "afm_pixel_nm")
     try:
-        images = spheres.per_load_inputs(sphere, "fluorescence")
+        files += fluorescence_files(spheres, sphere, choices[0], fluorescence_pixel)
     except RawDataError as error:
         errors.append(str(error))
-        images = []
-    files += [describe_file(path, image, fluorescence_pixel) for path in images]
     if spheres.has(sphere, RHEOMETER):
         try:
             files += [
@@ -188,8 +210,11 @@ def check(configfiles: list[str], workflow_dir: Path = WORKFLOW_DIR) -> list[dic
 
 
 def _file_line(record: dict) -> str:
+    path = record["path"]
+    if "plane" in record:
+        path += f" {record['plane']} = {record['load_mn']:g} mN"
     if "error" in record:
-        return f"    {record['path']}: UNREADABLE: {record['error']}"
+        return f"    {path}: UNREADABLE: {record['error']}"
     details = []
     if "shape" in record:
         details.append("×".join(map(str, record["shape"])) + " px")
@@ -199,7 +224,7 @@ def _file_line(record: dict) -> str:
         details.append("NO PIXEL SIZE (neither the file nor the sheet gives one)")
     if "rows" in record:
         details.append(f"{record['rows']} rows")
-    return f"    {record['path']} [{record['format']}]: {', '.join(details)}"
+    return f"    {path} [{record['format']}]: {', '.join(details)}"
 
 
 def report(plans: list[dict]) -> str:

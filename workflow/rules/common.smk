@@ -111,6 +111,9 @@ AFM_READING = afm_reading(config)
 # Which plane of a confocal file is the image: the fluorescence and bead one, the reflection one.
 IMAGES = image_choice(config)
 REFLECTION_IMAGES = image_choice(config, reflection=True)
+# A sphere's fluorescence plane choice: IMAGES, and which plane is which load where one file
+# holds them all (config/README.md, "A load series in one file").
+fluorescence_choice = partial(SPHERES.fluorescence_choice, images=IMAGES)
 
 # Scenes, scans and the study (amontons.workflow.scenes, amontons.workflow.study).
 SCENES = RUN.scenes.scenes

@@ -27,7 +27,7 @@ rule measure_contact_area:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        images=IMAGES,
+        images=lambda wc: fluorescence_choice(wc.sphere),
         otsu=OTSU,
         data_label=lambda wc: data_label([wc.sphere]),
     script:
@@ -151,7 +151,7 @@ rule measure_edge_gap:
     params:
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        images=IMAGES,
+        images=lambda wc: fluorescence_choice(wc.sphere),
         reflection_images=REFLECTION_IMAGES,
         otsu=OTSU,
         newton_rings=config_slice("optics", "newton_rings"),
@@ -188,7 +188,7 @@ rule measure_intensity_pressure:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        images=IMAGES,
+        images=lambda wc: fluorescence_choice(wc.sphere),
         otsu=OTSU,
         intensity=config_slice("optics", "intensity"),
         confidence=config["load_area"]["confidence"],

@@ -162,7 +162,7 @@ rule compare_scene:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        images=IMAGES,
+        images=lambda wc: fluorescence_choice(wc.sphere),
         otsu=OTSU,
         data_label=lambda wc: data_label([wc.sphere]),
     script:

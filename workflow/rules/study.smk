@@ -31,7 +31,7 @@ rule scan_scene:
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        images=IMAGES,
+        images=lambda wc: fluorescence_choice(wc.sphere),
         otsu=OTSU,
     script:
         "../../scripts/scan_scene.py"
@@ -122,7 +122,7 @@ rule plot_scan_maps:
         scans=RUN.study.scan_maps,
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        images=IMAGES,
+        images=lambda wc: fluorescence_choice(wc.sphere),
         otsu=OTSU,
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
     script:
@@ -158,7 +158,7 @@ rule plot_load_series_maps:
         k_scan=RUN.study.k_scan,
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
-        images=IMAGES,
+        images=lambda wc: fluorescence_choice(wc.sphere),
         otsu=OTSU,
         label=lambda wc: f"{wc.sphere} ({data_label([wc.sphere])})",
     script:

@@ -13,6 +13,8 @@ Accepted, each tested on files its own writer made (tests/io/test_confocal.py):
 
 Which plane is used is an :class:`ImageChoice` (config ``optics.images``). A file whose
 choice cannot be met raises ImageError listing what it holds (channel names, series, frames).
+A file that holds a sphere's whole load series (one series or one frame per load) gives each
+load's plane through the choice's :class:`LoadPlane`.
 The writers (the virtual experiment's) are in amontons.io.confocal_writers.
 """
 
@@ -29,7 +31,12 @@ import numpy as np
 import pylibCZIrw.czi as pyczi
 import tifffile
 
-from amontons.io.layout import confocal_suffix
+from amontons.io.layout import (
+    confocal_suffix,
+    load_axis_conflict,
+    load_count_mismatch,
+    same_load,
+)
 from amontons.io.tiff import Image, ImageError, read_image, resolve_pixel
 
 log = logging.getLogger(__name__)
@@ -54,17 +61,53 @@ _FRAMES_MEAN = "mean"
 
 
 @dataclass(frozen=True)
+class LoadPlane:
+    """Where one load's image lies in a file that holds the whole load series (config
+    ``optics.images.load_series``): along ``axis`` ('series' or 'frames'), the plane of
+    ``load_mn``. ``plane_loads_mn`` is the load (mN) of every plane in plane order
+    (amontons.io.layout.plane_loads): the file must hold exactly that many along ``axis``."""
+
+    axis: str
+    plane_loads_mn: tuple[float, ...]
+    load_mn: float
+
+    def __post_init__(self):
+        if self.axis not in ("series", "frames"):
+            raise ValueError(f"load axis {self.axis!r}; expected 'series' or 'frames'")
+        if not any(same_load(load, self.load_mn) for load in self.plane_loads_mn):
+            raise ValueError(
+                f"{self.load_mn:g} mN is none of the planes' loads {list(self.plane_loads_mn)} mN"
+            )
+
+    @property
+    def index(self) -> int:
+        """The plane index of ``load_mn`` along ``axis``."""
+        return next(i for i, f in enumerate(self.plane_loads_mn) if same_load(f, self.load_mn))
+
+
+@dataclass(frozen=True)
 class ImageChoice:
     """Which 2-D plane of a confocal file is the image (config ``optics.images``).
 
     ``channel``: a channel name or index (None: the file must hold one channel);
     ``series``: the series (CZI scene, OME image) index; ``frames``: 'mean' (the mean of all
-    frames, time points and z planes; a single frame is returned as stored) or a frame index.
+    frames, time points and z planes; a single frame is returned as stored) or a frame index;
+    ``load``: in a file holding the whole load series, the load's plane, which takes the place
+    of ``series`` or ``frames`` (that one must then keep its default: ValueError otherwise).
     """
 
     channel: str | int | None = None
     series: int = 0
     frames: str | int = _FRAMES_MEAN
+    load: LoadPlane | None = None
+
+    def __post_init__(self):
+        if self.load is not None:
+            conflict = load_axis_conflict(
+                self.load.axis, {"series": self.series, "frames": self.frames}
+            )
+            if conflict is not None:
+                raise ValueError(conflict)
 
 
 # What a 2-D single-channel TIFF needs: nothing chosen.
@@ -258,20 +301,22 @@ def _czi_planes(path: Path, series: int) -> Planes:
     return Planes(data, names, count, _czi_pixel(path, metadata), "CZI")
 
 
-def read_planes(path: str | Path, series: int = 0) -> Planes:
-    """Series ``series`` of the OME-TIFF, ImageJ hyperstack or CZI ``path`` as (frames,
-    channels, y, x), with its channel names and pixel size (m).
+def _series_count(path: Path) -> int:
+    """How many series (OME images, CZI scenes) the file holds, without reading pixels."""
+    if confocal_suffix(path) == ".czi":
+        with pyczi.open_czi(str(path)) as czi:
+            return max(len(czi.scenes_bounding_rectangle), 1)
+    with tifffile.TiffFile(path) as tif:
+        return len(tif.series)
 
-    Raises ImageError naming the file when it is missing, unreadable or truncated, or has no
-    such series.
-    """
-    path = Path(path)
+
+def _readable(path: Path, read, *args):
+    """``read(path, *args)``, with a file that is missing, unreadable or truncated raised as
+    ImageError naming it."""
     if not path.is_file():
         raise ImageError(f"{path}: no such image")
     try:
-        if confocal_suffix(path) == ".czi":
-            return _czi_planes(path, series)
-        return _tiff_planes(path, series)
+        return read(path, *args)
     except ImageError:
         raise
     except (
@@ -287,6 +332,18 @@ def read_planes(path: str | Path, series: int = 0) -> Planes:
             f"{path}: not a readable {confocal_suffix(path) or 'image'} file "
             f"({type(error).__name__}: {error}); expected a complete file"
         ) from error
+
+
+def read_planes(path: str | Path, series: int = 0) -> Planes:
+    """Series ``series`` of the OME-TIFF, ImageJ hyperstack or CZI ``path`` as (frames,
+    channels, y, x), with its channel names and pixel size (m).
+
+    Raises ImageError naming the file when it is missing, unreadable or truncated, or has no
+    such series.
+    """
+    path = Path(path)
+    reader = _czi_planes if confocal_suffix(path) == ".czi" else _tiff_planes
+    return _readable(path, reader, series)
 
 
 def _channel_index(path: Path, planes: Planes, channel: str | int | None) -> int:
@@ -365,9 +422,12 @@ def read_confocal(
     more than 1 % (amontons.io.tiff.resolve_pixel).
     """
     path = Path(path)
-    if is_plain_tiff(path):
+    if choice.load is not None:
+        planes, choice = _load_planes(path, choice)
+    elif is_plain_tiff(path):
         return read_image(path, fallback_pixel_m)
-    planes = read_planes(path, choice.series)
+    else:
+        planes = read_planes(path, choice.series)
     data = select_plane(path, planes, choice)
     if data.dtype.kind not in ("u", "f") or not np.all(np.isfinite(data)):
         raise ImageError(
@@ -378,3 +438,30 @@ def read_confocal(
         path, planes.pixel_m, fallback_pixel_m, f"{planes.format} metadata"
     )
     return Image(data=data, pixel_m=pixel_m, path=path, pixel_source=source, format=planes.format)
+
+
+def _load_count_error(path: Path, load: LoadPlane, described: str) -> ImageError:
+    return ImageError(load_count_mismatch(path, described, load.axis, load.plane_loads_mn))
+
+
+def _load_planes(path: Path, choice: ImageChoice) -> tuple[Planes, ImageChoice]:
+    """The planes of a load-series file that hold ``choice.load``'s image, and the choice
+    that picks it from them (its frame, where frames carry the loads). The file must hold
+    exactly one plane per load along the load axis: ImageError naming it, what it holds and
+    the loads otherwise."""
+    load = choice.load
+    if is_plain_tiff(path):
+        raise ImageError(
+            f"{path}: a plain TIFF holds one image, but optics.images.load_series reads "
+            f"{len(load.plane_loads_mn)} loads from it; expected an OME-TIFF, ImageJ "
+            "hyperstack or CZI holding one series or frame per load"
+        )
+    if load.axis == "series":
+        count = _readable(path, _series_count)
+        if count != len(load.plane_loads_mn):
+            raise _load_count_error(path, load, f"it holds {count} series")
+        return read_planes(path, load.index), choice
+    planes = read_planes(path, choice.series)
+    if len(planes.data) != len(load.plane_loads_mn):
+        raise _load_count_error(path, load, planes.describe())
+    return planes, ImageChoice(choice.channel, choice.series, load.index)

@@ -2,6 +2,10 @@
 
 <folder>/fluorescence/<load in mN>.tif   one confocal image per load (e.g. 25.tif or 25mN.tif),
                                          or .ome.tif or .czi (CONFOCAL_SUFFIXES)
+<folder>/fluorescence.ome.tif            or instead one file holding every load (.ome.tif,
+                                         ImageJ .tif or .czi): one series or one frame per
+                                         load, mapped to the sheet's loads by the config
+                                         (optics.images.load_series; :func:`plane_loads`)
 <folder>/rheometer/<load in mN>.csv      one friction test per load: our CSV
                                          (amontons.io.rheometer) or the program's export,
                                          .csv or .txt (amontons.io.rheometer_export)
@@ -42,6 +46,19 @@ FLIM_NAMES = (FLIM_NAME, FLIM_PTU_NAME)
 AFM_BEFORE_NAME = "afm_before.tif"
 AFM_AFTER_NAME = "afm_after.tif"
 FLUORESCENCE_DIR = "fluorescence"
+# The one file that holds a sphere's whole load series, in place of FLUORESCENCE_DIR:
+# <folder>/fluorescence.<one of CONFOCAL_SUFFIXES> (config/README.md, "A load series in one
+# file").
+LOAD_SERIES_STEM = "fluorescence"
+# The axes of a confocal file that may carry the loads (config optics.images.load_series.axis),
+# and the plane order that follows the sheet's load order (load_series.planes).
+LOAD_AXES = ("series", "frames")
+IN_LOAD_ORDER = "in_load_order"
+# The choice of optics.images that each load axis takes over, and that choice's default
+# (amontons.io.confocal.ImageChoice): it cannot also pick a plane along the same axis.
+LOAD_AXIS_CHOICE = {"series": ("series", 0), "frames": ("frames", "mean")}
+# One plane along each load axis, by name (messages, python -m amontons.check).
+PLANE_NOUN = {"series": "series", "frames": "frame"}
 RHEOMETER_DIR = "rheometer"
 # Our own CSV, and the suffixes rheometer programs give their text exports.
 RHEOMETER_SUFFIXES = (".csv", ".txt")
@@ -172,6 +189,55 @@ def confocal_file(folder: str | Path, stem: str) -> Path | None:
             f"{folder}: {', '.join(p.name for p in found)}; expected one {stem} image"
         )
     return found[0] if found else None
+
+
+def load_axis_conflict(axis: str, choice: dict) -> str | None:
+    """Why the image choice ``choice`` (keys series, frames of optics.images) conflicts with
+    loads carried along ``axis``, or None: the series (frames) of a load-series file are its
+    loads, one each, so optics.images.series (frames) cannot pick among them too."""
+    key, default = LOAD_AXIS_CHOICE[axis]
+    if choice[key] == default:
+        return None
+    return (
+        f"optics.images.{key} is {choice[key]!r}, but optics.images.load_series.axis is "
+        f"'{axis}': the {axis} of the load-series file are its loads, one {PLANE_NOUN[axis]} each; "
+        f"expected {key} {default!r} (it then applies to the per-load, reflection and bead "
+        f"images only), or the loads along the other axis"
+    )
+
+
+def load_count_mismatch(path: str | Path, described: str, axis: str, plane_loads_mn) -> str:
+    """The message for a load-series file ``path`` whose planes along ``axis`` are not one per
+    load: ``described`` says what it holds (e.g. 'it holds 4 series')."""
+    loads = len(plane_loads_mn)
+    return (
+        f"{path}: {described}, but optics.images.load_series puts the sheet's {loads} loads "
+        f"{list(plane_loads_mn)} mN along its {axis}, one each; expected exactly {loads} {axis}"
+    )
+
+
+def plane_loads(loads_mn: Sequence[float], planes: str | Sequence[int], where: str) -> list[float]:
+    """The load (mN) of each plane of a load-series file, in plane order, from the sheet's
+    ``loads_mn`` and the config's ``planes`` (IN_LOAD_ORDER: plane i is the i-th load; or a
+    list giving each load's plane index, in the sheet's load order).
+
+    Every plane must be a load and every load a plane: a list must give as many distinct
+    indices as there are loads, from 0 to one less (a plane left over may as well be a load
+    the sheet left out). Raises RawDataError naming ``where`` (the sphere) otherwise.
+    """
+    if planes == IN_LOAD_ORDER:
+        return list(loads_mn)
+    planes = list(planes)
+    if sorted(planes) != list(range(len(loads_mn))):
+        raise RawDataError(
+            f"{where}: optics.images.load_series.planes {planes} for the sheet's "
+            f"{len(loads_mn)} loads {list(loads_mn)} mN; expected one plane index per load, "
+            f"each of 0 to {len(loads_mn) - 1} once"
+        )
+    by_plane = [0.0] * len(loads_mn)
+    for load, plane in zip(loads_mn, planes, strict=True):
+        by_plane[plane] = load
+    return by_plane
 
 
 def rheometer_files(folder: str | Path, loads_mn: Sequence[float]) -> list[Path]:

@@ -12,7 +12,12 @@ The readers (amontons.io.confocal, amontons.io.tiff) take the pixel from the sam
   an OME-TIFF: PhysicalSizeX in the OME-XML;
 - CZI: the Scaling of the XML metadata segment (X distance > 0).
 
-tests/io/test_pixel_probe.py holds the probe to the readers on files their writers made.
+The same headers say how many series and frames a file holding a sphere's whole load series
+has (:func:`load_plane_count`), so that one with a plane too many or too few stops the run
+before any job too.
+
+tests/io/test_pixel_probe.py holds the probe to the readers on files their writers made
+(tests/io/test_load_series.py the plane count).
 """
 
 from __future__ import annotations
@@ -122,7 +127,8 @@ def _tiff_states_pixel(path: Path) -> bool:
     return _tag_pixel_m(tags, _X_RESOLUTION) is not None
 
 
-def _czi_states_pixel(path: Path) -> bool:
+def _czi_metadata(path: Path) -> ElementTree.Element:
+    """The root of a CZI's XML metadata segment."""
     with open(path, "rb") as stream:
         header = stream.read(_CZI_METADATA_POSITION + 8)
         if not header.startswith(_CZI_MAGIC) or len(header) < _CZI_METADATA_POSITION + 8:
@@ -135,9 +141,13 @@ def _czi_states_pixel(path: Path) -> bool:
         (xml_size,) = struct.unpack("<i", segment[32:36])
         xml = stream.read(xml_size)
     try:
-        root = ElementTree.fromstring(xml)
+        return ElementTree.fromstring(xml)
     except ElementTree.ParseError as error:
         raise RawDataError(f"{path}: unreadable CZI metadata ({error})") from error
+
+
+def _czi_states_pixel(path: Path) -> bool:
+    root = _czi_metadata(path)
     for distance in root.iter("Distance"):
         if distance.get("Id") == "X":
             value = distance.findtext("Value") or "0"
@@ -145,16 +155,71 @@ def _czi_states_pixel(path: Path) -> bool:
     return False
 
 
+def _size(element: ElementTree.Element | None, name: str, get) -> int:
+    """A size of ``element`` (1 where it gives none)."""
+    value = None if element is None else get(element, name)
+    return int(value) if value else 1
+
+
+def _tiff_plane_count(path: Path, axis: str, series: int) -> int | None:
+    """Series (OME images) or frames (T x Z of series ``series``) of an OME-TIFF or ImageJ
+    hyperstack, from the first page's ImageDescription; None for a plain TIFF."""
+    description = str(_tiff_tags(path).get(_IMAGE_DESCRIPTION, ""))
+    if "<OME" in description:
+        root = ElementTree.fromstring(description)
+        images = [e for e in root if e.tag.endswith("}Image")]
+        if axis == "series":
+            return len(images)
+        if not 0 <= series < len(images):
+            return None  # the job names the series the file lacks
+        pixels = next((e for e in images[series] if e.tag.endswith("}Pixels")), None)
+        return _size(pixels, "SizeT", ElementTree.Element.get) * _size(
+            pixels, "SizeZ", ElementTree.Element.get
+        )
+    if description.startswith("ImageJ="):
+        if axis == "series":
+            return 1  # a hyperstack is one series
+        fields = dict(re.findall(r"^(\w+)=(.*)$", description, re.MULTILINE))
+        return int(fields.get("images", 1)) // int(fields.get("channels", 1))
+    return None
+
+
+def _czi_plane_count(path: Path, axis: str) -> int:
+    """Scenes (SizeS) or frames (SizeT x SizeZ) of a CZI, from its XML metadata."""
+    image = next(_czi_metadata(path).iter("Image"), None)
+    if axis == "series":
+        return _size(image, "SizeS", ElementTree.Element.findtext)
+    find = ElementTree.Element.findtext
+    return _size(image, "SizeT", find) * _size(image, "SizeZ", find)
+
+
+def _header(path: Path, read, *args):
+    """``read(path, *args)``, with a header that cannot be read raised as RawDataError naming
+    the file."""
+    try:
+        return read(path, *args)
+    except (OSError, struct.error, ValueError, UnicodeDecodeError) as error:
+        if isinstance(error, RawDataError):
+            raise
+        raise RawDataError(f"{path}: unreadable image header ({error})") from error
+
+
 def states_pixel_size(path: str | Path) -> bool:
     """Whether the confocal image ``path`` (a suffix of amontons.io.layout.CONFOCAL_SUFFIXES)
     states its pixel size in its metadata. Raises RawDataError naming the file when its header
     cannot be read."""
     path = Path(path)
-    try:
-        if confocal_suffix(path) == ".czi":
-            return _czi_states_pixel(path)
-        return _tiff_states_pixel(path)
-    except (OSError, struct.error, ValueError, UnicodeDecodeError) as error:
-        if isinstance(error, RawDataError):
-            raise
-        raise RawDataError(f"{path}: unreadable image header ({error})") from error
+    read = _czi_states_pixel if confocal_suffix(path) == ".czi" else _tiff_states_pixel
+    return _header(path, read)
+
+
+def load_plane_count(path: str | Path, axis: str, series: int = 0) -> int | None:
+    """How many planes a load-series file holds along ``axis`` (amontons.io.layout.LOAD_AXES):
+    its series (OME images, CZI scenes), or the frames (time points x z planes) of series
+    ``series``, as amontons.io.confocal counts them, read from the header alone; None where
+    the header does not say (a plain TIFF: the job's reader names what is wrong). Raises
+    RawDataError naming the file when its header cannot be read."""
+    path = Path(path)
+    if confocal_suffix(path) == ".czi":
+        return _header(path, _czi_plane_count, axis)
+    return _header(path, _tiff_plane_count, axis, series)

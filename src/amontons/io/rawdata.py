@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from amontons.io.absorbance import AbsorbanceError, read_absorbance_csv
-from amontons.io.confocal import NO_CHOICE, ImageChoice, read_confocal
-from amontons.io.layout import RawDataError
+from amontons.io.confocal import NO_CHOICE, ImageChoice, LoadPlane, read_confocal
+from amontons.io.layout import RawDataError, fluorescence_names, per_load_files, same_load
 from amontons.io.ptu import PhotonImage, PtuError, read_ptu_image
 from amontons.io.rheometer import RheometerError, RheometerTrace, read_rheometer_csv
 from amontons.io.rheometer_export import ExportMap, read_rheometer_export
@@ -146,15 +146,66 @@ def read_absorbance(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
         raise RawDataError(str(error)) from error
 
 
+def fluorescence_planes(
+    given: str | Path | Sequence[str | Path], loads_mn: Sequence[float], images: dict
+) -> tuple[list[Path], list[ImageChoice]]:
+    """Where each load's fluorescence image is, in the order of ``loads_mn`` (mN): the file
+    and the plane of it.
+
+    ``images`` is a rule's ``images`` param (amontons.workflow.spheres.Spheres.image_params):
+    the keyword arguments of ImageChoice, and for a sphere whose one file holds every load,
+    ``load_series`` ({axis, plane_loads_mn}: the load axis and the load of each plane). Then
+    ``given`` is that one file and each load gets its plane; else ``given`` is one file per
+    load, or the virtual experiment's folder (amontons.io.layout.per_load_files). Raises
+    RawDataError naming the file for a load that is none of its planes'.
+    """
+    images = dict(images)
+    series = images.pop("load_series", None)
+    if series is None:
+        paths = per_load_files(given, loads_mn, fluorescence_names)
+        return paths, [ImageChoice(**images)] * len(paths)
+    # the one file, for every load (per_load_files checks that it is one file and there)
+    (path,) = per_load_files(given, [series["plane_loads_mn"][0]], fluorescence_names)
+    plane_loads = tuple(series["plane_loads_mn"])
+    missing = [load for load in loads_mn if not any(same_load(load, f) for f in plane_loads)]
+    if missing:
+        raise RawDataError(
+            f"{path}: no plane for {missing} mN; expected one of its planes' loads "
+            f"{list(plane_loads)} mN"
+        )
+    choices = [
+        ImageChoice(**images, load=LoadPlane(series["axis"], plane_loads, load))
+        for load in loads_mn
+    ]
+    return [path] * len(loads_mn), choices
+
+
+def read_fluorescence_loads(
+    given: str | Path | Sequence[str | Path],
+    loads_mn: Sequence[float],
+    fallback_pixel_m: float | None,
+    images: dict,
+) -> list[Image]:
+    """Each load's fluorescence image, in the order of ``loads_mn`` (mN), wherever
+    :func:`fluorescence_planes` finds it (``given``, ``images``: a rule's input and param), read
+    as :func:`read_fluorescence_series` reads them (``fallback_pixel_m``: the sheet's, m)."""
+    paths, choices = fluorescence_planes(given, loads_mn, images)
+    return read_fluorescence_series(paths, fallback_pixel_m, choices)
+
+
 def read_fluorescence_series(
-    paths: Sequence[str | Path], fallback_pixel_m: float | None, choice: ImageChoice = NO_CHOICE
+    paths: Sequence[str | Path],
+    fallback_pixel_m: float | None,
+    choice: ImageChoice | Sequence[ImageChoice] = NO_CHOICE,
 ) -> list[Image]:
     """A sphere's fluorescence images (``paths``, one per load; the plane ``choice`` picks of
-    each); raises RawDataError if their pixel sizes differ (areas and pressures of one series
-    share one pixel)."""
+    each, or the plane of each load's own choice, :func:`fluorescence_planes`); raises
+    RawDataError if their pixel sizes differ (areas and pressures of one series share one
+    pixel)."""
+    choices = [choice] * len(paths) if isinstance(choice, ImageChoice) else list(choice)
     images = []
-    for path in paths:
-        image = read_fluorescence(path, fallback_pixel_m, choice)
+    for path, plane in zip(paths, choices, strict=True):
+        image = read_fluorescence(path, fallback_pixel_m, plane)
         if images and abs(image.pixel_m - images[0].pixel_m) > 1e-6 * images[0].pixel_m:
             raise RawDataError(
                 f"{path}: pixel {image.pixel_m * 1e9:.4g} nm differs from "

@@ -126,11 +126,12 @@ def measure_intensity_pressure(
     background_margin_px: int,
     pressure_ref_pa: float,
     confidence: float = 0.95,
-    choice: ImageChoice = NO_CHOICE,
+    choice: ImageChoice | Sequence[ImageChoice] = NO_CHOICE,
 ) -> tuple[IntensityPressure, list[float], dict[float, str]]:
     """Mean contact intensity versus mean contact pressure F/A (appendix Fig. B.4), from
     the fluorescence images ``image_paths`` (one per load of ``loads_mn``; ``choice``: the plane
-    of a confocal file, amontons.io.confocal).
+    of a confocal file, amontons.io.confocal, or each load's own, as a file holding the whole
+    load series needs: amontons.io.rawdata.fluorescence_planes).
 
     Returns the fit, each fitted image's background (counts, from the pixels far from the
     mask) and the loads left out (mN → why): an image in which no contact stands out

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from amontons.accuracy.settings import check_accuracy_study
+from amontons.config.errors import ConfigError
 from amontons.config.scenes import (
     check_curvature_pairs,
     check_scans,
@@ -24,7 +25,7 @@ from amontons.config.sheet import (
     check_shared_files,
     read_sample_sheet,
 )
-from amontons.io.layout import IMAGE_FORMATS
+from amontons.io.layout import IMAGE_FORMATS, load_axis_conflict
 from amontons.workflow.accuracy import AccuracyStudy
 from amontons.workflow.ledger import read_held_out
 from amontons.workflow.paths import RunPaths
@@ -67,7 +68,21 @@ def load_workflow_config(
     check_scans(config, source)
     check_curvature_pairs(config, source)
     check_accuracy_study(config, sheet, source)
+    check_load_series(config["optics"]["images"], source)
     return selected
+
+
+def check_load_series(images: Mapping, source: str) -> None:
+    """optics.images.load_series takes over the choice along its axis (series or frames):
+    that choice must keep its default, as a file of one plane per load has no other plane to
+    pick (amontons.io.layout.load_axis_conflict). Each sphere's planes are checked against
+    its loads when the DAG looks at its folder (amontons.workflow.spheres)."""
+    series = images["load_series"]
+    if series is None:
+        return
+    conflict = load_axis_conflict(series["axis"], images)
+    if conflict is not None:
+        raise ConfigError(f"{source}: {conflict}")
 
 
 @dataclass
@@ -140,8 +155,10 @@ class WorkflowRun:
             psf_stand_in=config["optics"]["psf"].get("stand_in") is not None,
             synthetic_flim=config["virtual_experiment"]["formats"]["flim"],
             synthetic_images=IMAGE_FORMATS[config["virtual_experiment"]["formats"]["images"]],
+            load_series=config["optics"]["images"]["load_series"],
         )
         spheres.check_pixel_sizes()
+        spheres.check_load_series_files(config["optics"]["images"]["series"])
         digest = config_digest(config)
         spheres.hold_out(
             read_held_out(paths, spheres, lambda sphere: spheres.data_stamp(sphere, digest))

@@ -3,7 +3,10 @@ their raw data lie and which raw files a rule reads (config/README.md, "Your own
 
 Raw data are the virtual experiment's (data_source 'synthetic') or a folder the sheet names.
 A measured sphere's per-load files are matched to its sheet loads here, at DAG time
-(amontons.io.layout), so that a replaced file re-runs exactly the jobs that read it.
+(amontons.io.layout), so that a replaced file re-runs exactly the jobs that read it. A sphere
+may instead give one file holding every load (config/README.md, "A load series in one file"):
+then that file is every fluorescence job's input, and the jobs' ``images`` param says which
+plane is which load.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from amontons.io.layout import (
     BEAD_STEM,
     CONFOCAL_SUFFIXES,
     FLUORESCENCE_DIR,
+    LOAD_SERIES_STEM,
     REFLECTION_STEM,
     RHEOMETER_DIR,
     RawDataError,
@@ -28,10 +32,13 @@ from amontons.io.layout import (
     flim_file,
     fluorescence_images,
     folder_files,
+    load_count_mismatch,
+    plane_loads,
     rheometer_files,
 )
-from amontons.io.pixel_probe import states_pixel_size
+from amontons.io.pixel_probe import load_plane_count, states_pixel_size
 from amontons.workflow.failures import FailedJob
+from amontons.workflow.params import sorted_keys
 from amontons.workflow.paths import CONTACT_AREA, RunPaths
 
 # The sheet values a scene takes from its sphere.
@@ -76,17 +83,22 @@ class Spheres:
         psf_stand_in: bool = False,
         synthetic_flim: str = "tif",
         synthetic_images: str = ".tif",
+        load_series: Mapping | None = None,
     ):
         """``psf_stand_in``: whether the config gives a PSF (optics.psf.stand_in) for the
         spheres with no bead image; ``synthetic_flim``: the format of the virtual experiment's
         FLIM file ('tif' or 'ptu', config virtual_experiment.formats.flim);
         ``synthetic_images``: the suffix of its confocal images ('.tif', '.ome.tif', '.czi';
-        amontons.io.layout.IMAGE_FORMATS of virtual_experiment.formats.images)."""
+        amontons.io.layout.IMAGE_FORMATS of virtual_experiment.formats.images);
+        ``load_series``: how a file holding a sphere's whole load series maps its planes to
+        the loads (config optics.images.load_series: {axis, planes}; None: no such file is
+        accepted)."""
         self.records = dict(records)
         self.paths = paths
         self.psf_stand_in = psf_stand_in
         self.synthetic_flim = synthetic_flim
         self.synthetic_images = synthetic_images
+        self.load_series = None if load_series is None else dict(load_series)
         self._missing: dict[str, dict[str, str]] = {}
         self.held_out: dict[str, list[FailedJob]] = {}
 
@@ -180,26 +192,101 @@ class Spheres:
                 "CZI Scaling, TIFF resolution tags)"
             )
 
+    def load_series_file(self, sphere: str) -> str | None:
+        """A measured sphere's one file holding every load's fluorescence image
+        (``<folder>/fluorescence.<suffix>``, amontons.io.layout.LOAD_SERIES_STEM); None where
+        it has none (the virtual experiment writes one image per load).
+
+        Raises RawDataError naming both where the folder also has the per-load
+        ``fluorescence/``, and naming the file where the config does not say how its planes
+        map to the loads (optics.images.load_series): neither is guessed."""
+        if self.is_synthetic(sphere):
+            return None
+        folder = self.raw_dir(sphere)
+        found = confocal_file(folder, LOAD_SERIES_STEM)
+        if found is None:
+            return None
+        if os.path.isdir(f"{folder}/{FLUORESCENCE_DIR}"):
+            raise RawDataError(
+                f"sphere {sphere}: both {folder}/{FLUORESCENCE_DIR}/ (one image per load) and "
+                f"{found} (every load in one file); expected one of the two"
+            )
+        if self.load_series is None:
+            raise RawDataError(
+                f"sphere {sphere}: {found} holds every load, but optics.images.load_series is "
+                "null; expected it to say which axis (series or frames) carries the loads and "
+                "which plane is which load (config/README.md, 'A load series in one file')"
+            )
+        return str(found)
+
+    def plane_loads(self, sphere: str) -> list[float] | None:
+        """The load (mN) of each plane of a sphere's load-series file, in plane order; None
+        where it has per-load images. A planes list that does not fit the sheet's loads stops
+        the run, naming the sphere (amontons.io.layout.plane_loads)."""
+        if self.load_series_file(sphere) is None:
+            return None
+        return plane_loads(self.loads_mn(sphere), self.load_series["planes"], f"sphere {sphere}")
+
+    def fluorescence_choice(self, sphere: str, images: Mapping) -> dict:
+        """The ``images`` param of a rule that reads a sphere's fluorescence images: the
+        config's choice (amontons.workflow.params.image_choice), plus for a load-series file
+        ``load_series`` {axis, plane_loads_mn} (amontons.io.rawdata.fluorescence_planes).
+        Spheres with per-load images get ``images`` as it is, so their jobs' params, and
+        what they make, stay those of a run without load-series files."""
+        planes = self.plane_loads(sphere)
+        if planes is None:
+            return dict(images)
+        series = {"axis": self.load_series["axis"], "plane_loads_mn": planes}
+        return sorted_keys({**images, "load_series": series})
+
+    def check_load_series_files(self, series: int = 0) -> None:
+        """Stop the run before any job where a sphere's load-series file does not hold one
+        plane per load along the load axis, as its header says (amontons.io.pixel_probe;
+        ``series``: optics.images.series, the series whose frames carry the loads):
+        RawDataError naming the sphere, the file, what it holds and the loads. A header that
+        does not say is left to the jobs' reader, which counts the planes again; a folder that
+        cannot be mapped at all, to the rules' input functions, which name it."""
+        for sphere in self.records:
+            try:
+                path, planes = self.load_series_file(sphere), self.plane_loads(sphere)
+            except RawDataError:
+                continue
+            if path is None:
+                continue
+            axis = self.load_series["axis"]
+            count = load_plane_count(path, axis, series)
+            if count is not None and count != len(planes):
+                described = f"it holds {count} {axis} (its header says)"
+                raise RawDataError(
+                    f"sphere {sphere}: {load_count_mismatch(path, described, axis, planes)}"
+                )
+
     def per_load_inputs(self, sphere: str, kind: str) -> str | list[str]:
         """The per-load raw files of a sphere, 'fluorescence' or 'rheometer', in load order.
 
         Measured data: each load's file, matched to the sheet's loads (a folder that does not
-        match them stops the run, naming it), so that the script reads exactly these files.
-        Synthetic data: the folder, which the virtual experiment writes whole and names by
-        load (amontons.io.layout.per_load_files)."""
+        match them stops the run, naming it), so that the script reads exactly these files;
+        for fluorescence held in one load-series file, that file alone (every load's job
+        reads it). Synthetic data: the folder, which the virtual experiment writes whole and
+        names by load (amontons.io.layout.per_load_files)."""
         subfolder = FLUORESCENCE_DIR if kind == "fluorescence" else RHEOMETER_DIR
         folder = f"{self.raw_dir(sphere)}/{subfolder}"
         if self.is_synthetic(sphere):
             return folder
+        if kind == "fluorescence" and self.load_series_file(sphere) is not None:
+            return [self.load_series_file(sphere)]
         files = fluorescence_images if kind == "fluorescence" else rheometer_files
         return [str(path) for path in files(folder, self.loads_mn(sphere))]
 
     def reflection_fluorescence(self, sphere: str) -> str:
         """The one fluorescence image the edge gap reads: the one at the reflection load (for
-        synthetic data, the folder the virtual experiment writes it into)."""
+        synthetic data, the folder the virtual experiment writes it into; for a load-series
+        file, that file)."""
         images = self.per_load_inputs(sphere, "fluorescence")
         if self.is_synthetic(sphere):
             return images
+        if self.load_series_file(sphere) is not None:
+            return images[0]
         load = self.value(sphere, "reflection_load_mn")
         return images[[abs(load - f) < 1e-9 for f in self.loads_mn(sphere)].index(True)]
 
