@@ -97,45 +97,22 @@ def test_gap_moments(state):
         _close_sum(g, w, mag)
 
 
+def _violator_records(ks, nch):
+    """``(vidx, vg)`` of a kernel set's direction."""
+    return np.zeros((nch, ks.SLOTS), np.int64), np.zeros((nch, ks.SLOTS))
+
+
 @pytest.mark.parametrize("bounded", [False, True])
 def test_direction(state, bounded):
     s = state
     p_max = s["p_max"] if bounded else np.full(1, np.inf)
     t_num, t_arr = s["t"].copy(), s["t"].copy()
-    v_num, v_arr = np.zeros(K.n_chunks(N), np.int64), np.zeros(1, np.int64)
     nch = K.n_chunks(N)
-    got = A.direction(
-        s["u"],
-        1.1,
-        s["h"],
-        s["m"],
-        t_arr,
-        0.1,
-        0.7,
-        0.05,
-        s["p"],
-        p_max,
-        bounded,
-        v_arr,
-        np.zeros((1, A.SLOTS), np.int64),
-        np.zeros((1, A.SLOTS)),
-    )
-    want = K.direction(
-        s["u"],
-        1.1,
-        s["h"],
-        s["m"],
-        t_num,
-        0.1,
-        0.7,
-        0.05,
-        s["p"],
-        p_max,
-        bounded,
-        v_num,
-        np.zeros((nch, K.SLOTS), np.int64),
-        np.zeros((nch, K.SLOTS)),
-    )
+    v_num, v_arr = np.zeros(nch, np.int64), np.zeros(1, np.int64)
+    head = (s["u"], 1.1, s["h"], s["m"])
+    tail = (0.1, 0.7, 0.05, s["p"], p_max, bounded)
+    got = A.direction(*head, t_arr, *tail, v_arr, *_violator_records(A, 1))
+    want = K.direction(*head, t_num, *tail, v_num, *_violator_records(K, nch))
     np.testing.assert_allclose(t_arr, t_num, rtol=ELEMENT_RTOL, atol=1e-15)
     _close_sum(float(got), want, np.abs(t_num).sum())
     # the violator count (the numba set keeps a chunk's count when it exceeds SLOTS)
@@ -203,7 +180,7 @@ def test_update(bounded, events, keep_mask, with_u):
         nch = ks.n_chunks(N)
         if ks is K:
             viol = np.zeros(nch, np.int64)
-            vidx, vg = np.zeros((nch, K.SLOTS), np.int64), np.zeros((nch, K.SLOTS))
+            vidx, vg = _violator_records(K, nch)
             K.direction(
                 c["u"],
                 sigma,
@@ -226,29 +203,10 @@ def test_update(bounded, events, keep_mask, with_u):
         idx, val = np.zeros((nch, ks.SLOTS), np.int64), np.zeros((nch, ks.SLOTS))
         counts = np.zeros((nch, 2), np.int64)
         p_new = c["p"] if not keep_mask else np.empty(N)
-        out = ks.update(
-            c["p"],
-            p_new,
-            c["u"],
-            c["r"],
-            c["t"],
-            c["h"],
-            c["m"],
-            c["p_max"],
-            bounded,
-            sigma,
-            d,
-            tau,
-            viol,
-            idx,
-            val,
-            counts,
-            keep_mask,
-            with_u,
-            vidx,
-            vg,
-            record_max,
-        )
+        fields = [c[k] for k in ("u", "r", "t", "h", "m", "p_max")]
+        step = (bounded, sigma, d, tau)
+        records = (viol, idx, val, counts, keep_mask, with_u, vidx, vg, record_max)
+        out = ks.update(c["p"], p_new, *fields, *step, *records)
         results[name] = (out, c, p_new, counts.sum(axis=0), _records(counts, idx, val))
     (o_n, c_n, p_n, k_n, r_n), (o_a, c_a, p_a, k_a, r_a) = results["numba"], results["array"]
     assert np.array_equal(k_n, k_a)
