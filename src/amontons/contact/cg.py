@@ -322,7 +322,11 @@ def _loop(
     def conv(x, out):
         nonlocal calls
         calls += 1
-        operator(x.reshape(shape), out=out.reshape(shape))
+        base_op(x.reshape(shape), out=out.reshape(shape))
+        if winkler:
+            # the elastic-plus-Winkler operator's K*x + x/k (winkler.WinklerOperator), with the
+            # compliance in the kernel set's memory
+            out += compliance * x
         return out
 
     if load_control:
