@@ -229,11 +229,11 @@ def test_update(bounded, events, keep_mask, with_u):
         step = (bounded, sigma, d, tau)
         records = (viol, idx, val, counts, keep_mask, with_u, vidx, vg, record_max)
         out = ks.update(c["p"], p_new, *fields, *step, *records)
-        results[name] = (out, c, p_new, counts.sum(axis=0), _records(counts, idx, val))
+        results[name] = (out, c, p_new, ks.event_counts(counts), _records(counts, idx, val))
     (o_n, c_n, p_n, k_n, r_n), (o_a, c_a, p_a, k_a, r_a) = results["numba"], results["array"]
-    assert np.array_equal(k_n, k_a)
+    assert k_n == k_a  # (clipped, added)
     if events:
-        assert k_n.sum() >= 2 * events * 0.9  # the case made the events it was meant to
+        assert sum(k_n) >= 2 * events * 0.9  # the case made the events it was meant to
     np.testing.assert_allclose(p_a, p_n, rtol=ELEMENT_RTOL, atol=0)
     assert np.array_equal(c_a["m"], c_n["m"]) and np.array_equal(c_a["t"], c_n["t"])
     np.testing.assert_allclose(c_a["u"], c_n["u"], rtol=ELEMENT_RTOL)
@@ -241,7 +241,7 @@ def test_update(bounded, events, keep_mask, with_u):
     assert o_a[1] == pytest.approx(o_n[1], rel=ELEMENT_RTOL)
     _close_sum(o_a[2], o_n[2], np.abs(p_n).sum())
     assert o_a[3] == o_n[3]
-    if o_n[3] and k_n.sum():
+    if o_n[3] and sum(k_n):
         assert [i for i, _ in r_a] == [i for i, _ in r_n]
         np.testing.assert_allclose([v for _, v in r_a], [v for _, v in r_n], rtol=1e-14)
 

@@ -291,6 +291,11 @@ class ArrayKernels:
         p[...] = q
         return total, at_bound, int(left), int(joined)
 
+    def event_counts(self, counts) -> tuple[int, int]:
+        """The points ``update`` clipped and added, in one transfer."""
+        n_clip, n_add = self.to_host(counts.sum(axis=0)).tolist()
+        return int(n_clip), int(n_add)
+
     def changed_points(self, counts, idx_buf, val_buf):
         """Flat indices and added pressures (Pa) recorded by the last ``update`` or
         ``rescale_free`` (arrays of the namespace)."""

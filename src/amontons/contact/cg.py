@@ -253,7 +253,8 @@ def kernel_set(options: CGOptions):
     ``empty(n, dtype)``, ``asarray`` (host to the set's memory), ``to_host``, ``on_host(fn,
     *args, writes=())`` (a numpy routine on host copies, the arrays at ``writes`` copied
     back; the numba set calls ``fn`` as it is), ``add_at`` (``np.add.at``),
-    ``kernel_threads``, ``n_chunks`` and ``SLOTS``."""
+    ``event_counts`` (the points ``update`` clipped and added, as ints), ``kernel_threads``,
+    ``n_chunks`` and ``SLOTS``."""
     if options.array_module is None:
         return _k
     return array_kernel_set(options.array_module)
@@ -512,8 +513,7 @@ def _loop(
                 violators, idx_buf, val_buf, counts, False, not split, vidx, vg,
                 sparse_max if sparse_ok else -1,
             )  # fmt: skip
-            n_clip = int(counts[:, 0].sum())
-            n_add = int(counts[:, 1].sum())
+            n_clip, n_add = ks.event_counts(counts)
             backtracked = False
         if backtracked:
             delta = 0.0

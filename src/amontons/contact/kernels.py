@@ -976,6 +976,11 @@ def empty(n: int, dtype=np.float64) -> np.ndarray:
     return _fft.empty(n, dtype, _ALIGNED)
 
 
+def event_counts(counts) -> tuple[int, int]:
+    """The points ``update`` clipped and added, over every chunk of ``counts``."""
+    return int(counts[:, 0].sum()), int(counts[:, 1].sum())
+
+
 def on_host(fn, *args, writes=()):
     """``fn(*args)``: the arrays are on the host already (``writes`` is the array set's
     concern, :meth:`.array_kernels.ArrayKernels.on_host`)."""
