@@ -43,6 +43,7 @@ def main(
     images: dict,
     otsu: dict,
     threads: int,
+    solver_backend: str = "cpu",
 ) -> None:
     config = scene_config_at(base_config, scan["parameter"], value)
     levelled = load_levelled_map(levelled_path)
@@ -64,7 +65,7 @@ def main(
         return
     indenter = afm_indenter(levelled, scene, levelled_path)
     try:
-        solution = solve_scene(scene, indenter, threads=threads)
+        solution = solve_scene(scene, indenter, threads=threads, backend=solver_backend)
     except FreeBoundaryError as error:
         # A value so soft that the contact outgrows the base scene's window (which holds the
         # measured contact with room to spare) matches the measurement worse than any value
@@ -170,4 +171,5 @@ if __name__ == "__main__":
         images=sm.params.images,
         otsu=sm.params.otsu,
         threads=sm.threads,
+        solver_backend=sm.params.get("solver_backend", "cpu"),
     )

@@ -55,6 +55,7 @@ def main(
     sphere: str | None,
     sphere_record: dict | None,
     threads: int,
+    solver_backend: str = "cpu",
 ) -> None:
     coverage = {}
     if sphere is None:
@@ -80,7 +81,7 @@ def main(
         indenter.afm_statistics["roughness_rms_nm"],
         indenter.afm_statistics["slope_rms"],
     )
-    solution = solve_scene(scene, indenter, threads=threads)
+    solution = solve_scene(scene, indenter, threads=threads, backend=solver_backend)
     settings = {
         **scene.to_record(),
         "sphere": sphere,
@@ -110,4 +111,5 @@ if __name__ == "__main__":
         sphere=sm.params.sphere,
         sphere_record=sm.params.sphere_record,
         threads=sm.threads,
+        solver_backend=sm.params.get("solver_backend", "cpu"),
     )

@@ -202,11 +202,11 @@ def test_no_module_outside_the_solver_closes_an_import_circle():
 # only modules of its own floor or of floors below it, never above.
 CONTACT_FLOORS = (
     # 1. laws, options, results: what a caller passes and gets
-    ("errors", "laws", "options", "result", "surfaces"),
+    ("errors", "laws", "options", "result", "surfaces", "array_backends"),
     # 2. operators: FFT plans and wisdom, Green's functions, convolutions
-    ("wisdom", "fft", "greens", "jit", "spectrum", "convolution"),
+    ("wisdom", "fft", "greens", "jit", "spectrum", "array_convolution", "convolution"),
     # 3. kernel sets: the element-wise work of one iteration
-    ("kernels", "bounded_load"),
+    ("kernels", "array_kernels", "bounded_load"),
     # 4. the iteration: the one Polonsky-Keer control flow
     ("stall", "cg"),
     # 5. routes, chosen from one table
@@ -301,6 +301,27 @@ def test_the_solver_hides_no_import():
         hit for path in sorted((PACKAGE / "contact").glob("*.py")) for hit in _hidden_imports(path)
     ]
     assert hidden == []
+
+
+def test_cupy_is_imported_by_one_module_only():
+    """CuPy, the optional GPU dependency, is imported in one small module
+    (amontons.contact.array_backends) and only inside the function that loads it, so that
+    no other import, and no solve on the CPU, needs it."""
+    found = {
+        f"{_module_name(path)}:{base}"
+        for path in PACKAGE.rglob("*.py")
+        for base, _ in _import_pairs(path)
+        if base.split(".")[0] in ("cupy", "cupyx")
+    }
+    loader = "amontons.contact.array_backends"
+    assert found == {f"{loader}:cupy", f"{loader}:cupyx"}
+    tree = ast.parse((PACKAGE / "contact" / "array_backends.py").read_text())
+    at_top = [
+        node.lineno
+        for node in tree.body
+        if isinstance(node, ast.Import | ast.ImportFrom) and "cupy" in ast.unparse(node)
+    ]
+    assert at_top == []
 
 
 def _function_level_imports(module: str) -> list[str]:

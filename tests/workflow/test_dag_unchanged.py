@@ -34,8 +34,9 @@ CASES = {
 }
 
 
-def current_jobs(project: Path, name: str) -> list[dict]:
-    """The jobs of case ``name`` as the workflow builds them now, in ``project``."""
+def current_jobs(project: Path, name: str, extra_configs=()) -> list[dict]:
+    """The jobs of case ``name`` as the workflow builds them now, in ``project`` (with the
+    config files ``extra_configs`` merged over its own)."""
     overlay, target = CASES[name]
     command = [
         sys.executable,
@@ -44,6 +45,7 @@ def current_jobs(project: Path, name: str) -> list[dict]:
         str(project),
         "--configfile",
         str(project / "config" / overlay),
+        *[arg for path in extra_configs for arg in ("--configfile", str(path))],
         *([target] if target else []),
     ]
     result = subprocess.run(command, capture_output=True, text=True, cwd=project, timeout=300)
@@ -100,6 +102,31 @@ def test_a_changed_job_is_reported_field_by_field():
 def test_the_dag_is_the_recorded_one(project, name):
     found = differences(recorded_jobs(name), current_jobs(project, name))
     assert found == [], "\n".join(found[:40])
+
+
+# With the solver backend switched to cupy (config solver_backend, config/README.md), every job
+# of the solve rules asks for a GPU and passes the backend to its script, and no other job
+# changes; the dry run needs no CuPy (only a solve job itself does).
+SOLVE_RULES = {"simulate_scene", "simulate_synthetic_scene", "scan_scene"}
+
+
+@pytest.mark.parametrize("name", ["test", "test_accuracy"])
+def test_with_cupy_every_solve_job_asks_for_a_gpu(project, name):
+    switch = project / "config" / "gpu.yaml"
+    switch.write_text("solver_backend: cupy\n")
+    jobs = {_key(job): job for job in current_jobs(project, name, [switch])}
+    recorded = {_key(job): job for job in recorded_jobs(name)}
+    assert jobs.keys() == recorded.keys()
+    solves = 0
+    for key, job in jobs.items():
+        before = recorded[key]
+        if job["rule"] in SOLVE_RULES:
+            solves += 1
+            assert job["resources"] == {**before["resources"], "gpu": 1}
+            assert job["params"] == {**before["params"], "solver_backend": "cupy"}
+        else:
+            assert job == before, key
+    assert solves > 0 or name == "test_accuracy"
 
 
 if __name__ == "__main__":

@@ -131,6 +131,10 @@ measured_runtime = RUN.resources.runtime
 measured_mem_mb = RUN.resources.mem_mb
 solve_runtime = RUN.resources.solve_runtime
 solve_mem_mb = RUN.resources.solve_mem_mb
+# The solver's engine (config solver_backend): empty for cpu, else the GPU resource of the
+# solve rules and the param their scripts pass to the solver.
+SOLVE_GPU = RUN.resources.backend.resources
+SOLVE_BACKEND = RUN.resources.backend.params
 
 # The run's answer (amontons.workflow.summary, docs/study.md §6).
 SUMMARY = RUN.summary

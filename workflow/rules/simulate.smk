@@ -44,9 +44,11 @@ rule simulate_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
+        **SOLVE_GPU,
         mem_mb=solve_mem_mb(lambda wc: (wc.scene, wc.sphere)),
         runtime=solve_runtime(lambda wc: (wc.scene, wc.sphere)),
     params:
+        **SOLVE_BACKEND,
         scene=lambda wc: scene_config(wc.scene),
         sphere=lambda wc: wc.sphere,
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
@@ -93,9 +95,11 @@ rule simulate_synthetic_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
+        **SOLVE_GPU,
         mem_mb=solve_mem_mb(lambda wc: (wc.scene, None)),
         runtime=solve_runtime(lambda wc: (wc.scene, None)),
     params:
+        **SOLVE_BACKEND,
         scene=lambda wc: scene_config(wc.scene),
         sphere=None,
         sphere_record=None,

@@ -24,9 +24,11 @@ rule scan_scene:
         "../envs/amontons.yaml"
     threads: 1
     resources:
+        **SOLVE_GPU,
         mem_mb=solve_mem_mb(scan_solve(SCANS)),
         runtime=solve_runtime(scan_solve(SCANS)),
     params:
+        **SOLVE_BACKEND,
         scan=lambda wc: RUN.scenes.scan_params(wc.sphere, wc.scan),
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),

@@ -73,8 +73,8 @@ Warnings
     to a solve that has no effect on it: ``method`` or ``max_outer`` on an elastic solve,
     ``max_outer`` on the "bounded" route;
     ``coarse_to_fine=True`` with plasticity, with a ``warm_start`` or on a grid without a
-    coarse level; ``threads > 1`` or a non-default ``planner_effort`` with the numpy
-    backend.
+    coarse level; ``threads > 1`` or a non-default ``planner_effort`` with a backend other
+    than pyfftw.
 
 Exceptions
     ``ContactError`` (base) with ``ContactInputError`` (also a ValueError),
@@ -86,6 +86,7 @@ Exceptions
 
 from .api import solve, solve_load_series, solve_scan
 from .errors import (
+    BackendUnavailableError,
     ContactError,
     ContactInputError,
     ConvergenceError,
@@ -97,6 +98,7 @@ from .result import CoarseLevel, ContactResult, SolveInfo
 from .surfaces import self_affine, sphere
 
 __all__ = [
+    "BackendUnavailableError",
     "CoarseLevel",
     "ContactError",
     "ContactHardening",

@@ -98,8 +98,14 @@ def solve(
         coarser grids. Ignored, with an :class:`IgnoredOptionWarning`, with plasticity, with
         a ``warm_start``, or when the grid has no coarse level (a side odd or below
         ``2 * COARSE_MIN_SIZE`` = 64 pixels).
-    backend : {"pyfftw", "numpy", None}
-        FFT backend; None picks pyfftw when importable.
+    backend : {"pyfftw", "numpy", "cupy", None}
+        ``"pyfftw"``, ``"numpy"``: the CPU solver (numba kernels) with that FFT backend;
+        None picks pyfftw when importable. ``"cupy"``: the same Polonsky–Keer loop on the
+        GPU, with the array kernel set and cuFFT (:mod:`amontons.contact.array_kernels`;
+        the optional extra ``pip install amontons[gpu]``); results come back as numpy
+        arrays, and without CuPy or a CUDA device the call raises
+        :class:`BackendUnavailableError`. (``"numpy-array"`` runs the GPU route's code on
+        numpy, for tests.)
     plasticity : PenetrationHardness or ContactHardening, optional
         Plasticity law of appendix B.2.3 (None: purely elastic). The result's
         ``plastic_displacement`` is then the plastic displacement of the indenter (m, <= 0
@@ -436,12 +442,12 @@ def _ignored_options(opts, shape, *, method, max_outer, coarse_to_fine, warm_sta
         reason = _coarse_to_fine_obstacle(opts, shape, warm_start)
         if reason:
             notes.append(f"coarse_to_fine=True is ignored: {reason}")
-    if opts.backend == "numpy" and opts.threads > 1:
-        notes.append(f"threads={opts.threads} is ignored: the numpy FFT backend is serial")
-    if opts.backend == "numpy" and opts.planner_effort != DEFAULT_PLANNER_EFFORT:
+    if opts.backend != "pyfftw" and opts.threads > 1:
+        notes.append(f"threads={opts.threads} is ignored: the {opts.backend} backend sets none")
+    if opts.backend != "pyfftw" and opts.planner_effort != DEFAULT_PLANNER_EFFORT:
         notes.append(
-            f"planner_effort={opts.planner_effort!r} is ignored: the numpy FFT backend does "
-            "not plan"
+            f"planner_effort={opts.planner_effort!r} is ignored: the {opts.backend} backend "
+            "does not plan with FFTW"
         )
     return notes
 

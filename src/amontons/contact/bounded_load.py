@@ -29,8 +29,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import kernels as _k
-
 # Rounds of rescale-and-clip allowed to impose the load on the free points; each round clips
 # at least one point at p_max or ends, and one or two suffice in practice.
 MAX_LOAD_ROUNDS = 50
@@ -187,15 +185,20 @@ def fully_bound_approach(u, h, p, d):
 class BoundedLoadSweep:
     """The fused bounded load step with ``u = K*p`` kept up to date (module docstring).
 
-    ``base_op`` is the convolution (with ``real_space_kernel()`` when ``sparse_ok``),
-    ``conv(x, out)`` the caller's counted ``out = K*x``, ``buf()`` an aligned work array;
-    ``p_max`` (Pa) has one entry per point, ``target`` is the force over the pixel area
-    (Σp, Pa). At most ``sparse_max`` changed points of the step, and as many of each rescale
-    round, are applied as point responses; more, and ``u`` is convolved afresh.
+    ``ks`` is the kernel set of the solve (:func:`.cg.kernel_set`: the numba kernels of
+    :mod:`.kernels` or an array set), whose ``update``, ``rescale_free``, ``free_mask``,
+    ``changed_points`` and ``add_point_responses`` take the step; its rare numpy parts (a
+    shortened step, a restart of the free set) run through ``ks.on_host``. ``base_op`` is
+    the convolution (with ``real_space_kernel()`` when ``sparse_ok``), ``conv(x, out)`` the
+    caller's counted ``out = K*x``, ``buf()`` a work array of the set; ``p_max`` (Pa) has one
+    entry per point, ``target`` is the force over the pixel area (Σp, Pa). At most
+    ``sparse_max`` changed points of the step, and as many of each rescale round, are
+    applied as point responses; more, and ``u`` is convolved afresh.
     """
 
-    def __init__(self, base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf):
+    def __init__(self, ks, base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf):
         n = p_max.size
+        self.ks = ks
         self.base_op = base_op
         self.shape = shape
         self.p_max = p_max
@@ -204,7 +207,7 @@ class BoundedLoadSweep:
         self.conv = conv
         self.buf = buf
         self.spare = buf()  # the next pressure; the old one becomes the spare
-        self.spare_mask = np.empty(n, dtype=np.uint8)
+        self.spare_mask = ks.empty(n, np.uint8)
         self.v = None  # K*p_b (m), None while it is not known
         self._v_buf = self._bound_buf = None  # allocated on first use
         self.green = None
@@ -231,7 +234,8 @@ class BoundedLoadSweep:
         """
         q = self.spare
         violators, vidx, vg = found
-        total, pen, at_bound, complete = _k.update(
+        ks = self.ks
+        total, pen, at_bound, complete = ks.update(
             p, q, u, r, t, h, m, self.p_max, True, 1.0, d, tau, violators,
             idx_buf, val_buf, counts, True, True, vidx, vg, self.sparse_max,
         )  # fmt: skip
@@ -243,7 +247,7 @@ class BoundedLoadSweep:
         # records complete: no chunk was swept without them (kernels.update)
         sparse = changed <= self.sparse_max and complete
         if sparse:
-            idx, vals = _k.changed_points(counts, idx_buf, val_buf)
+            idx, vals = ks.changed_points(counts, idx_buf, val_buf)
             self._add_responses(u, idx, vals)
             self._follow_bound(p, q, idx)
         else:
@@ -257,14 +261,14 @@ class BoundedLoadSweep:
                 sparse = False
                 self.v = None
             v = self.v if sparse else u  # v is not read without u
-            total, at_bound, left, joined = _k.rescale_free(
+            total, at_bound, left, joined = ks.rescale_free(
                 q, u, v, m, m_new, t, self.p_max, s, sparse, idx_buf, val_buf, counts
             )
             over = int(counts[:, 0].sum())
             if not over:
                 break
             if sparse and over <= self.sparse_max:
-                idx, vals = _k.changed_points(counts, idx_buf, val_buf)
+                idx, vals = ks.changed_points(counts, idx_buf, val_buf)
                 self._add_responses(u, idx, vals)
                 self._add_responses(self.v, idx, self.p_max[idx])
             else:
@@ -292,7 +296,9 @@ class BoundedLoadSweep:
         """The step that must be shortened: :func:`bounded_load_step` from the old state
         (``update`` left ``p``, ``m`` and ``t`` as they were), then ``u = K*p``."""
         u += tau * r  # back to K*p to round-off (it gives the gap of the joining points)
-        left, joined, pen, _ = bounded_load_step(p, u, h, m, t, self.p_max, d, tau, self.target)
+        left, joined, pen, _ = self.ks.on_host(
+            bounded_load_step, p, u, h, m, t, self.p_max, d, tau, self.target, writes=(0, 3, 4)
+        )
         self.conv(p, u)
         self.v = None
         return p, m, left, joined, pen, "full: bounded load", True
@@ -300,12 +306,16 @@ class BoundedLoadSweep:
     def _restart_free_set(self, q, u, h, m_old, m_new, t):
         """:func:`impose_bounded_load`'s restart on ``q``, then the free set rebuilt;
         returns ``(left, joined)`` against ``m_old``."""
-        impose_bounded_load(q, m_new, t, self.p_max, self.target, u, h)
-        _k.free_mask(q, m_new, self.p_max, True)
+        ks = self.ks
+        ks.on_host(
+            impose_bounded_load, q, m_new, t, self.p_max, self.target, u, h, writes=(0, 1, 2)
+        )
+        ks.free_mask(q, m_new, self.p_max, True)
         t *= m_new
         old = m_old != 0
         new = m_new != 0
-        return int(np.count_nonzero(old & ~new)), int(np.count_nonzero(~old & new))
+        xp = ks.xp
+        return int(xp.count_nonzero(old & ~new)), int(xp.count_nonzero(~old & new))
 
     def _follow_bound(self, p, q, idx):
         """Bring ``v`` from ``K*p_b`` to ``K*q_b``: only the changed points ``idx`` can have
@@ -313,13 +323,14 @@ class BoundedLoadSweep:
         if self.v is None:
             if self._v_buf is None:
                 self._v_buf, self._bound_buf = self.buf(), self.buf()
-            np.multiply(q, q >= self.p_max, out=self._bound_buf)
+            self.ks.xp.multiply(q, q >= self.p_max, out=self._bound_buf)
             self.v = self.conv(self._bound_buf, self._v_buf)
             return
-        idx = np.unique(idx)  # a point clipped and rejoined is recorded twice
+        xp = self.ks.xp
+        idx = xp.unique(idx)  # a point clipped and rejoined is recorded twice
         ub = self.p_max[idx]
-        before = np.where(p[idx] >= ub, p[idx], 0.0)
-        after = np.where(q[idx] >= ub, q[idx], 0.0)
+        before = xp.where(p[idx] >= ub, p[idx], 0.0)
+        after = xp.where(q[idx] >= ub, q[idx], 0.0)
         moved = after != before
         self._add_responses(self.v, idx[moved], (after - before)[moved])
 
@@ -329,4 +340,4 @@ class BoundedLoadSweep:
             return
         if self.green is None:
             self.green = self.base_op.real_space_kernel()
-        _k.add_point_responses(field.reshape(self.shape), self.green, idx, values)
+        self.ks.add_point_responses(field.reshape(self.shape), self.green, idx, values)

@@ -62,8 +62,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import fft as _fft
 from . import kernels as _k
+from .array_kernels import array_kernel_set
 from .bounded_load import (
     BoundedLoadSweep,
     bounded_load_step,
@@ -227,8 +227,10 @@ def polonsky_keer(
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
-    with _k.kernel_threads(_kernel_threads(operator, options.threads)):
+    ks = kernel_set(options)
+    with ks.kernel_threads(_kernel_threads(operator, options.threads)):
         return _loop(
+            ks,
             operator,
             heights,
             options,
@@ -239,6 +241,23 @@ def polonsky_keer(
             displacement=displacement,
             constraint=constraint,
         )
+
+
+def kernel_set(options: CGOptions):
+    """The kernel set a solve runs on: the fused numba kernels (the module :mod:`.kernels`)
+    unless ``options.array_module`` names an array namespace, then the array kernels of
+    :mod:`.array_kernels` on it (``"cupy"``: on the GPU).
+
+    A kernel set offers the functions of :mod:`.kernels` that :func:`_loop` calls, under
+    their contracts, and the host side of its arrays: ``xp`` (the array namespace),
+    ``empty(n, dtype)``, ``asarray`` (host to the set's memory), ``to_host``, ``on_host(fn,
+    *args, writes=())`` (a numpy routine on host copies, the arrays at ``writes`` copied
+    back; the numba set calls ``fn`` as it is), ``add_at`` (``np.add.at``),
+    ``event_counts`` (the points ``update`` clipped and added, as ints), ``kernel_threads``,
+    ``n_chunks`` and ``SLOTS``."""
+    if options.array_module is None:
+        return _k
+    return array_kernel_set(options.array_module)
 
 
 def _winkler_parts(operator):
@@ -262,6 +281,7 @@ def _bound_array(constraint, n):
 
 
 def _loop(
+    ks,
     operator,
     heights,
     options,
@@ -279,20 +299,23 @@ def _loop(
     load_control = load is not None
     shape = heights.shape
     n = heights.size
-    backend = "pyfftw" if _fft.HAVE_PYFFTW else "numpy"
+    xp = ks.xp
 
     def buf():
-        # SIMD-aligned work arrays let the FFT plans run on them without copies
-        return _fft.empty(n, np.float64, backend)
+        # the numba set's are SIMD-aligned: the FFT plans run on them without copies
+        return ks.empty(n, np.float64)
 
     base_op, compliance = _winkler_parts(operator)
     winkler = compliance is not None
-    comp_arg = compliance if winkler else np.zeros(1)
+    if winkler:
+        compliance = ks.asarray(compliance)
+    comp_arg = compliance if winkler else xp.zeros(1)
     p_max, bounded = _bound_array(constraint, n)
+    p_max = ks.asarray(p_max)
     h = buf()
-    h[:] = np.ravel(heights)
+    h[:] = ks.asarray(np.ravel(heights))
     p = buf()
-    p[:] = np.ravel(p_init)
+    p[:] = ks.asarray(np.ravel(p_init))
     if p.min() < 0:
         raise ValueError("p_init must be >= 0")
     calls = 0
@@ -300,7 +323,11 @@ def _loop(
     def conv(x, out):
         nonlocal calls
         calls += 1
-        operator(x.reshape(shape), out=out.reshape(shape))
+        base_op(x.reshape(shape), out=out.reshape(shape))
+        if winkler:
+            # the elastic-plus-Winkler operator's K*x + x/k (winkler.WinklerOperator), with the
+            # compliance in the kernel set's memory
+            out += compliance * x
         return out
 
     if load_control:
@@ -311,30 +338,30 @@ def _loop(
         p *= load / (pixel_area * total)
     if bounded:
         # after the load's rescale, which may push a start's points through the bound
-        np.minimum(p, p_max, out=p)
+        xp.minimum(p, p_max, out=p)
     # bounded load control: the force is imposed on the free points only (module docstring)
     bounded_load = bounded and load_control
     target = load / pixel_area if load_control else 0.0  # Σp, Pa
     t = buf()
     t[:] = 0.0
-    m = np.empty(n, dtype=np.uint8)
+    m = ks.empty(n, np.uint8)
     if bounded_load:
-        _k.free_mask(p, m, p_max, bounded)
-        impose_bounded_load(p, m, t, p_max, target, np.zeros(n), h)
+        ks.free_mask(p, m, p_max, bounded)
+        ks.on_host(impose_bounded_load, p, m, t, p_max, target, np.zeros(n), h, writes=(0, 1, 2))
     u, r = buf(), buf()
     p_old = None  # a copy of p, taken only when the step may converge
-    nch = _k.n_chunks(n)
-    idx_buf = np.zeros((nch, _k.SLOTS), dtype=np.int64)
-    val_buf = np.zeros((nch, _k.SLOTS))
-    counts = np.zeros((nch, 2), dtype=np.int64)
-    violators = np.zeros(nch, dtype=np.int64)
+    nch = ks.n_chunks(n)
+    idx_buf = xp.zeros((nch, ks.SLOTS), dtype=np.int64)
+    val_buf = xp.zeros((nch, ks.SLOTS))
+    counts = xp.zeros((nch, 2), dtype=np.int64)
+    violators = xp.zeros(nch, dtype=np.int64)
     # the violators of chunks with few, recorded by direction for update (kernels.direction)
-    vidx = np.zeros((nch, _k.SLOTS), dtype=np.int64)
-    vg = np.zeros((nch, _k.SLOTS))
+    vidx = xp.zeros((nch, ks.SLOTS), dtype=np.int64)
+    vg = xp.zeros((nch, ks.SLOTS))
     found = (violators, vidx, vg)
     conv(p, u)
     sigma = 1.0  # true p = sigma·p, u = sigma·u (module docstring)
-    nc = int(_k.free_mask(p, m, p_max, bounded))
+    nc = int(ks.free_mask(p, m, p_max, bounded))
     delta = 0.0
     g_old = 1.0
     since_fresh = 0
@@ -362,7 +389,9 @@ def _loop(
     split = getattr(base_op, "splits", False) and not winkler and not bounded_load
     forward_only = 0  # forward transforms whose inverse was skipped
     if bounded_load and options.bounded_load_sweep and not winkler:
-        sweep = BoundedLoadSweep(base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf)
+        sweep = BoundedLoadSweep(
+            ks, base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf
+        )
     monitor = StallMonitor()
     while it < max_iter:
         if history and monitor.update(history[-1]):
@@ -390,10 +419,11 @@ def _loop(
             # displacement control, or bounded load control with every loaded point at the
             # bound: start the free set from the points the constraint says should be free
             if load_control:
-                d = fully_bound_approach(sigma * u, h, p, d)
+                d = ks.on_host(fully_bound_approach, sigma * u, h, p, d)
             g = sigma * u - h - d
-            mf = np.zeros(n)
-            start = constraint.violators(sigma * p, g, mf)
+            mf = xp.zeros(n)
+            # a restart of the free set, rare: the constraint's numpy test on the host
+            start = ks.asarray(ks.on_host(constraint.violators, sigma * p, g, mf))
             nc = int(start.size)
             if nc == 0:
                 residual = 0.0
@@ -407,17 +437,17 @@ def _loop(
             if sweep is not None:
                 sweep.forget_bound_displacement()
         if load_control:
-            d, big_g, gt_old, t_old_sum, recentred = _centred_moments(u, sigma, h, m, t, d, nc)
+            d, big_g, gt_old, t_old_sum, recentred = _centred_moments(ks, u, sigma, h, m, t, d, nc)
             recentres += recentred
         else:
-            _, big_g, gt_old, _ = _k.gap_moments(u, sigma, h, m, t, d)
+            _, big_g, gt_old, _ = ks.gap_moments(u, sigma, h, m, t, d)
             t_old_sum = 0.0
         beta = delta * big_g / g_old if g_old > 0 else 0.0
         g_dot_t = big_g + beta * gt_old if beta else big_g
         # load control: Σ_Ic t = 0 (t_old loses its sum where points were
         # clipped); the mean of r over Ic then drops out of Σ r t
         shift = beta * t_old_sum / nc
-        _k.direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, *found)
+        ks.direction(u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, *found)
         g_old = big_g
         if split:
             # r = K*t in halves: Σ r t from the spectrum now, the inverse only if u follows
@@ -428,7 +458,7 @@ def _loop(
         else:
             conv_t(base_op, t, r, shape)
             calls += 1
-            rt, _ = _k.step_dots(r, t, m, comp_arg, winkler)
+            rt, _ = ks.step_dots(r, t, m, comp_arg, winkler)
         if load_control and nc == 1:
             # a one-point free set has no direction that keeps its force (its t is
             # round-off): no descent direction
@@ -440,8 +470,8 @@ def _loop(
             # convolved u; penetrating points join the free set at p = 0 and the next
             # (steepest-descent) iteration moves them
             g = sigma * u - h - d
-            ol = constraint.violators(sigma * p, g, m.astype(np.float64))
-            pen = float(np.abs(g[ol]).max()) if ol.size else 0.0
+            ol = ks.asarray(ks.on_host(constraint.violators, sigma * p, g, m.astype(np.float64)))
+            pen = float(abs(g[ol]).max()) if ol.size else 0.0
             residual = max(np.sqrt(big_g / nc), pen) / h_scale
             history.append(residual)
             if residual < tol and since_fresh:
@@ -463,7 +493,7 @@ def _loop(
         if rms_ok:
             # the convergence test below needs the pressure change: keep the old field
             # (this pass is paid only in the last iterations; otherwise p is updated in place)
-            p_old = np.copy(p) if p_old is None else _copy(p, p_old)
+            p_old = xp.copy(p) if p_old is None else _copy(xp, p, p_old)
         how = None  # how u followed the step, when the bounded load step says
         complete = True  # update's records hold every changed point (kernels.update)
         if sweep is not None:
@@ -471,20 +501,19 @@ def _loop(
                 p, u, r, t, h, m, d, tau, found, idx_buf, val_buf, counts
             )
         elif bounded_load:
-            n_clip, n_add, pen, backtracked = bounded_load_step(
-                p, u, h, m, t, p_max, d, tau, target
+            n_clip, n_add, pen, backtracked = ks.on_host(
+                bounded_load_step, p, u, h, m, t, p_max, d, tau, target, writes=(0, 3, 4)
             )
             # the step rescaled the free points only: u is taken afresh
             conv(p, u)
             how = "full: bounded load"
         else:
-            psum, pen, _, complete = _k.update(
+            psum, pen, _, complete = ks.update(
                 p, p, u, r, t, h, m, p_max, bounded, sigma, d, tau,
                 violators, idx_buf, val_buf, counts, False, not split, vidx, vg,
                 sparse_max if sparse_ok else -1,
             )  # fmt: skip
-            n_clip = int(counts[:, 0].sum())
-            n_add = int(counts[:, 1].sum())
+            n_clip, n_add = ks.event_counts(counts)
             backtracked = False
         if backtracked:
             delta = 0.0
@@ -529,22 +558,22 @@ def _loop(
                 base_op.inverse(r.reshape(shape))
                 forward_only -= 1
                 calls += 1
-                _k.subtract_scaled(u, r, tau / sigma_old)
+                ks.subtract_scaled(u, r, tau / sigma_old)
             if changes:
                 # u (stored, scale sigma_old) += K*c / sigma_old; u = K*p holds for the stored
                 # pair whatever their common scale, so the new scale needs no pass
-                idx, vals = _k.changed_points(counts, idx_buf, val_buf)
+                idx, vals = ks.changed_points(counts, idx_buf, val_buf)
                 if green is None:
                     green = base_op.real_space_kernel()
-                _k.add_point_responses(u.reshape(shape), green, idx, vals / sigma_old)
+                ks.add_point_responses(u.reshape(shape), green, idx, vals / sigma_old)
                 if winkler:
                     # a point clipped and re-added appears twice: add.at sums both
-                    np.add.at(u, idx, compliance[idx] * vals / sigma_old)
+                    ks.add_at(u, idx, compliance[idx] * vals / sigma_old)
             since_fresh += 1
         comp = max(np.sqrt(big_g / max(nc_start, 1)), pen) / h_scale
         residual = comp
         if comp < tol and rms_ok:
-            change, psum_true = _k.relative_change(p, sigma, p_old, sigma_old)
+            change, psum_true = ks.relative_change(p, sigma, p_old, sigma_old)
             change = float(change / psum_true) if psum_true > 0 else 0.0
             residual = max(change, comp)
             if change < tol:
@@ -557,7 +586,7 @@ def _loop(
                     u *= sigma
                 sigma = 1.0
                 comp_now, d_now, nc = _final_complementarity(
-                    u, h, p, d, load_control, m, t, p_max, bounded
+                    ks, u, h, p, d, load_control, m, t, p_max, bounded
                 )
                 comp_now /= h_scale
                 residual = max(change, comp_now)
@@ -573,6 +602,8 @@ def _loop(
         u *= sigma
     if since_fresh:
         conv(p, u)
+    # the outcome is built on the host (numpy arrays; the numba set's are already)
+    p, u, h = ks.to_host(p), ks.to_host(u), ks.to_host(h)
     return finish_outcome(
         constraint,
         tol,
@@ -600,8 +631,8 @@ def _loop(
     )
 
 
-def _copy(src, dst):
-    np.copyto(dst, src)
+def _copy(xp, src, dst):
+    xp.copyto(dst, src)
     return dst
 
 
@@ -610,7 +641,7 @@ def conv_t(base_op, t, r, shape):
     base_op(t.reshape(shape), out=r.reshape(shape))
 
 
-def _centred_moments(u, sigma, h, m, t, d_old, nc):
+def _centred_moments(ks, u, sigma, h, m, t, d_old, nc):
     """Load control: the approach ``d`` (m, the mean of ``sigma·u - h`` on the free set),
     ``G = Σ_Ic g²`` (m²) and ``Σ g·t`` with ``g`` centred on it, ``Σ t`` (m), and whether a
     second pass was needed.
@@ -620,28 +651,28 @@ def _centred_moments(u, sigma, h, m, t, d_old, nc):
     catastrophically (relative error ~ 1e-16 · Σa²/G), so the moments are taken again about
     the new approach whenever ``Σa² > RECENTRE · G``: G is then good to ~1e-13.
     """
-    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d_old)
+    s1, s2, st, tsum = ks.gap_moments(u, sigma, h, m, t, d_old)
     mean = s1 / nc
     d = d_old + mean
     big_g = max(s2 - s1 * mean, 0.0)
     if s2 <= RECENTRE * big_g:
         return d, big_g, st - mean * tsum, tsum, 0
-    s1, s2, st, tsum = _k.gap_moments(u, sigma, h, m, t, d)
+    s1, s2, st, tsum = ks.gap_moments(u, sigma, h, m, t, d)
     mean = s1 / nc
     return d + mean, max(s2 - s1 * mean, 0.0), st - mean * tsum, tsum, 1
 
 
-def _final_complementarity(u, h, p, d, load_control, m, t, p_max, bounded):
+def _final_complementarity(ks, u, h, p, d, load_control, m, t, p_max, bounded):
     """Complementarity (m), approach (m) and free-set size for the final ``p`` (fresh mask)."""
-    nc = int(_k.free_mask(p, m, p_max, bounded))
+    nc = int(ks.free_mask(p, m, p_max, bounded))
     if load_control and nc:
-        s1, _, _, _ = _k.gap_moments(u, 1.0, h, m, t, 0.0)
+        s1, _, _, _ = ks.gap_moments(u, 1.0, h, m, t, 0.0)
         d = s1 / nc
     elif load_control:
-        d = fully_bound_approach(u, h, p, d)
-    s1, s2, _, _ = _k.gap_moments(u, 1.0, h, m, t, d)
+        d = ks.on_host(fully_bound_approach, u, h, p, d)
+    s1, s2, _, _ = ks.gap_moments(u, 1.0, h, m, t, d)
     rms = np.sqrt(max(s2, 0.0) / nc) if nc else 0.0
-    pen = _k.worst_violation(p, u, h, d, m, p_max, bounded)
+    pen = ks.worst_violation(p, u, h, d, m, p_max, bounded)
     return max(rms, pen), d, nc
 
 

@@ -39,6 +39,8 @@ import numpy as np
 
 from . import fft as _fft
 from . import spectrum as _spectrum
+from .array_backends import ARRAY_BACKENDS, array_module
+from .array_convolution import ArrayConvolution
 from .greens import hockney_multiplier, love_square, periodic_multiplier
 
 
@@ -440,9 +442,23 @@ def get_operator(
     )
 
 
+@lru_cache(maxsize=8)
+def array_operator(shape, spacing, e_star, periodic, backend) -> ArrayConvolution:
+    """The cached :class:`.array_convolution.ArrayConvolution` of an array backend
+    (:data:`.array_backends.ARRAY_BACKENDS`), padded to :func:`fast_padded_shape` when not
+    periodic (the CPU operator's grid)."""
+    xp = array_module(backend).xp
+    padded = None if periodic else fast_padded_shape(shape)
+    return ArrayConvolution(shape, spacing, e_star, xp, padded)
+
+
 def operator_for(opts, shape, spacing, e_star):
     """The cached operator of a grid of ``shape`` (spacing m, E* Pa) under a solve's
-    :class:`~.options.SolveOptions` (boundary, backend, threads, planner effort)."""
+    :class:`~.options.SolveOptions` (boundary, backend, threads, planner effort): the
+    array namespace's for an array backend."""
+    if opts.backend in ARRAY_BACKENDS:
+        key = (tuple(int(s) for s in shape), float(spacing), float(e_star), bool(opts.periodic))
+        return array_operator(*key, opts.backend)
     return get_operator(
         shape,
         spacing,

@@ -56,6 +56,12 @@ class ConvergenceError(ContactError, RuntimeError):
         self.status = status
 
 
+class BackendUnavailableError(ContactError, RuntimeError):
+    """A solver backend was asked for that this machine cannot run (``backend="cupy"``
+    without CuPy or without a CUDA device); the message names the backend and how to
+    install it."""
+
+
 class FreeBoundaryError(ContactError, RuntimeError):
     """Non-periodic solve: pressure on the outermost ring of the window.
 

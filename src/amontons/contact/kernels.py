@@ -40,6 +40,7 @@ import numba
 import numpy as np
 from numba import prange
 
+from . import fft as _fft
 from . import jit
 from .spectrum import ENTRY_POINTS as SPECTRUM_ENTRY_POINTS
 
@@ -958,6 +959,32 @@ def changed_points(counts, idx_buf, val_buf):
     idx = np.concatenate([idx_buf[c, : per[c]] for c in rows])
     vals = np.concatenate([val_buf[c, : per[c]] for c in rows])
     return idx, vals
+
+
+# The host side of the kernel-set protocol (cg.kernel_set): this set's arrays are numpy
+# arrays in host memory, so there is nothing to move.
+xp = np
+# SIMD-aligned work arrays (pyfftw's when importable) let the FFT plans run without copies
+_ALIGNED = "pyfftw" if _fft.HAVE_PYFFTW else "numpy"
+asarray = np.asarray
+to_host = np.asarray
+add_at = np.add.at
+
+
+def empty(n: int, dtype=np.float64) -> np.ndarray:
+    """An uninitialised flat work array of ``n`` points, SIMD-aligned."""
+    return _fft.empty(n, dtype, _ALIGNED)
+
+
+def event_counts(counts) -> tuple[int, int]:
+    """The points ``update`` clipped and added, over every chunk of ``counts``."""
+    return int(counts[:, 0].sum()), int(counts[:, 1].sum())
+
+
+def on_host(fn, *args, writes=()):
+    """``fn(*args)``: the arrays are on the host already (``writes`` is the array set's
+    concern, :meth:`.array_kernels.ArrayKernels.on_host`)."""
+    return fn(*args)
 
 
 # the kernels called from Python (the others are compiled into them)

@@ -23,6 +23,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numpy as np  # noqa: E402
 
+from .array_backends import ARRAY_BACKENDS, array_module  # noqa: E402
 from .errors import ContactInputError  # noqa: E402
 from .laws import ContactHardening, PenetrationHardness  # noqa: E402
 
@@ -44,20 +45,28 @@ PLANNER_EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUS
 DEFAULT_PLANNER_EFFORT = "FFTW_MEASURE"
 
 
-def resolve_backend(backend: str | None) -> str:
+def resolve_backend(backend: str | None, *, arrays: bool = False) -> str:
     """Return the backend name to use: ``"pyfftw"`` if available, else ``"numpy"``.
+
+    With ``arrays`` (a solve's backend) the names of the array kernel set are accepted too
+    (:data:`.array_backends.ARRAY_BACKENDS`: ``"cupy"``, and ``"numpy-array"`` for tests);
+    ``"cupy"`` is checked to be runnable here.
 
     Raises
     ------
     ContactInputError
         (a ValueError) For an unknown name, or ``"pyfftw"`` requested but not importable.
+    BackendUnavailableError
+        ``"cupy"`` without CuPy or without a CUDA device.
     """
     if backend is None:
         return "pyfftw" if HAVE_PYFFTW else "numpy"
+    if arrays and backend in ARRAY_BACKENDS:
+        array_module(backend)  # raises, naming the backend and how to install it
+        return backend
     if backend not in BACKENDS:
-        raise ContactInputError(
-            f"unknown FFT backend {backend!r}; expected one of {BACKENDS} or None"
-        )
+        allowed = BACKENDS + ARRAY_BACKENDS[:1] if arrays else BACKENDS
+        raise ContactInputError(f"unknown backend {backend!r}; expected one of {allowed} or None")
     if backend == "pyfftw" and not HAVE_PYFFTW:
         raise ContactInputError("FFT backend 'pyfftw' requested but pyfftw is not importable")
     return backend
@@ -155,8 +164,11 @@ class CGOptions:
     problem: the residual ``tol`` (dimensionless), the iteration cap ``max_iter``, a fresh
     ``u = K*p`` at least every ``refresh`` iterations, whether a solve that stops unconverged
     raises (``raise_on_failure``; else its outcome carries the status), the kernels'
-    ``threads`` (None: the operator's FFTW threads, else 1) and the kernel set of bounded
-    load control (``bounded_load_sweep``, as :class:`SolveOptions`'s)."""
+    ``threads`` (None: the operator's FFTW threads, else 1), the kernel set of bounded
+    load control (``bounded_load_sweep``, as :class:`SolveOptions`'s) and the kernel set
+    of the loop (``array_module``: None for the fused numba kernels, else the array
+    kernels on that namespace, a name of :data:`.array_backends.ARRAY_BACKENDS`; the
+    operator must then be the namespace's, :class:`.array_convolution.ArrayConvolution`)."""
 
     tol: float = 1e-8
     max_iter: int = 1000
@@ -164,6 +176,7 @@ class CGOptions:
     raise_on_failure: bool = True
     threads: int | None = None
     bounded_load_sweep: bool = True
+    array_module: str | None = None
 
 
 @dataclass(frozen=True)
@@ -200,6 +213,7 @@ class SolveOptions:
             max_iter=self.max_iter,
             raise_on_failure=False,
             bounded_load_sweep=self.bounded_load_sweep,
+            array_module=self.backend if self.backend in ARRAY_BACKENDS else None,
         )
 
 
@@ -235,7 +249,7 @@ def solve_options(
     tol = check_positive("tol", tol, "(dimensionless)")
     max_iter = default_max_iter(shape) if max_iter is None else check_count("max_iter", max_iter)
     threads = check_threads(threads)
-    backend = resolve_backend(backend)
+    backend = resolve_backend(backend, arrays=True)
     planner_effort = resolve_planner_effort(planner_effort)
     check_method(method)
     law = None if plasticity is None else check_law(plasticity)

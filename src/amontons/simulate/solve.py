@@ -64,8 +64,15 @@ def _diagnostics(result: ContactResult) -> dict:
     }
 
 
-def solve_scene(scene: Scene, indenter: Indenter, *, threads: int = 1) -> SceneSolution:
-    """The scene's load series on its indenter (one ContactResult per load, as fields)."""
+# config solver_backend -> the solver's backend (None: the CPU solver's default FFT backend)
+SOLVER_BACKENDS = {"cpu": None, "cupy": "cupy"}
+
+
+def solve_scene(
+    scene: Scene, indenter: Indenter, *, threads: int = 1, backend: str = "cpu"
+) -> SceneSolution:
+    """The scene's load series on its indenter (one ContactResult per load, as fields), on
+    the solver engine ``backend`` (config ``solver_backend``: ``cpu`` or ``cupy``)."""
     start = time.perf_counter()
     results = solve_load_series(
         indenter.heights,
@@ -76,6 +83,7 @@ def solve_scene(scene: Scene, indenter: Indenter, *, threads: int = 1) -> SceneS
         tol=scene.tol,
         plasticity=scene.plasticity,
         threads=threads,
+        backend=SOLVER_BACKENDS[backend],
     )
     for result in results:
         log.info(

@@ -17,6 +17,22 @@ from amontons.workflow.spheres import Spheres
 
 # (scene, sphere or None for a synthetic scene[, scan parameter, scan value]) of a job
 SolveOf = Callable[[object], tuple]
+# config solver_backend -> what the solve rules add: their resources and their params
+GPU_BACKENDS = {"cupy": {"gpu": 1}}
+
+
+class SolverBackend:
+    """The contact solver's engine of the scene and scan solves (config ``solver_backend``,
+    config/README.md): ``cpu`` adds nothing to their jobs, so that they stay as they were; a
+    GPU backend (``cupy``) adds the resource ``gpu=1`` (the SLURM executor asks for a GPU)
+    and the param ``solver_backend`` their scripts pass to the solver. Nothing here imports
+    CuPy: a dry run needs none, a missing one fails the solve job."""
+
+    def __init__(self, config: Mapping):
+        self.name = config.get("solver_backend", "cpu")
+        gpu = GPU_BACKENDS.get(self.name)
+        self.resources = dict(gpu) if gpu else {}
+        self.params = {"solver_backend": self.name} if gpu else {}
 
 
 class SolveResources:
@@ -33,6 +49,7 @@ class SolveResources:
         self.spheres = spheres
         self.measured = measured
         self.timing_model = timing_model
+        self.backend = SolverBackend(config)
 
     @classmethod
     def from_files(

@@ -1,0 +1,318 @@
+"""The array kernel set: :mod:`.kernels`' contracts written once in array-namespace code.
+
+:func:`.cg.polonsky_keer` runs one control flow on a *kernel set* (:func:`.cg.kernel_set`):
+the fused numba kernels of :mod:`.kernels` on the CPU, or this set on an array namespace
+``xp`` (:mod:`.array_backends`): CuPy on a GPU (``backend="cupy"``), numpy in tests and CI
+(``backend="numpy-array"``), which run the same code. Each method keeps the contract of
+the :mod:`.kernels` function of its name (arguments, in-place writes, returns); the
+differences are the ones a GPU asks for:
+
+* **one chunk.** :meth:`ArrayKernels.n_chunks` is 1: the per-chunk records of ``update``
+  and ``rescale_free`` are one row of ``SLOTS`` (>= :data:`.cg.SPARSE_MAX_PADDED`, the most
+  changed points the loop applies as point responses), written only when the events fit
+  (else the records are reported incomplete and the loop convolves afresh, as it does on
+  the numba set past ``record_max``). ``direction`` counts the violators but records none:
+  ``update`` finds them itself in its dense pass.
+* **dense passes, element-wise parts fused.** The element-wise parts are small functions
+  of arrays and scalars (:func:`_gap`, :func:`_direction_value`, :func:`_should_join`,
+  ...), compiled by ``ArrayModule.fuse`` (``cupy.fuse``: one CUDA kernel each; on numpy
+  they run as plain numpy). No branch is taken per point: a projection or a join is a
+  ``where``.
+* **reductions by the namespace.** Sums are ``xp.sum`` over the flat array: numpy's
+  pairwise summation, CuPy's block-tree reduction. The order differs from the numba
+  set's fixed chunks, so results agree with it to round-off (~1e-15 relative per sum,
+  tests/contact/test_array_kernels.py), not bit for bit; on a given namespace and device
+  they are deterministic. Maxima and counts are exact.
+* **few host reads.** The scalars a method returns are gathered into one array and read
+  with one transfer (:meth:`ArrayKernels._floats`): one per kernel call, the loop's only
+  synchronisations besides the rare paths below. ``direction`` returns ``Σ t`` as a 0-d
+  array of the namespace (the loop does not read it). The numpy routines the loop runs
+  on rare paths (a restart of the free set, the bounded load step's shortened or restarted
+  step) run on host copies through :meth:`ArrayKernels.on_host`.
+
+Arrays are flat float64 of the namespace (the free set ``m`` uint8), in the units of
+:mod:`.kernels`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from .array_backends import ArrayModule, array_module
+
+# Records per chunk (the one chunk): at least the most changed points the loop applies as
+# point responses (.cg.SPARSE_MAX_PERIODIC, SPARSE_MAX_PADDED), as kernels.SLOTS.
+SLOTS = 64
+
+
+# The element-wise parts: functions of arrays and scalars with one result, so that
+# ``cupy.fuse`` compiles each into one kernel. Their arithmetic is written as the numba
+# kernels' (same association), so that the element-wise results agree bit for bit where
+# the compilers keep it; only the sums differ in order.
+
+
+def _gap(u, sigma, h, d):
+    """The gap ``sigma·u - h - d`` (m)."""
+    return sigma * u - h - d
+
+
+def _direction_value(u, sigma, h, d, beta, t, shift, m):
+    """``m·(g + beta·t - shift)`` (kernels.direction)."""
+    return (sigma * u - h - d + beta * t - shift) * m
+
+
+def _should_join(q, g, ub):
+    """The violator test of a constrained point (kernels._should_join): unloaded and
+    penetrating with room to rise, or at the bound ``ub`` and open."""
+    return ((q <= 0.0) & (g < 0.0) & (q < ub)) | ((q >= ub) & (g > 0.0) & (q > 0.0))
+
+
+def _violates(m, q, g, ub):
+    """A constrained point (``m == 0``) that should be free."""
+    return (m == 0) & _should_join(q, g, ub)
+
+
+def _masked(x, mask):
+    """``x`` where ``mask``, else 0."""
+    return x * mask
+
+
+def _where(xp):
+    def pick(cond, a, b):
+        return xp.where(cond, a, b)
+
+    return pick
+
+
+@lru_cache(maxsize=4)
+def array_kernel_set(name: str) -> ArrayKernels:
+    """The array kernel set on the namespace of backend ``name``
+    (:func:`.array_backends.array_module`; raises there without CuPy or a device)."""
+    return ArrayKernels(array_module(name))
+
+
+class ArrayKernels:
+    """The kernel set on the namespace of ``module`` (an :class:`.array_backends.ArrayModule`).
+    Methods as the functions of :mod:`.kernels` of the same name (module docstring)."""
+
+    SLOTS = SLOTS
+
+    def __init__(self, module: ArrayModule):
+        self.module = module
+        self.xp = xp = module.xp
+        fuse = module.fuse
+        self.to_host = module.to_host
+        self.add_at = module.add_at
+        self.asarray = xp.asarray
+        self._gap = fuse(_gap)
+        self._direction_value = fuse(_direction_value)
+        self._violates = fuse(_violates)
+        self._masked = fuse(_masked)
+        self._where = _where(xp)
+
+    # -- the host side of the protocol (cg.kernel_set) --
+
+    def n_chunks(self, n: int) -> int:
+        """One chunk (module docstring)."""
+        return 1
+
+    def kernel_threads(self, threads: int):
+        """No thread pool to set: a no-op context."""
+        return contextlib.nullcontext()
+
+    def empty(self, n: int, dtype=np.float64):
+        """An uninitialised flat array of the namespace."""
+        return self.xp.empty(n, dtype=dtype)
+
+    def on_host(self, fn, *args, writes=()):
+        """``fn(*args)`` with the namespace's arrays among ``args`` as numpy copies; the
+        arrays at the positions ``writes`` (those ``fn`` changes in place) are copied back.
+        On numpy, ``fn(*args)`` itself."""
+        if self.xp is np:
+            return fn(*args)
+        array = self.xp.ndarray
+        host = [self.to_host(a) if isinstance(a, array) else a for a in args]
+        out = fn(*host)
+        for i in writes:
+            args[i][...] = self.xp.asarray(host[i])
+        return out
+
+    def _floats(self, *values) -> list:
+        """The namespace's scalars as Python numbers, in one transfer."""
+        return self.to_host(self.xp.stack(values)).tolist()
+
+    def _bound(self, p_max, bounded):
+        return p_max if bounded else math.inf
+
+    # -- the kernels --
+
+    def free_mask(self, p, m, p_max, bounded):
+        """``m ← (0 < p < p_max)`` (uint8); returns its size."""
+        free = p > 0.0
+        if bounded:
+            free &= p < p_max
+        m[...] = free
+        return int(self.xp.count_nonzero(free))
+
+    def gap_moments(self, u, sigma, h, m, t, shift):
+        """``(Σ_m a, Σ_m a², Σ_m a·t, Σ t)`` of ``a = sigma·u - h - shift`` on ``m``."""
+        a = self._masked(self._gap(u, sigma, h, shift), m)
+        return tuple(self._floats(a.sum(), (a * a).sum(), (a * t).sum(), t.sum()))
+
+    def direction(self, u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, vidx, vg):
+        """``t ← m·(sigma·u - h - d + beta·t - shift)`` in place; ``violators[0]`` gets the
+        number of constrained points that should be free (none is recorded in ``vidx``,
+        ``vg``: module docstring). Returns ``Σ t`` as a 0-d array of the namespace."""
+        g = self._gap(u, sigma, h, d)
+        ub = self._bound(p_max, bounded)
+        violators[0] = self.xp.count_nonzero(self._violates(m, sigma * p, g, ub))
+        t[...] = self._direction_value(u, sigma, h, d, beta, t, shift, m)
+        return t.sum()
+
+    def step_dots(self, r, t, m, compliance, winkler):
+        """With ``winkler``, ``r += compliance·t`` in place; ``(Σ r·t, Σ_m r)``."""
+        if winkler:
+            r += compliance * t
+        rt, rm = self._floats((r * t).sum(), self._masked(r, m).sum())
+        return rt, rm
+
+    def update(
+        self, p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, idx, val,
+        counts, keep_mask, with_u, vidx, vg, record_max,
+    ):  # fmt: skip
+        """One CG step in dense passes, as :func:`.kernels.update` (its docstring): step,
+        projection onto ``[0, p_max]``, violators joining at ``-tau·g``, the free set and
+        ``t`` updated (unless ``keep_mask``), ``u -= tau/sigma·r`` with ``with_u``.
+        ``violators``, ``vidx``, ``vg`` are not read (the violators are found here). The
+        changed points are recorded in ``idx[0]``, ``val[0]`` (clipped ones first, then
+        the added ones, each in index order) when they are at most ``min(record_max,
+        SLOTS)``; ``counts[0]`` gets ``(clipped, added)``. Returns ``(Σ p_new, max |g| over
+        the added points, Σ p_new at p_max, records complete)``."""
+        xp, pick = self.xp, self._where
+        ub = self._bound(p_max, bounded)
+        step = tau / sigma
+        g = self._gap(u, sigma, h, d)
+        free = m != 0
+        q = p - step * t
+        pn = sigma * q
+        low = free & (pn < 0.0)
+        high = free & (pn > ub)
+        clip = low | high
+        pc = pick(low, 0.0, pick(high, ub, pn))  # the projected true pressure
+        cval = pc - pn  # the pressure the projection added (0 off the clipped points)
+        join = (~free | clip) & _should_join(pc, g, ub)
+        added = -tau * g
+        joined = pc + added
+        if keep_mask:
+            inside = (joined >= 0.0) & (joined <= ub)
+            joined_in = xp.minimum(xp.maximum(joined, 0.0), ub)
+            added = pick(inside, added, joined_in - pc)
+            joined = joined_in
+        p_new[...] = pick(join, joined / sigma, pick(clip, pc / sigma, q))
+        if not keep_mask:
+            m[...] = (free & ~clip) | join
+            t[...] = pick(clip, 0.0, t)
+        if with_u:
+            u -= step * r
+        ev = xp.stack([xp.count_nonzero(clip), xp.count_nonzero(join)])
+        counts[0] = ev
+        at_bound = self._masked(p_new, sigma * p_new >= p_max).sum() if bounded else xp.zeros(())
+        pen = self._masked(xp.abs(g), join).max()
+        psum, pen, at_bound, n_clip, n_add = self._floats(p_new.sum(), pen, at_bound, *ev)
+        events = int(n_clip) + int(n_add)
+        complete = not (events > 0 and events > min(record_max, SLOTS))
+        if events and complete:
+            where_clip = xp.flatnonzero(clip)
+            where_join = xp.flatnonzero(join)
+            self._record(idx, val, where_clip, cval[where_clip], where_join, added[where_join])
+        return psum, pen, at_bound, complete
+
+    def _record(self, idx, val, *pairs):
+        """Write the ``(indices, values)`` pairs one after the other into ``idx[0]``,
+        ``val[0]``."""
+        k = 0
+        for where, values in zip(pairs[::2], pairs[1::2], strict=True):
+            n = where.size
+            idx[0, k : k + n] = where
+            val[0, k : k + n] = values
+            k += n
+
+    def subtract_scaled(self, u, r, step):
+        """``u -= step·r`` in place."""
+        u -= step * r
+
+    def relative_change(self, p_new, s_new, p, s_old):
+        """``(Σ|s_new·p_new - s_old·p|, Σ s_new·p_new)``."""
+        q = s_new * p_new
+        a, b = self._floats(self.xp.abs(q - s_old * p).sum(), q.sum())
+        return a, b
+
+    def worst_violation(self, p, u, h, d, m, p_max, bounded):
+        """Largest ``|g|`` over constrained points that should be free (``g = u - h - d``);
+        0 when there are none."""
+        g = self._gap(u, 1.0, h, d)
+        hit = self._violates(m, p, g, self._bound(p_max, bounded))
+        return self._floats(self._masked(self.xp.abs(g), hit).max())[0]
+
+    def rescale_free(self, p, u, v, m_old, m_new, t, p_max, s, with_u, idx, val, counts):
+        """As :func:`.kernels.rescale_free`: the free points of ``p`` scaled by ``s`` and
+        clipped at ``p_max`` (recorded in ``idx[0]``, ``val[0]`` when at most ``SLOTS``;
+        ``counts[0] = (clipped, 0)``), the free set rebuilt into ``m_new``, ``t`` zeroed
+        off it, ``u ← s·u - (s - 1)·v`` with ``with_u``. Returns ``(Σ p, Σ p at p_max,
+        left, joined)``."""
+        xp, pick = self.xp, self._where
+        free = (p > 0.0) & (p < p_max)
+        scaled = pick(free, p * s, p)
+        over = free & (scaled >= p_max)
+        q = pick(over, p_max, scaled)
+        now = free & ~over
+        was = m_old != 0
+        m_new[...] = now
+        t[...] = pick(now, t, 0.0)
+        if with_u:
+            u[...] = s * u - (s - 1.0) * v
+        n_over = xp.count_nonzero(over)
+        counts[0, 0] = n_over
+        counts[0, 1] = 0
+        total, at_bound, left, joined, n_over = self._floats(
+            q.sum(),
+            self._masked(q, q >= p_max).sum(),
+            xp.count_nonzero(was & ~now),
+            xp.count_nonzero(now & ~was),
+            n_over,
+        )
+        if 0 < n_over <= SLOTS:
+            where = xp.flatnonzero(over)
+            self._record(idx, val, where, (p_max - scaled)[where])
+        p[...] = q
+        return total, at_bound, int(left), int(joined)
+
+    def event_counts(self, counts) -> tuple[int, int]:
+        """The points ``update`` clipped and added, in one transfer."""
+        n_clip, n_add = self.to_host(counts.sum(axis=0)).tolist()
+        return int(n_clip), int(n_add)
+
+    def changed_points(self, counts, idx_buf, val_buf):
+        """Flat indices and added pressures (Pa) recorded by the last ``update`` or
+        ``rescale_free`` (arrays of the namespace)."""
+        k = int(self.to_host(counts[0]).sum())
+        return idx_buf[0, :k], val_buf[0, :k]
+
+    def add_point_responses(self, u, green, idx, values):
+        """``u[i, j] += Σ_k values_k · green[(i - a_k) mod N0, (j - b_k) mod N1]`` in place
+        (as :func:`.kernels.add_point_responses`): one gather of the kernel and one axpy on
+        ``u`` per point (a few points: the loop applies at most ``SPARSE_MAX_*``)."""
+        xp = self.xp
+        n0, n1 = u.shape
+        big0, big1 = green.shape
+        rows0, cols0 = xp.arange(n0), xp.arange(n1)
+        ids, vals = self.to_host(idx).tolist(), self.to_host(values).tolist()
+        for k, v in zip(ids, vals, strict=True):
+            a, b = divmod(int(k), n1)
+            rows = (rows0 - a) % big0
+            cols = (cols0 - b) % big1
+            u += v * green[rows[:, None], cols[None, :]]
