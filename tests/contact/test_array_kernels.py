@@ -55,6 +55,16 @@ N = 2 * K.CHUNK + 1234
 HAVE_CUPY = importlib.util.find_spec("cupy") is not None
 
 
+@pytest.fixture(autouse=True)
+def _numba_kernels_from_the_cache():
+    """The numba kernels called directly run from numba's disk cache, as in every solve
+    (kernels.kernel_threads; a cold cache is compiled in a child first). Compiled in this
+    process instead, they would round otherwise than the cached ones for every later test of
+    the session (tests/contact/test_kernel_cache.py)."""
+    with K.kernel_threads(1):
+        yield
+
+
 def _device() -> bool:
     """Whether backend="cupy" can run here (CuPy and a CUDA device)."""
     try:
