@@ -100,6 +100,7 @@ class Spheres:
         self.synthetic_images = synthetic_images
         self.load_series = None if load_series is None else dict(load_series)
         self._missing: dict[str, dict[str, str]] = {}
+        self._series_files: dict[str, str | None] = {}
         self.held_out: dict[str, list[FailedJob]] = {}
 
     def __iter__(self):
@@ -199,7 +200,13 @@ class Spheres:
 
         Raises RawDataError naming both where the folder also has the per-load
         ``fluorescence/``, and naming the file where the config does not say how its planes
-        map to the loads (optics.images.load_series): neither is guessed."""
+        map to the loads (optics.images.load_series): neither is guessed. The folder is
+        looked at once, when the DAG asks first."""
+        if sphere not in self._series_files:
+            self._series_files[sphere] = self._find_load_series_file(sphere)
+        return self._series_files[sphere]
+
+    def _find_load_series_file(self, sphere: str) -> str | None:
         if self.is_synthetic(sphere):
             return None
         folder = self.raw_dir(sphere)
@@ -273,8 +280,9 @@ class Spheres:
         folder = f"{self.raw_dir(sphere)}/{subfolder}"
         if self.is_synthetic(sphere):
             return folder
-        if kind == "fluorescence" and self.load_series_file(sphere) is not None:
-            return [self.load_series_file(sphere)]
+        series_file = self.load_series_file(sphere) if kind == "fluorescence" else None
+        if series_file is not None:
+            return [series_file]
         files = fluorescence_images if kind == "fluorescence" else rheometer_files
         return [str(path) for path in files(folder, self.loads_mn(sphere))]
 
