@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from amontons.io.heightmap import LENGTH_UNITS, TopographyError, read_height_map, read_heights
+from amontons.io.pixel_probe import tiff_scan_side_m
 
 EXAMPLES = Path(__file__).resolve().parents[2].parent / "shared" / "afm-examples"
 pytestmark = pytest.mark.skipif(
@@ -87,6 +88,12 @@ def test_park_tiff_reads_its_heights_not_its_8_bit_preview():
     height_map = read_height_map(EXAMPLES / "example_ps.tiff")
     assert height_map.heights.shape == (512, 512)
     assert _sq(height_map.heights) == pytest.approx(3.933e-9, rel=1e-3)
+
+
+def test_the_dag_leaves_a_park_tiffs_size_to_its_reader():
+    """Its first page is a 256² 8-bit preview of the 512² map: sized from the header (with a
+    sheet pixel), the scan would be half its size, so the header probe gives none."""
+    assert tiff_scan_side_m(EXAMPLES / "example_ps.tiff", 1.953125e-9) is None
 
 
 def test_non_square_pixels_are_kept_per_axis():

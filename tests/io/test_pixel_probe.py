@@ -99,12 +99,18 @@ def test_a_tiff_scans_size_is_read_from_its_header_as_the_reader_reads_it(
 
 
 def test_a_tiff_scan_without_a_pixel_or_a_readable_header_has_no_size(tmp_path):
-    """None: the job that reads the map then names the file or the missing pixel."""
+    """None: the job that reads the map then names the file or the missing pixel, or finds
+    the map where a vendor's TIFF keeps it."""
     untagged = tmp_path / "untagged.tif"
     tifffile.imwrite(untagged, SCAN)
     truncated = tmp_path / "truncated.tif"
     write_image(truncated, SCAN, 40e-9)
     truncated.write_bytes(truncated.read_bytes()[:6])
     assert tiff_scan_side_m(untagged) is None
+    # integer samples: a vendor's TIFF (or its preview page), whose map its reader finds
+    preview = tmp_path / "preview.tif"
+    tifffile.imwrite(preview, SCAN.astype(np.uint8), resolution=(2.5e5, 2.5e5),
+                     resolutionunit="CENTIMETER")  # fmt: skip
+    assert tiff_scan_side_m(preview, 40e-9) is None
     assert tiff_scan_side_m(truncated, 40e-9) is None
     assert tiff_scan_side_m(tmp_path / "absent.tif", 40e-9) is None

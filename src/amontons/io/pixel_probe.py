@@ -30,11 +30,20 @@ from pathlib import Path
 from amontons.io.layout import RawDataError, confocal_suffix
 
 _WIDTH, _LENGTH, _IMAGE_DESCRIPTION, _X_RESOLUTION, _RESOLUTION_UNIT = 256, 257, 270, 282, 296
-_Y_RESOLUTION = 283
+_Y_RESOLUTION, _SAMPLE_FORMAT = 283, 339
+_IEEE_FLOAT = 3  # SampleFormat of float samples: a height map amontons.io.heightmap reads itself
 _CENTIMETRE, _INCH = 3, 2
 _METRES_PER_UNIT = {_INCH: 0.0254, _CENTIMETRE: 0.01}
 _DISPLAY_DPI_MAX = 1200.0  # amontons.io.tiff: an inch resolution up to this is a display default
-_TAGS = (_WIDTH, _LENGTH, _IMAGE_DESCRIPTION, _X_RESOLUTION, _Y_RESOLUTION, _RESOLUTION_UNIT)
+_TAGS = (
+    _WIDTH,
+    _LENGTH,
+    _IMAGE_DESCRIPTION,
+    _X_RESOLUTION,
+    _Y_RESOLUTION,
+    _RESOLUTION_UNIT,
+    _SAMPLE_FORMAT,
+)
 # TIFF field types: byte size of one value
 _TYPE_SIZES = {1: 1, 2: 1, 3: 2, 4: 4, 5: 8, 6: 1, 7: 1, 8: 2, 9: 4, 10: 8, 11: 4, 12: 8, 16: 8}
 _CZI_MAGIC = b"ZISRAWFILE"
@@ -77,8 +86,9 @@ def _tiff_tags(path: Path) -> dict[int, object]:
                 tags[code] = value.rstrip(b"\0").decode("utf-8", "replace")
             elif code in (_X_RESOLUTION, _Y_RESOLUTION):
                 tags[code] = struct.unpack(order + "II", value[:8])
-            else:  # SHORT (3) or LONG (4)
-                tags[code] = struct.unpack(order + ("I" if kind == 4 else "H"), value[:size])[0]
+            else:  # SHORT (3) or LONG (4); the first value of a per-sample tag
+                first = order + ("I" if kind == 4 else "H")
+                tags[code] = struct.unpack(first, value[: struct.calcsize(first)])[0]
     return tags
 
 
@@ -97,14 +107,16 @@ def _tag_pixel_m(tags: dict[int, object], code: int) -> float | None:
 
 def tiff_scan_side_m(path: str | Path, sheet_pixel_m: float | None = None) -> float | None:
     """The shorter side (m) of a TIFF height map's scan: its width and length in pixels times
-    the pixel its resolution tags state (amontons.io.tiff's rules), else ``sheet_pixel_m``;
-    None where neither gives a pixel, or where the header cannot be read (the job that reads
-    the map then names the file)."""
+    the pixel its resolution tags state (amontons.io.tiff's rules), else ``sheet_pixel_m``.
+    Only a float TIFF's first page is the map itself (amontons.io.heightmap); a vendor's
+    TIFF keeps its heights elsewhere (a Park Systems file's first page is a 256² preview of
+    a 512² map), so its size is left to the job's reader. None then, where neither gives a
+    pixel, or where the header cannot be read (the job that reads the map names the file)."""
     try:
         tags = _tiff_tags(Path(path))
     except (OSError, struct.error, ValueError, RawDataError):
         return None
-    if _WIDTH not in tags or _LENGTH not in tags:
+    if _WIDTH not in tags or _LENGTH not in tags or tags.get(_SAMPLE_FORMAT) != _IEEE_FLOAT:
         return None
     pixel_x = _tag_pixel_m(tags, _X_RESOLUTION) or sheet_pixel_m
     pixel_y = _tag_pixel_m(tags, _Y_RESOLUTION) or pixel_x
