@@ -28,12 +28,12 @@ import time
 
 import numpy as np
 from _common import E_STAR, header, parser, sphere_problem, table
-from threadpoolctl import threadpool_limits
 
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import NonPeriodicConvolution
 from amontons.contact.fft import DEFAULT_PLANNER_EFFORT
 from amontons.contact.options import CGOptions
+from amontons.contact.pools import solve_pools
 
 
 def factorise(m: int) -> str:
@@ -56,7 +56,7 @@ def solve_time(op, h, load, iterations, threads):
     """Wall time per iteration (s) of the first ``iterations`` CG iterations, and the
     result."""
     t0 = time.perf_counter()
-    with threadpool_limits(limits=1):  # as amontons.contact.solve does
+    with solve_pools(threads):  # as amontons.contact.solve does
         out = polonsky_keer(
             op,
             h,

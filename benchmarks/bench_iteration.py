@@ -20,8 +20,8 @@ Medians of --repeats.
 
 Paths: ``fused`` (numba kernels, the solver's one loop) and ``numpy`` (the reference loop
 the tests compare with, tests/contact/numpy_oracle.py). The solve runs inside
-``threadpool_limits(1)`` as :func:`amontons.contact.solve` does, in a plain process (no
-thread environment variables, unless ``--pinned``).
+:func:`amontons.contact.pools.solve_pools` as :func:`amontons.contact.solve` does, in a
+plain process (no thread environment variables, unless ``--pinned``).
 
     python benchmarks/bench_iteration.py                    # 1024², 2048²
     python benchmarks/bench_iteration.py --sizes 512 1024 2048 --threads 1 2
@@ -47,12 +47,12 @@ from _common import (
     sphere_problem,
     table,
 )
-from threadpoolctl import threadpool_limits
 
 from amontons.contact.cg import polonsky_keer
 from amontons.contact.convolution import get_operator
 from amontons.contact.fft import RealFFT2Pair, resolve_planner_effort
 from amontons.contact.options import CGOptions
+from amontons.contact.pools import solve_pools
 
 _ORACLE = Path(__file__).resolve().parents[1] / "tests" / "contact" / "numpy_oracle.py"
 
@@ -105,7 +105,7 @@ def problem(n, periodic):
 def solve_once(op, h, load, kernels, threads):
     timed = TimedOperator(op)
     t0 = time.perf_counter()
-    with threadpool_limits(limits=1):
+    with solve_pools(threads):
         loop = polonsky_keer if kernels else numpy_polonsky_keer
         options = CGOptions(tol=1e-8, max_iter=5000, threads=threads)  # the numpy loop: no threads
         out = loop(

@@ -14,7 +14,6 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from .elastic import COARSE_MIN_SIZE, finite, has_coarse_level
 from .errors import (
@@ -37,6 +36,7 @@ from .options import (
     check_warm_start,
     solve_options,
 )
+from .pools import solve_pools
 from .result import ContactResult, SolveInfo
 from .routes import run_route
 
@@ -87,10 +87,10 @@ def solve(
         ``1000 + 4(n0 + n1)``).
     threads : int or None
         FFTW threads; None means every core this process may use (its CPU affinity). The
-        numpy FFT backend is serial (a warning says so when threads > 1). Every other native
-        thread pool (OpenBLAS, OpenMP) is held to one thread for the duration of the call and
-        the caller's limits are restored after it, also on an exception: the CG's BLAS calls
-        are level 1, and their threads cost more than they bring.
+        numpy FFT backend is serial (a warning says so when threads > 1). For the duration of
+        the call the OpenMP pools (FFTW's and the kernels') run ``threads`` threads and the
+        BLAS pools one, and the caller's limits are restored after it, also on an exception:
+        the CG's BLAS calls are level 1, and their threads cost more than they bring.
     warm_start : array_like, optional
         Initial pressure, Pa (e.g. the pressure of a previous, nearby solve).
     coarse_to_fine : bool
@@ -200,11 +200,9 @@ def solve(
         coarse_to_fine=coarse_to_fine,
         warm_start=warm_start is not None,
     )
-    # Every native pool (OpenBLAS, OpenMP) runs one thread for the call and is restored after
-    # it, also on an exception: BLAS threads would spin against the solver's own
-    # (benchmarks/README.md, "Speed as a user gets it"); ``threads`` goes to FFTW and the
-    # kernels.
-    with threadpool_limits(limits=1):
+    # BLAS pools on one thread, OpenMP pools (FFTW's and the kernels') on ``threads``, the
+    # caller's limits back after the call (.pools says why)
+    with solve_pools(opts.threads):
         return _solve_step(
             h,
             spacing,
@@ -228,7 +226,7 @@ def solve_with_options(
     h = check_heights(heights)
     load, displacement = check_control(load, displacement)
     plastic_prev = None if opts.law is None else np.zeros(h.shape)
-    with threadpool_limits(limits=1):
+    with solve_pools(opts.threads):
         return _solve_step(
             h,
             check_positive("spacing", spacing, "m"),
@@ -326,7 +324,7 @@ def solve_load_series(
     plastic = None if opts.law is None else np.zeros(h.shape)
     results = []
     prev = None
-    with threadpool_limits(limits=1):  # as in solve
+    with solve_pools(opts.threads):  # as in solve
         for i, w in enumerate(arr):
             try:
                 res = _solve_step(
