@@ -9,12 +9,20 @@ iteration, not by timing."""
 
 import os
 
+import numba
 import numpy as np
 import pytest
 from threadpoolctl import threadpool_info, threadpool_limits
 
 import amontons.contact.greenwood_tripp as gt_module
-from amontons.contact import ContactInputError, ConvergenceError, elastic, solve, solve_load_series
+from amontons.contact import (
+    ContactInputError,
+    ConvergenceError,
+    elastic,
+    kernels,
+    solve,
+    solve_load_series,
+)
 from amontons.contact.greenwood_tripp import AsperityModel, greenwood_tripp
 from amontons.contact.options import check_threads
 from amontons.contact.surfaces import sphere
@@ -189,3 +197,21 @@ def test_idle_openmp_workers_sleep_unless_the_user_says_otherwise(given, expecte
         [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
     )
     assert out.stdout.strip() == expected
+
+
+@pytest.mark.parametrize(("n", "expected"), [(64, 1), (128, 1), (256, 2)])
+def test_the_kernels_take_no_more_threads_than_the_grid_has_chunks(monkeypatch, n, expected):
+    """A thread without a chunk would only pay its wake-up in every kernel: 64² and 128² are
+    one chunk (kernels.CHUNK = 16384 points), 256² four, so threads=2 runs the kernels on 1,
+    1 and 2 threads. Observed from inside the kernels' caller, as numba's thread count."""
+    seen = []
+    original = kernels.update
+
+    def recording(*args):
+        seen.append(numba.get_num_threads())
+        return original(*args)
+
+    monkeypatch.setattr(kernels, "update", recording)
+    h = sphere((n, n), 1e-6, 1e-3)
+    solve(h, 1e-6, 1e9, load=1e-3, threads=2)
+    assert seen and set(seen) == {expected}

@@ -228,7 +228,9 @@ def polonsky_keer(
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
     ks = kernel_set(options)
-    with ks.kernel_threads(_kernel_threads(operator, options.threads)):
+    with ks.kernel_threads(
+        _kernel_threads(operator, options.threads, ks.n_chunks(np.size(heights)))
+    ):
         return _loop(
             ks,
             operator,
@@ -676,14 +678,16 @@ def _final_complementarity(ks, u, h, p, d, load_control, m, t, p_max, bounded):
     return max(rms, pen), d, nc
 
 
-def _kernel_threads(operator, threads):
-    """Threads for the fused kernels: ``threads``, else the operator's, else 1."""
+def _kernel_threads(operator, threads, chunks):
+    """Threads for the fused kernels: ``threads``, else the operator's, else 1, and no more
+    than the grid's ``chunks``: a thread without a chunk only pays its wake-up in every
+    kernel (benchmarks/README.md, "A second core")."""
     if threads is None:
         base = getattr(operator, "operator", operator)  # a Winkler wrapper's convolution
         threads = getattr(base, "threads", 1)
     if not (isinstance(threads, int | np.integer) and threads >= 1):
         raise ValueError(f"threads must be a positive integer, got {threads!r}")
-    return int(threads)
+    return min(int(threads), chunks)
 
 
 def finish_outcome(
