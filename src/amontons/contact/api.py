@@ -90,7 +90,8 @@ def solve(
         numpy FFT backend is serial (a warning says so when threads > 1). For the duration of
         the call the OpenMP pools (FFTW's and the kernels') run ``threads`` threads and the
         BLAS pools one, and the caller's limits are restored after it, also on an exception:
-        the CG's BLAS calls are level 1, and their threads cost more than they bring.
+        the CG's BLAS calls are level 1, and their threads cost more than they bring. A
+        second thread pays from about 512² (benchmarks/README.md, "A second core").
     warm_start : array_like, optional
         Initial pressure, Pa (e.g. the pressure of a previous, nearby solve).
     coarse_to_fine : bool
