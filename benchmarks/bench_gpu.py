@@ -5,11 +5,15 @@ benchmark surface and of the non-periodic rough sphere (Hockney padding), on the
 (numba kernels, pyfftw, ``--threads``) and on the array kernel set of ``--backend``
 (``cupy``: the GPU; ``numpy-array``: the same code on numpy, to try this script without a
 GPU). Per solve: wall time (median of ``--repeats``, after one untimed solve that builds the
-plans and compiles the fused kernels), iterations, ms per iteration, the speed-up, and the
+plans and compiles the fused kernels), iterations, ms per iteration and its ratio to one
+forward + inverse real FFT of the convolution's grid on the same backend (a cuFFT pair on a
+GPU: n² periodic, the Hockney grid padded), the speed-up, and the
 largest pressure difference over the peak pressure with the contact sets compared. The
 solve returns numpy arrays, so each timing includes the transfers to and from the device.
+``--device-only`` times the device alone (for grids whose CPU solve would take minutes).
 
     python benchmarks/bench_gpu.py --sizes 1024 2048 4096           # on a GPU machine
+    python benchmarks/bench_gpu.py --sizes 4096 --device-only
     python benchmarks/bench_gpu.py --sizes 128 --backend numpy-array --repeats 1
 """
 
@@ -21,6 +25,8 @@ import numpy as np
 from _common import E_STAR, header, parser, rough_load, rough_surface, sphere_problem, table
 
 from amontons.contact import solve
+from amontons.contact.array_backends import array_module
+from amontons.contact.convolution import fast_padded_shape
 
 
 def _timed(repeats, **kw):
@@ -34,9 +40,31 @@ def _timed(repeats, **kw):
     return float(np.median(times)), result
 
 
+def fft_pair_seconds(backend: str, shape, repeats: int) -> float:
+    """Median wall time (s) of one real forward + inverse 2-D FFT of ``shape`` on the array
+    backend, the device synchronised after each."""
+    xp = array_module(backend).xp
+    runtime = getattr(getattr(xp, "cuda", None), "runtime", None)  # CuPy's; none on numpy
+
+    def pair():
+        xp.fft.irfft2(xp.fft.rfft2(a), s=shape)
+        if runtime is not None:
+            runtime.deviceSynchronize()
+
+    a = xp.asarray(np.random.default_rng(0).random(shape))
+    pair()  # plans
+    times = []
+    for _ in range(max(repeats, 5)):
+        t0 = time.perf_counter()
+        pair()
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
 def main() -> None:
     ap = parser(__doc__.splitlines()[0])
     ap.add_argument("--backend", default="cupy", choices=("cupy", "numpy-array"))
+    ap.add_argument("--device-only", action="store_true", help="no CPU solve to compare with")
     args = ap.parse_args()
     sizes = args.sizes or ([128, 256] if args.quick else [1024, 2048])
     repeats = args.repeats or 3
@@ -50,26 +78,37 @@ def main() -> None:
                 h, load = sphere_problem(n)
             kw = {"heights": h, "spacing": 1.0, "e_star": E_STAR, "load": load}
             kw["periodic"] = bc == "periodic"
-            t_cpu, cpu = _timed(repeats, threads=args.threads, **kw)
             t_dev, dev = _timed(repeats, backend=args.backend, **kw)
-            peak = float(np.abs(cpu.pressure).max())
-            rows.append(
-                {
-                    "grid": f"{n}²",
-                    "bc": bc,
-                    "CPU s": t_cpu,
-                    "CPU iterations": cpu.iterations,
-                    "CPU ms / it": 1e3 * t_cpu / cpu.iterations,
-                    f"{args.backend} s": t_dev,
-                    f"{args.backend} iterations": dev.iterations,
-                    f"{args.backend} ms / it": 1e3 * t_dev / dev.iterations,
-                    "speed-up": t_cpu / t_dev,
-                    "max |Δp| / p_max": float(np.abs(dev.pressure - cpu.pressure).max()) / peak,
-                    "same contact": bool(np.array_equal(cpu.pressure > 0, dev.pressure > 0)),
-                }
-            )
+            fft_shape = (n, n) if bc == "periodic" else fast_padded_shape((n, n))
+            t_pair = fft_pair_seconds(args.backend, fft_shape, repeats)
+            row = {
+                "grid": f"{n}²",
+                "bc": bc,
+                f"{args.backend} s": t_dev,
+                f"{args.backend} iterations": dev.iterations,
+                f"{args.backend} ms / it": 1e3 * t_dev / dev.iterations,
+                "FFT pair ms": 1e3 * t_pair,
+                "it / pair": t_dev / dev.iterations / t_pair,
+            }
+            if not args.device_only:
+                row.update(_against_cpu(repeats, args.threads, kw, t_dev, dev))
+            rows.append(row)
             print(rows[-1], flush=True)
     table(rows, list(rows[0]))
+
+
+def _against_cpu(repeats, threads, kw, t_dev, dev) -> dict:
+    """The CPU solve's time and iterations, the speed-up and the answers' difference."""
+    t_cpu, cpu = _timed(repeats, threads=threads, **kw)
+    peak = float(np.abs(cpu.pressure).max())
+    return {
+        "CPU s": t_cpu,
+        "CPU iterations": cpu.iterations,
+        "CPU ms / it": 1e3 * t_cpu / cpu.iterations,
+        "speed-up": t_cpu / t_dev,
+        "max |Δp| / p_max": float(np.abs(dev.pressure - cpu.pressure).max()) / peak,
+        "same contact": bool(np.array_equal(cpu.pressure > 0, dev.pressure > 0)),
+    }
 
 
 if __name__ == "__main__":

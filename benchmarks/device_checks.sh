@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# The checks that need a device machine, as one command: the CuPy route's tests and time to
+# solution (issue 39) and the CPU solver's scaling over many cores (issue 38). Prepare the
+# wheels here first (benchmarks/device_wheels.sh), then, with the device tool, in two calls
+# whose steps' limits add up to 340 and 330 s (the machine stays warm between them, so the
+# second's warm step finds the kernels compiled):
+#
+#     run  command: STEPS="machine warm tests gpu" bash benchmarks/device_checks.sh
+#          carry: [".whl"]   timeout_s: 360
+#     run  command: STEPS="warm scaling gpu_large" bash benchmarks/device_checks.sh
+#          carry: [".whl"]   timeout_s: 360
+#
+# or in one of ten (every step; the limits below add up to 580 s). Each step has its own
+# time limit, so that a slow one leaves the others their time, and writes its log to
+# $OUT/<step>.log as it runs: what a stopped step printed still comes back. Steps run in
+# the order below, whatever the order in STEPS.
+# QUICK=1 runs every step on small grids and BACKEND=numpy-array the GPU route's code on
+# numpy: together they try the script on any machine in a minute.
+set -uo pipefail
+out=${OUT:-/tmp/device-checks}
+mkdir -p "$out"
+python=${PYTHON:-python3}
+steps=" ${STEPS:-machine warm tests gpu scaling gpu_large} "
+backend=${BACKEND:-cupy}
+cores=$(nproc)
+if compgen -G ".whl/*.whl" > /dev/null; then
+    "$python" -m pip install --quiet --no-index --no-deps --no-compile --no-cache-dir \
+        --upgrade --target /tmp/device-site .whl/*.whl || exit 1
+    export PYTHONPATH=/tmp/device-site
+fi
+# the working tree's code, not the wheel's; the wheel gives the package's metadata
+export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
+
+if [[ ${QUICK:-0} == 1 ]]; then
+    gpu_sizes=(64 128) large_sizes=(256) scaling_size=256 repeats=1 threads=(1 2)
+else
+    gpu_sizes=(1024 2048) large_sizes=(4096) scaling_size=2048 repeats=3 threads=(1 2 4 8 16)
+fi
+
+step() {  # step NAME SECONDS COMMAND...: run COMMAND for at most SECONDS, logged
+    local name=$1 limit=$2
+    shift 2
+    [[ $steps == *" $name "* ]] || return 0
+    echo "== $name (at most $limit s): $*"
+    timeout "$limit" "$@" 2>&1 | tee "$out/$name.log"
+    echo "== $name: exit ${PIPESTATUS[0]} (124: stopped at its limit)"
+}
+
+step machine 30 bash -c "nvidia-smi --query-gpu=name,memory.total,driver_version \
+    --format=csv; lscpu | grep -E 'Model name|^CPU\(s\)|L3'; \"$python\" -c 'import sys, \
+    numpy, numba, pyfftw, amontons; print(sys.version); print(\"numpy\", numpy.__version__, \
+    \"numba\", numba.__version__, \"pyfftw\", pyfftw.__version__)'; \"$python\" -c 'import \
+    cupy; print(\"cupy\", cupy.__version__, cupy.cuda.runtime.getDeviceCount(), \"device(s)\")'"
+# the numba kernels compile once into their disk cache (26-46 s on a 2-core VM)
+step warm 90 "$python" -c "from amontons.contact.kernel_cache import main; main()"
+step tests 100 "$python" -m pytest -q -p no:cacheprovider \
+    tests/contact/test_array_kernels.py tests/contact/test_thread_pools.py
+cd benchmarks || exit 1
+step gpu 120 "$python" bench_gpu.py --backend "$backend" --sizes "${gpu_sizes[@]}" \
+    --threads "$cores" --repeats "$repeats"
+step scaling 180 "$python" bench_iteration.py --sizes "$scaling_size" --bc periodic \
+    --paths fused --thread-counts "${threads[@]}" --repeats "$repeats"
+step gpu_large 60 "$python" bench_gpu.py --backend "$backend" --device-only \
+    --sizes "${large_sizes[@]}" --repeats "$repeats"
