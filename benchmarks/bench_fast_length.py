@@ -56,7 +56,7 @@ def solve_time(op, h, load, iterations, threads):
     """Wall time per iteration (s) of the first ``iterations`` CG iterations, and the
     result."""
     t0 = time.perf_counter()
-    with solve_pools(threads):  # as amontons.contact.solve does
+    with solve_pools(threads):  # as amontons.contact.solve does (run holds them too)
         out = polonsky_keer(
             op,
             h,
@@ -70,6 +70,12 @@ def solve_time(op, h, load, iterations, threads):
 
 
 def run(n, args):
+    """One row, planned and timed under the pools a solve on ``args.threads`` holds."""
+    with solve_pools(args.threads):
+        return _measure(n, args)
+
+
+def _measure(n, args):
     kw = {"threads": args.threads, "planner_effort": args.effort}
     before = NonPeriodicConvolution((n, n), 1.0, E_STAR, padded_shape=(2 * n, 2 * n), **kw)
     after = NonPeriodicConvolution((n, n), 1.0, E_STAR, **kw)

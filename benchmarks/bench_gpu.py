@@ -98,7 +98,8 @@ def main() -> None:
 
 
 def _against_cpu(repeats, threads, kw, t_dev, dev) -> dict:
-    """The CPU solve's time and iterations, the speed-up and the answers' difference."""
+    """The CPU solve's time (s) and iterations, the speed-up (CPU time over ``t_dev``, s) and
+    the answers' difference (over the CPU's peak pressure)."""
     t_cpu, cpu = _timed(repeats, threads=threads, **kw)
     peak = float(np.abs(cpu.pressure).max())
     return {

@@ -115,6 +115,13 @@ def solve_once(op, h, load, kernels, threads):
 
 
 def run(n, periodic, path, threads, effort, repeats):
+    """One row: plans, floors and solves all under the pools a solve on ``threads`` holds
+    (OpenMP at ``threads``), so that the floors are timed as the solve's transforms run."""
+    with solve_pools(threads):
+        return _measure(n, periodic, path, threads, effort, repeats)
+
+
+def _measure(n, periodic, path, threads, effort, repeats):
     h, load = problem(n, periodic)
     effort = resolve_planner_effort(effort)
     op = get_operator(

@@ -13,9 +13,10 @@ paid once.
 
 The file is ``$AMONTONS_FFTW_WISDOM`` if set (an empty value keeps wisdom in the process
 only), else ``fftw-wisdom-<key>.json`` in ``$XDG_CACHE_HOME/amontons`` (``~/.cache``),
-where the key hashes the CPU model and flags, the machine type and the pyfftw version: a
-cache directory shared by different machines (a cluster's home) keeps one file per kind
-of node. docs/models.md §2.1 ("FFT plans") says what this means for reproducibility.
+where the key hashes the CPU model and flags, the machine type, the pyfftw version and
+:data:`TIMED_UNDER` (how plans were timed): a cache directory shared by different machines
+(a cluster's home) keeps one file per kind of node. docs/models.md §2.1 ("FFT plans")
+says what this means for reproducibility.
 """
 
 from __future__ import annotations
@@ -36,6 +37,10 @@ except ImportError:  # pragma: no cover - Windows: no lock, the file is still sh
     fcntl = None
 
 WISDOM_ENV = "AMONTONS_FFTW_WISDOM"
+# How the plans in a file were timed; a change sets the files of before aside. Until
+# 2026-11-26 a solve held OpenMP to one thread while it planned, so its two-thread MEASURE
+# plans were timed on one core (benchmarks/README.md, "A second core").
+TIMED_UNDER = "openmp-at-the-plan's-threads"
 
 
 class WisdomFileError(RuntimeError):
@@ -59,7 +64,7 @@ def machine_key() -> str:
     """12 hex digits naming this kind of machine and FFTW build."""
     import pyfftw
 
-    text = "\n".join((platform.machine(), _cpu_description(), pyfftw.__version__))
+    text = "\n".join((platform.machine(), _cpu_description(), pyfftw.__version__, TIMED_UNDER))
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
