@@ -206,7 +206,7 @@ CONTACT_FLOORS = (
     # 2. operators: FFT plans and wisdom, Green's functions, convolutions
     ("wisdom", "fft", "greens", "jit", "spectrum", "array_convolution", "convolution"),
     # 3. kernel sets: the element-wise work of one iteration
-    ("kernels", "array_kernels", "bounded_load"),
+    ("kernels", "device_sources", "array_kernels", "bounded_load"),
     # 4. the iteration: the one Polonsky-Keer control flow
     ("stall", "cg"),
     # 5. routes, chosen from one table

@@ -16,7 +16,7 @@ Snakemake dry run, which never solves) need it. A missing CuPy or device raises
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import lru_cache, partial
 
 import numpy as np
 
@@ -35,7 +35,10 @@ class ArrayModule:
     ``xp``: the namespace (``numpy`` or ``cupy``); ``to_host``: an array of it as a numpy
     array; ``add_at(a, idx, values)``: ``a[idx] += values`` with repeated indices summed
     (``np.add.at``, ``cupyx.scatter_add``); ``fuse``: compiles an element-wise function of
-    arrays and scalars into one kernel (``cupy.fuse``; identity on numpy).
+    arrays and scalars into one kernel (``cupy.fuse``; identity on numpy); ``compile``:
+    builds an element-wise kernel from its source (a :class:`.device_sources.KernelSource`)
+    and ``preamble``, callable as CuPy's are (inputs, then outputs), or None where the
+    namespace runs no CUDA source (numpy: the array set then runs its array code).
     """
 
     name: str
@@ -43,6 +46,7 @@ class ArrayModule:
     to_host: object
     add_at: object
     fuse: object
+    compile: object = None
 
 
 def _identity(fn):
@@ -92,4 +96,13 @@ def _load_cupy() -> ArrayModule:
             "backend='cupy': CuPy is installed but finds no CUDA device; run on a machine "
             "with an NVIDIA GPU, or use backend=None for the CPU solver"
         )
-    return ArrayModule(CUPY, cupy, cupy.asnumpy, cupyx.scatter_add, cupy.fuse)
+    return ArrayModule(
+        CUPY, cupy, cupy.asnumpy, cupyx.scatter_add, cupy.fuse, partial(_cupy_kernel, cupy)
+    )
+
+
+def _cupy_kernel(cupy, source, preamble: str):
+    """CuPy's element-wise kernel of ``source`` (a .device_sources.KernelSource)."""
+    return cupy.ElementwiseKernel(
+        source.in_params, source.out_params, source.body, source.name, preamble=preamble
+    )

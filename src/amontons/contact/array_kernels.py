@@ -42,6 +42,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from . import device_sources as src
 from .array_backends import ArrayModule, array_module
 
 # Records per chunk (the one chunk): at least the most changed points the loop applies as
@@ -91,8 +92,11 @@ def _where(xp):
 @lru_cache(maxsize=4)
 def array_kernel_set(name: str) -> ArrayKernels:
     """The array kernel set on the namespace of backend ``name``
-    (:func:`.array_backends.array_module`; raises there without CuPy or a device)."""
-    return ArrayKernels(array_module(name))
+    (:func:`.array_backends.array_module`; raises there without CuPy or a device):
+    :class:`DeviceKernels` where the namespace compiles CUDA source (CuPy), else
+    :class:`ArrayKernels`."""
+    module = array_module(name)
+    return ArrayKernels(module) if module.compile is None else DeviceKernels(module)
 
 
 class ArrayKernels:
@@ -316,3 +320,76 @@ class ArrayKernels:
             rows = (rows0 - a) % big0
             cols = (cols0 - b) % big1
             u += v * green[rows[:, None], cols[None, :]]
+
+
+class DeviceKernels(ArrayKernels):
+    """The array set with the element-wise passes of the four kernels of every iteration
+    (``gap_moments``, ``direction``, ``step_dots``, ``update``) as the user-defined kernels
+    of :mod:`.device_sources`, compiled by ``module.compile`` (CuPy): one launch per pass,
+    which writes the terms the namespace then sums (one launch per sum), in place of one
+    launch per array operation. Contracts, host reads and records as
+    :class:`ArrayKernels`' (whose array code the sources follow); the rare paths are its
+    array code."""
+
+    def __init__(self, module: ArrayModule):
+        super().__init__(module)
+        build = module.compile
+        self._gap_terms = build(src.GAP_TERMS, src.PREAMBLE)
+        self._direction = build(src.DIRECTION, src.PREAMBLE)
+        self._step_terms = build(src.STEP_TERMS, src.PREAMBLE)
+        self._update = build(src.UPDATE, src.PREAMBLE)
+
+    def _terms(self, n: int, count: int) -> list:
+        """``count`` uninitialised float64 arrays of ``n`` points."""
+        return [self.xp.empty(n) for _ in range(count)]
+
+    def gap_moments(self, u, sigma, h, m, t, shift):
+        """``(Σ_m a, Σ_m a², Σ_m a·t, Σ t)`` of ``a = sigma·u - h - shift`` on ``m``."""
+        a, a2, at = self._terms(u.size, 3)
+        self._gap_terms(u, sigma, h, shift, m, t, a, a2, at)
+        return tuple(self._floats(a.sum(), a2.sum(), at.sum(), t.sum()))
+
+    def direction(self, u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, vidx, vg):
+        """As :meth:`ArrayKernels.direction`: ``t`` in place, the violators counted into
+        ``violators[0]``; returns ``Σ t`` as a 0-d array of the namespace."""
+        flags = self.xp.empty(u.size, np.int8)
+        ub = self._bound(p_max, bounded)
+        self._direction(u, sigma, h, d, beta, shift, m, p, ub, t, flags)
+        violators[0] = self.xp.count_nonzero(flags)
+        return t.sum()
+
+    def step_dots(self, r, t, m, compliance, winkler):
+        """With ``winkler``, ``r += compliance·t`` in place; ``(Σ r·t, Σ_m r)``."""
+        if winkler:
+            r += compliance * t
+        rt, rm = self._terms(r.size, 2)
+        self._step_terms(r, t, m, rt, rm)
+        rt, rm = self._floats(rt.sum(), rm.sum())
+        return rt, rm
+
+    def update(
+        self, p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, idx, val,
+        counts, keep_mask, with_u, vidx, vg, record_max,
+    ):  # fmt: skip
+        """As :meth:`ArrayKernels.update`, the step's pass one kernel (``p_new`` may be
+        ``p``: the kernel reads each point's ``p`` before it writes it)."""
+        xp = self.xp
+        if p_new is not p:
+            p_new[...] = p
+        n = p.size
+        clipped, joined = xp.empty(n, np.int8), xp.empty(n, np.int8)
+        cval, added, gj, at_bound = self._terms(n, 4)
+        ub = self._bound(p_max, bounded)
+        step = (r, h, sigma, d, tau, tau / sigma, ub, int(keep_mask), int(with_u))
+        self._update(*step, p_new, m, t, u, clipped, joined, cval, added, gj, at_bound)
+        events = (xp.count_nonzero(clipped), xp.count_nonzero(joined))
+        counts[0] = xp.stack(events)
+        on_bound = at_bound.sum() if bounded else xp.zeros(())
+        psum, pen, on_bound, n_clip, n_add = self._floats(p_new.sum(), gj.max(), on_bound, *events)
+        n_events = int(n_clip) + int(n_add)
+        complete = not (n_events > 0 and n_events > min(record_max, SLOTS))
+        if n_events and complete:
+            where_clip = xp.flatnonzero(clipped)
+            where_join = xp.flatnonzero(joined)
+            self._record(idx, val, where_clip, cval[where_clip], where_join, added[where_join])
+        return psum, pen, on_bound, complete

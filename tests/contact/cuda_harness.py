@@ -1,0 +1,107 @@
+"""The GPU kernel set's CUDA sources (amontons.contact.device_sources) compiled as C++ on the
+CPU, so that CI, without a GPU, runs the kernels' arithmetic against the array code.
+
+:func:`harness_module` is an :class:`~amontons.contact.array_backends.ArrayModule` on numpy
+whose ``compile`` builds each source into a C++ function (g++) called as CuPy calls its
+element-wise kernels: inputs, then outputs; a scalar or a length-1 array broadcasts; the
+function loops over the points with each parameter bound to its element (the outputs by
+reference). Array arguments must have the declared dtype exactly, as CuPy's kernels with
+concrete types require.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from amontons.contact.array_backends import ArrayModule
+
+TYPES = {
+    "float64": ("double", np.float64),
+    "uint8": ("unsigned char", np.uint8),
+    "int8": ("signed char", np.int8),
+    "int32": ("int", np.int32),
+}
+PRELUDE = """
+#include <cmath>
+#define __device__
+using std::fabs;
+using std::fmax;
+using std::fmin;
+"""
+COMPILER = shutil.which("g++")
+
+
+def _params(text: str) -> list[tuple[str, str]]:
+    return [tuple(p.split()) for p in text.split(",")]
+
+
+def c_function(source) -> str:
+    """The C++ function of a ``KernelSource``: ``name(n, inputs..., outputs...)``."""
+    ins, outs = _params(source.in_params), _params(source.out_params)
+    args = ["long long n"] + [f"const {TYPES[t][0]}* {n}_" for t, n in ins]
+    args += [f"{TYPES[t][0]}* {n}_" for t, n in outs]
+    loads = " ".join(f"const {TYPES[t][0]} {n} = {n}_[i];" for t, n in ins)
+    refs = " ".join(f"{TYPES[t][0]}& {n} = {n}_[i];" for t, n in outs)
+    loop = f"for (long long i = 0; i < n; ++i) {{ {loads} {refs} {source.body} }}"
+    return f'extern "C" void {source.name}({", ".join(args)}) {{ {loop} }}'
+
+
+class HarnessKernel:
+    """A compiled source, called as CuPy's kernel of it."""
+
+    def __init__(self, library: ctypes.CDLL, source):
+        self.source = source
+        self.ins = _params(source.in_params)
+        self.outs = _params(source.out_params)
+        self.fn = getattr(library, source.name)
+
+    def __call__(self, *args):
+        n_in = len(self.ins)
+        inputs, outputs = args[:n_in], args[n_in:]
+        assert len(outputs) == len(self.outs), self.source.name
+        n = max(np.size(a) for a in args)
+        arrays = [self._input(a, t, n) for (t, _), a in zip(self.ins, inputs, strict=True)]
+        for (t, name), out in zip(self.outs, outputs, strict=True):
+            assert out.dtype == TYPES[t][1] and out.size == n, (self.source.name, name)
+            assert out.flags.c_contiguous, (self.source.name, name)
+        pointers = [a.ctypes.data_as(ctypes.c_void_p) for a in (*arrays, *outputs)]
+        self.fn(ctypes.c_longlong(n), *pointers)
+        return outputs
+
+    def _input(self, value, type_name: str, n: int) -> np.ndarray:
+        dtype = TYPES[type_name][1]
+        if isinstance(value, np.ndarray) and value.ndim:
+            assert value.dtype == dtype, (self.source.name, value.dtype, type_name)
+        return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=dtype), (n,)))
+
+
+_LIBRARIES: dict[str, ctypes.CDLL] = {}
+
+
+def compile_source(source, preamble: str) -> HarnessKernel:
+    """``source`` compiled with g++ (cached per text for the session)."""
+    code = PRELUDE + preamble + c_function(source) + "\n"
+    key = hashlib.sha256(code.encode()).hexdigest()[:16]
+    if key not in _LIBRARIES:
+        folder = Path(tempfile.mkdtemp(prefix="amontons-harness-"))
+        (folder / "k.cpp").write_text(code)
+        subprocess.run(
+            [COMPILER, "-O2", "-shared", "-fPIC", "-o", "k.so", "k.cpp"],
+            cwd=folder,
+            check=True,
+            capture_output=True,
+        )
+        _LIBRARIES[key] = ctypes.CDLL(str(folder / "k.so"))
+    return HarnessKernel(_LIBRARIES[key], source)
+
+
+def harness_module() -> ArrayModule:
+    """numpy, with the CUDA sources compiled as C++ (module docstring)."""
+    return ArrayModule("numpy-harness", np, np.asarray, np.add.at, lambda fn: fn, compile_source)

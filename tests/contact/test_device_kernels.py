@@ -1,0 +1,221 @@
+"""The GPU kernel set's CUDA kernels (amontons.contact.device_sources, run by
+``DeviceKernels`` on CuPy) against the array code they replace (``ArrayKernels``).
+
+Without a GPU the sources are compiled as C++ (tests/contact/cuda_harness.py) and called on
+numpy arrays as CuPy calls them, so the kernels' arithmetic and ``DeviceKernels``' glue (the
+arguments, the flags, the records) run here; only nvcc's code generation and the device's
+reductions are left to a machine with a GPU (tests/contact/test_array_kernels.py runs the
+whole solves there with ``backend="cupy"``).
+
+Tolerances, and why:
+
+* element-wise results (pressures, masks, the direction, ``u``) and counts: exact. The
+  sources evaluate the array code's expressions in its association, and g++ contracts no
+  multiply-add on x86-64 without ``-mfma``; so a difference is a changed expression;
+* sums: 1e-12 relative to the sum of the magnitudes. The harness folds in index order,
+  numpy pairwise: the two orders round differently by ~n·1e-16 at worst;
+* whole solves: the same contact set and iteration count, pressures within 1e-10 of the
+  peak pressure (the GPU route's target against the CPU path): the sums' round-off is all
+  that differs, and the iterates follow each other to it.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from amontons.contact import self_affine, sphere
+from amontons.contact.array_backends import NUMPY
+from amontons.contact.array_convolution import ArrayConvolution
+from amontons.contact.array_kernels import ArrayKernels, DeviceKernels
+from amontons.contact.cg import BoundedWall, HardWall, _loop
+from amontons.contact.convolution import fast_padded_shape
+from amontons.contact.options import CGOptions
+
+
+def _load_harness():
+    """tests/contact/cuda_harness.py (tests import helpers by file)."""
+    spec = importlib.util.spec_from_file_location(
+        "cuda_harness", Path(__file__).with_name("cuda_harness.py")
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+harness = _load_harness()
+COMPILER, harness_module = harness.COMPILER, harness.harness_module
+pytestmark = pytest.mark.skipif(COMPILER is None, reason="no C++ compiler (g++) here")
+
+N = 50_000
+SUM_RTOL = 1e-12
+A = ArrayKernels(NUMPY)
+
+
+@pytest.fixture(scope="module")
+def device():
+    return DeviceKernels(harness_module())
+
+
+def _close_sum(got, want, magnitude):
+    assert abs(got - want) <= SUM_RTOL * magnitude, (got, want)
+
+
+def _state(seed=5):
+    rng = np.random.default_rng(seed)
+    p = np.where(rng.random(N) < 0.6, rng.random(N), 0.0)
+    m = (p > 0).astype(np.uint8)
+    return {
+        "p": p,
+        "m": m,
+        "u": rng.normal(size=N),
+        "h": rng.normal(size=N),
+        "t": rng.normal(size=N) * m,
+        "r": rng.normal(size=N),
+        "p_max": np.full(N, 0.9),
+    }
+
+
+def test_gap_moments(device):
+    s = _state()
+    args = (s["u"], 1.3, s["h"], s["m"], s["t"], 0.2)
+    a = np.abs((1.3 * s["u"] - s["h"] - 0.2) * s["m"])
+    mags = (a.sum(), (a * a).sum(), (a * np.abs(s["t"])).sum(), np.abs(s["t"]).sum())
+    for got, want, mag in zip(device.gap_moments(*args), A.gap_moments(*args), mags, strict=True):
+        _close_sum(got, want, mag)
+
+
+@pytest.mark.parametrize("bounded", [False, True])
+def test_direction(device, bounded):
+    s = _state()
+    p_max = s["p_max"] if bounded else np.full(1, np.inf)
+    out = {}
+    for name, ks in (("device", device), ("array", A)):
+        t, violators = s["t"].copy(), np.zeros(1, np.int64)
+        total = ks.direction(
+            s["u"], 1.1, s["h"], s["m"], t, 0.1, 0.7, 0.05, s["p"], p_max, bounded, violators,
+            None, None,
+        )  # fmt: skip
+        out[name] = (t, int(violators[0]), float(total))
+    assert np.array_equal(out["device"][0], out["array"][0])
+    assert out["device"][1] == out["array"][1] > 0
+    _close_sum(out["device"][2], out["array"][2], np.abs(out["array"][0]).sum())
+
+
+@pytest.mark.parametrize("winkler", [False, True])
+def test_step_dots(device, winkler):
+    s = _state()
+    comp = np.abs(s["h"]) if winkler else np.zeros(1)
+    r_dev, r_arr = s["r"].copy(), s["r"].copy()
+    got = device.step_dots(r_dev, s["t"], s["m"], comp, winkler)
+    want = A.step_dots(r_arr, s["t"], s["m"], comp, winkler)
+    assert np.array_equal(r_dev, r_arr)
+    mag = np.abs(r_arr).sum() * (1 + np.abs(s["t"]).max())
+    _close_sum(got[0], want[0], mag)
+    _close_sum(got[1], want[1], mag)
+
+
+def _update_case(rng, bounded, events):
+    """A state whose step clips about ``events`` free points and adds as many violators
+    (as tests/contact/test_array_kernels.py's)."""
+    p = np.where(rng.random(N) < 0.6, 0.2 + 0.5 * rng.random(N), 0.0)
+    m = (p > 0).astype(np.uint8)
+    t = 1e-3 * rng.normal(size=N) * m
+    free, bound = np.flatnonzero(m), np.flatnonzero(m == 0)
+    clip = rng.choice(free, events, replace=False)
+    t[clip] = 5.0 * np.sign(rng.normal(size=events)) if bounded else 5.0
+    u = np.abs(rng.normal(size=N)) + 3.0
+    h = np.zeros(N)
+    join = rng.choice(bound, events, replace=False)
+    u[join] = -0.5
+    p_max = np.full(N, 0.9) if bounded else np.full(1, np.inf)
+    if bounded:
+        top = rng.choice(np.setdiff1d(bound, join), events, replace=False)
+        p[top] = 0.9
+    return {"p": p, "m": m, "t": t, "u": u, "h": h, "r": rng.normal(size=N), "p_max": p_max}
+
+
+@pytest.mark.parametrize("bounded", [False, True])
+@pytest.mark.parametrize("events", [0, 4, 200])
+@pytest.mark.parametrize(("keep_mask", "with_u"), [(False, False), (False, True), (True, True)])
+def test_update(device, bounded, events, keep_mask, with_u):
+    rng = np.random.default_rng(events + 10 * bounded)
+    case = _update_case(rng, bounded, events)
+    out = {}
+    for name, ks in (("device", device), ("array", A)):
+        c = {k: v.copy() for k, v in case.items()}
+        idx, val = np.zeros((1, ks.SLOTS), np.int64), np.zeros((1, ks.SLOTS))
+        counts = np.zeros((1, 2), np.int64)
+        p_new = c["p"] if not keep_mask else np.empty(N)
+        fields = [c[k] for k in ("u", "r", "t", "h", "m", "p_max")]
+        records = (np.zeros(1, np.int64), idx, val, counts, keep_mask, with_u, None, None, 32)
+        result = ks.update(c["p"], p_new, *fields, bounded, 1.2, 0.1, 0.3, *records)
+        out[name] = (result, c, p_new, ks.event_counts(counts), idx, val)
+    (o_d, c_d, p_d, k_d, i_d, v_d), (o_a, c_a, p_a, k_a, i_a, v_a) = out["device"], out["array"]
+    assert k_d == k_a
+    if events:
+        assert sum(k_a) >= 2 * events * 0.9  # the case made the events it was meant to
+    assert np.array_equal(p_d, p_a)
+    for field in ("m", "t", "u", "p"):
+        assert np.array_equal(c_d[field], c_a[field]), field
+    _close_sum(o_d[0], o_a[0], np.abs(p_a).sum())
+    assert o_d[1] == o_a[1] and o_d[3] == o_a[3]
+    _close_sum(o_d[2], o_a[2], np.abs(p_a).sum())
+    if o_a[3]:
+        k = sum(k_a)
+        assert np.array_equal(i_d[0, :k], i_a[0, :k]) and np.array_equal(v_d[0, :k], v_a[0, :k])
+
+
+def _rough(n):
+    return self_affine((n, n), 1.0, 0.8, rms_slope=0.1, rng=3)
+
+
+def _sphere(n):
+    return sphere((n, n), 1.0, 4.0 * n) + self_affine((n, n), 1.0, 0.8, rms_height=0.3, rng=4)
+
+
+SOLVES = {
+    "periodic, load": (lambda: _rough(96), True, {"load": 0.005 * 96**2}, None),
+    "padded, load": (lambda: _sphere(96), False, {"load": 20.0}, None),
+    "padded, displacement, bounded": (
+        lambda: _sphere(96),
+        False,
+        {"displacement": 1.0 - float(_sphere(96).max())},
+        0.08,
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SOLVES))
+def test_whole_solve_agrees_with_the_array_code(device, name):
+    make, periodic, control, p_y = SOLVES[name]
+    h = make()
+    padded = None if periodic else fast_padded_shape(h.shape)
+    op = ArrayConvolution(h.shape, 1.0, 1.0, np, padded)
+    constraint = HardWall() if p_y is None else BoundedWall(np.full(h.shape, p_y))
+    options = CGOptions(tol=1e-8, max_iter=3000)
+    outs = [
+        _loop(
+            ks,
+            op,
+            h,
+            options,
+            pixel_area=1.0,
+            h_scale=float(h.std()),
+            p_init=np.ones_like(h),
+            constraint=constraint,
+            load=control.get("load"),
+            displacement=control.get("displacement"),
+        )  # fmt: skip
+        for ks in (device, A)
+    ]
+    dev, arr = outs
+    assert dev.status == arr.status == 0
+    assert dev.iterations == arr.iterations
+    assert np.array_equal(dev.pressure > 0, arr.pressure > 0)
+    assert np.abs(dev.pressure - arr.pressure).max() <= 1e-10 * arr.pressure.max()
+    if p_y is not None:
+        assert np.any(arr.pressure >= p_y * (1 - 1e-12))  # the bound is reached somewhere
