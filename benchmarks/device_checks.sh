@@ -10,7 +10,7 @@
 # The limits are ceilings for a fresh machine (FFTW plans measured, kernels compiled). The
 # steps that measure an issue's target come first: the GPU route against the CPU solver at
 # 512² and 2048², elastic and penetration hardness (the CPU solve timed once); 4096² on the
-# device alone; then benchmark 1 at 2048² on 1, 8, 16, 4 and 2 threads (issue 38's target
+# device alone; a profile of the host's time in the 2048² device solves; then benchmark 1 at 2048² on 1, 8, 16, 4 and 2 threads (issue 38's target
 # is 8); the CuPy tests last, their kernels compiled by then. Each step has its own time
 # limit, so that a slow one leaves the others their time, and writes its log to
 # $OUT/<step>.log as it runs: what a stopped step printed still comes back. Steps run in
@@ -23,7 +23,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)  # absolute: the benchmark steps run in benchmarks/
 failed=0
 python=${PYTHON:-python3}
-steps=" ${STEPS:-machine warm tests gpu scaling gpu_large} "
+steps=" ${STEPS:-machine warm gpu gpu_large profile scaling tests} "
 backend=${BACKEND:-cupy}
 cores=$(nproc)
 if compgen -G ".whl/*.whl" > /dev/null; then
@@ -36,8 +36,10 @@ export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
 
 if [[ ${QUICK:-0} == 1 ]]; then
     gpu_sizes=(64 128) large_sizes=(256) scaling_size=256 repeats=1 threads=(1 2)
+    profile_size=128
 else
     gpu_sizes=(512 2048) large_sizes=(4096) scaling_size=2048 repeats=3 threads=(1 8 16 4 2)
+    profile_size=2048
 fi
 
 step() {  # step NAME SECONDS COMMAND...: run COMMAND for at most SECONDS, logged
@@ -63,9 +65,13 @@ step gpu 170 "$python" bench_gpu.py --backend "$backend" --sizes "${gpu_sizes[@]
     --laws elastic hardness --threads "$cores" --repeats "$repeats" --cpu-repeats 1
 step gpu_large 60 "$python" bench_gpu.py --backend "$backend" --device-only \
     --sizes "${large_sizes[@]}" --repeats "$repeats"
+# where the host's time goes in the GPU route's solves: the 45 costliest functions
+step profile 40 bash -c "\"$python\" -m cProfile -s tottime bench_gpu.py --backend $backend \
+    --device-only --sizes $profile_size --repeats 3 | head -75"
 step scaling 170 "$python" bench_iteration.py --sizes "$scaling_size" --bc periodic \
     --paths fused --thread-counts "${threads[@]}" --repeats "$repeats"
 cd .. || exit 1
 step tests 80 "$python" -m pytest -q -p no:cacheprovider \
-    tests/contact/test_array_kernels.py tests/contact/test_thread_pools.py
+    tests/contact/test_array_kernels.py tests/contact/test_device_kernels.py \
+    tests/contact/test_thread_pools.py
 exit "$failed"
