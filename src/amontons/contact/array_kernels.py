@@ -30,6 +30,10 @@ differences are the ones a GPU asks for:
   on rare paths (a restart of the free set, the bounded load step's shortened or restarted
   step) run on host copies through :meth:`ArrayKernels.on_host`.
 
+On CuPy the set is :class:`DeviceKernels`: the element-wise passes of the four kernels of
+every iteration run as the CUDA kernels of :mod:`.device_sources` (one launch per pass, in
+place of one per array operation), the sums as above.
+
 Arrays are flat float64 of the namespace (the free set ``m`` uint8), in the units of
 :mod:`.kernels`.
 """
