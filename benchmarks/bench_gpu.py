@@ -32,7 +32,6 @@ from amontons.contact import PenetrationHardness, solve
 from amontons.contact.array_backends import array_module
 from amontons.contact.convolution import fast_padded_shape
 
-
 # Penetration hardness of the "hardness" rows, in E*: above the periodic surface's mean
 # pressure (0.005 E*) and the sphere's Hertz peak (2a/(πR) E* = 0.032 E*), below the local
 # peaks that the roughness raises, so that part of the contact, not all of it, is plastic.
