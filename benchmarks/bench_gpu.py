@@ -5,9 +5,11 @@ the periodic benchmark surface and of the non-periodic rough sphere (Hockney pad
 ``elastic``, or ``hardness``, penetration hardness p_y = HARDNESS·E* (a share of the
 contact then sits at p_y: the row's "at p_y" column), on the CPU solver
 (numba kernels, pyfftw, ``--threads``) and on the array kernel set of ``--backend``
-(``cupy``: the GPU; ``numpy-array``: the same code on numpy, to try this script without a
-GPU). Per solve: wall time (median of ``--repeats``, after one untimed solve that builds the
-plans and compiles the fused kernels), iterations, ms per iteration and its ratio to one
+(``cupy``: the GPU, its iteration's kernels as CUDA kernels; ``cupy-array``: the GPU, the
+array code alone, the baseline of those kernels; ``numpy-array``: the array code on numpy,
+to try this script without a GPU). Per solve: wall time (median of ``--repeats``, after
+one untimed solve that builds the plans and compiles the fused kernels), iterations, ms per
+iteration and its ratio to one
 forward + inverse real FFT of the convolution's grid on the same backend (a cuFFT pair on a
 GPU: n² periodic, the Hockney grid padded), the speed-up, and the
 largest pressure difference over the peak pressure with the contact sets compared. The
@@ -72,7 +74,8 @@ def fft_pair_seconds(backend: str, shape, repeats: int) -> float:
 
 def main() -> None:
     ap = parser(__doc__.splitlines()[0])
-    ap.add_argument("--backend", default="cupy", choices=("cupy", "numpy-array"))
+    # cupy-array: the array code on the GPU without its CUDA kernels, the baseline
+    ap.add_argument("--backend", default="cupy", choices=("cupy", "cupy-array", "numpy-array"))
     ap.add_argument("--device-only", action="store_true", help="no CPU solve to compare with")
     ap.add_argument(
         "--cpu-repeats", type=int, default=None, help="CPU solves timed (default: --repeats)"

@@ -1,29 +1,32 @@
 #!/usr/bin/env bash
 # The checks that need a device machine, as one command: the CuPy route's agreement with the
-# CPU path and its time to solution (issue 39) and the CPU solver's scaling over many cores
-# (issue 38). Prepare the wheels here first (benchmarks/device_wheels.sh), then, with the
-# device tool, in one call whose steps' limits add up to 560 s:
+# CPU path and its time to solution (issue 39), and on request the CPU solver's scaling over
+# many cores (issue 38). Prepare the wheels here first (benchmarks/device_wheels.sh), then,
+# with the device tool, in one call whose steps' limits add up to 490 s:
 #
 #     run  command: bash benchmarks/device_checks.sh
-#          carry: [".whl"]   timeout_s: 590
+#          carry: [".whl"]   timeout_s: 510
 #
 # The limits are ceilings for a fresh machine (FFTW plans measured, kernels compiled). The
 # steps that measure an issue's target come first: the GPU route against the CPU solver at
 # 512² and 2048², elastic and penetration hardness (the CPU solve timed once); 4096² on the
-# device alone; a profile of the host's time in the 2048² device solves; then benchmark 1 at 2048² on 1, 8, 16, 4 and 2 threads (issue 38's target
-# is 8); the CuPy tests last, their kernels compiled by then. Each step has its own time
-# limit, so that a slow one leaves the others their time, and writes its log to
-# $OUT/<step>.log as it runs: what a stopped step printed still comes back. Steps run in
-# the order below, whatever the order in STEPS.
+# device alone; the array code without the CUDA kernels (backend cupy-array) at 2048² and
+# 4096², their baseline on the same device; a profile of the host's time in the 2048²
+# device solves; the CuPy tests last, their kernels compiled by then. STEPS=scaling (170 s
+# more; measured on 2026-11-26) runs benchmark 1 at 2048² on 1, 8, 16, 4 and 2 threads.
+# Each step has its own time limit, so that a slow one leaves the others their time, and
+# writes its log to $OUT/<step>.log as it runs: what a stopped step printed still comes
+# back. Steps run in the order below, whatever the order in STEPS.
 # QUICK=1 runs every step on small grids and BACKEND=numpy-array the GPU route's code on
-# numpy: together they try the script on any machine in a minute.
+# numpy (BACKEND_BASELINE=numpy-array the baseline's): together they try the script on any
+# machine in a minute.
 set -uo pipefail
 out=${OUT:-/tmp/device-checks}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)  # absolute: the benchmark steps run in benchmarks/
 failed=0
 python=${PYTHON:-python3}
-steps=" ${STEPS:-machine warm gpu gpu_large profile scaling tests} "
+steps=" ${STEPS:-machine warm gpu gpu_large baseline profile tests} "
 backend=${BACKEND:-cupy}
 cores=$(nproc)
 if compgen -G ".whl/*.whl" > /dev/null; then
@@ -36,10 +39,10 @@ export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
 
 if [[ ${QUICK:-0} == 1 ]]; then
     gpu_sizes=(64 128) large_sizes=(256) scaling_size=256 repeats=1 threads=(1 2)
-    profile_size=128
+    profile_size=128 baseline_sizes=(128)
 else
     gpu_sizes=(512 2048) large_sizes=(4096) scaling_size=2048 repeats=3 threads=(1 8 16 4 2)
-    profile_size=2048
+    profile_size=2048 baseline_sizes=(2048 4096)
 fi
 
 step() {  # step NAME SECONDS COMMAND...: run COMMAND for at most SECONDS, logged
@@ -65,6 +68,8 @@ step gpu 170 "$python" bench_gpu.py --backend "$backend" --sizes "${gpu_sizes[@]
     --laws elastic hardness --threads "$cores" --repeats "$repeats" --cpu-repeats 1
 step gpu_large 60 "$python" bench_gpu.py --backend "$backend" --device-only \
     --sizes "${large_sizes[@]}" --repeats "$repeats"
+step baseline 60 "$python" bench_gpu.py --backend "${BACKEND_BASELINE:-cupy-array}" \
+    --device-only --sizes "${baseline_sizes[@]}" --repeats "$repeats"
 # where the host's time goes in the GPU route's solves: the 45 costliest functions
 step profile 40 bash -c "\"$python\" -m cProfile -s tottime bench_gpu.py --backend $backend \
     --device-only --sizes $profile_size --repeats 3 | head -75"

@@ -4,9 +4,12 @@ CPU, so that CI, without a GPU, runs the kernels' arithmetic against the array c
 :func:`harness_module` is an :class:`~amontons.contact.array_backends.ArrayModule` on numpy
 whose ``compile`` builds each source into a C++ function (g++) called as CuPy calls its
 element-wise kernels: inputs, then outputs; a scalar or a length-1 array broadcasts; the
-function loops over the points with each parameter bound to its element (the outputs by
-reference). Array arguments must have the declared dtype exactly, as CuPy's kernels with
-concrete types require.
+function loops over the points with each parameter bound to its element by reference
+(``const`` for the inputs), as CuPy binds them, so an input that is also an output reads
+what the body wrote. Array arguments must have the declared dtype exactly, as CuPy's kernels
+with concrete types require; Python numbers are converted. Compiled with
+``-ffp-contract=off``: no multiply-add is fused on any CPU, so the C++ evaluates each
+expression as numpy does.
 """
 
 from __future__ import annotations
@@ -47,7 +50,7 @@ def c_function(source) -> str:
     ins, outs = _params(source.in_params), _params(source.out_params)
     args = ["long long n"] + [f"const {TYPES[t][0]}* {n}_" for t, n in ins]
     args += [f"{TYPES[t][0]}* {n}_" for t, n in outs]
-    loads = " ".join(f"const {TYPES[t][0]} {n} = {n}_[i];" for t, n in ins)
+    loads = " ".join(f"const {TYPES[t][0]}& {n} = {n}_[i];" for t, n in ins)
     refs = " ".join(f"{TYPES[t][0]}& {n} = {n}_[i];" for t, n in outs)
     loop = f"for (long long i = 0; i < n; ++i) {{ {loads} {refs} {source.body} }}"
     return f'extern "C" void {source.name}({", ".join(args)}) {{ {loop} }}'
@@ -77,8 +80,10 @@ class HarnessKernel:
 
     def _input(self, value, type_name: str, n: int) -> np.ndarray:
         dtype = TYPES[type_name][1]
-        if isinstance(value, np.ndarray) and value.ndim:
+        if isinstance(value, np.ndarray):
             assert value.dtype == dtype, (self.source.name, value.dtype, type_name)
+        else:
+            assert isinstance(value, int | float), (self.source.name, type(value))
         return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=dtype), (n,)))
 
 
@@ -93,7 +98,7 @@ def compile_source(source, preamble: str) -> HarnessKernel:
         folder = Path(tempfile.mkdtemp(prefix="amontons-harness-"))
         (folder / "k.cpp").write_text(code)
         subprocess.run(
-            [COMPILER, "-O2", "-shared", "-fPIC", "-o", "k.so", "k.cpp"],
+            [COMPILER, "-O2", "-ffp-contract=off", "-shared", "-fPIC", "-o", "k.so", "k.cpp"],
             cwd=folder,
             check=True,
             capture_output=True,

@@ -81,6 +81,11 @@ BACKENDS = [
     pytest.param(
         "cupy", marks=pytest.mark.skipif(not _device(), reason="no CuPy or no CUDA device")
     ),
+    # the array code on the GPU, without the CUDA kernels (the benchmarks' baseline)
+    pytest.param(
+        "cupy-array",
+        marks=pytest.mark.skipif(not _device(), reason="no CuPy or no CUDA device"),
+    ),
 ]
 
 
@@ -456,6 +461,12 @@ def test_load_series_agrees(backend):
 
 
 # -- backend="cupy" without CuPy --
+
+
+@pytest.mark.skipif(HAVE_CUPY, reason="CuPy is installed: the error path is not reachable")
+def test_cupy_array_backend_without_cupy_names_the_install():
+    with pytest.raises(BackendUnavailableError, match=r"amontons\[gpu\]"):
+        solve(_rough(32), SPACING, E_STAR, load=1.0, periodic=True, backend="cupy-array")
 
 
 @pytest.mark.skipif(HAVE_CUPY, reason="CuPy is installed: the error path is not reachable")

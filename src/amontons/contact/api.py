@@ -107,7 +107,8 @@ def solve(
         the optional extra ``pip install amontons[gpu]``); results come back as numpy
         arrays, and without CuPy or a CUDA device the call raises
         :class:`BackendUnavailableError`. (``"numpy-array"`` runs the GPU route's code on
-        numpy, for tests.)
+        numpy, for tests; ``"cupy-array"`` its array code on the GPU without its CUDA
+        kernels, the baseline benchmarks time them against.)
     plasticity : PenetrationHardness or ContactHardening, optional
         Plasticity law of appendix B.2.3 (None: purely elastic). The result's
         ``plastic_displacement`` is then the plastic displacement of the indenter (m, <= 0

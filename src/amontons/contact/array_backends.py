@@ -3,8 +3,10 @@
 the same array code on the CPU so that CI, without a GPU, tests its logic.
 
 ``ARRAY_BACKENDS`` are the ``backend`` names of :func:`amontons.contact.solve` that select
-the array set: ``"cupy"`` and ``"numpy-array"`` (the latter for tests: the GPU route's
-code on numpy arrays, which the numba set outruns on a CPU).
+the array set: ``"cupy"``, ``"numpy-array"`` (for tests: the GPU route's code on numpy
+arrays, which the numba set outruns on a CPU) and ``"cupy-array"`` (for benchmarks: the
+array code on the GPU without its CUDA kernels, the baseline those kernels are timed
+against on the same device).
 
 This is the one module that imports CuPy, and it does so lazily, inside
 :func:`_load_cupy`: CuPy is an optional dependency that most installations lack, and its
@@ -15,7 +17,7 @@ Snakemake dry run, which never solves) need it. A missing CuPy or device raises
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache, partial
 
 import numpy as np
@@ -24,7 +26,8 @@ from .errors import BackendUnavailableError
 
 CUPY = "cupy"
 NUMPY_ARRAY = "numpy-array"
-ARRAY_BACKENDS = (CUPY, NUMPY_ARRAY)
+CUPY_ARRAY = "cupy-array"
+ARRAY_BACKENDS = (CUPY, NUMPY_ARRAY, CUPY_ARRAY)
 INSTALL_HINT = "pip install 'amontons[gpu]' (CuPy for CUDA 12, cupy-cuda12x)"
 
 
@@ -62,7 +65,7 @@ def array_module(name: str) -> ArrayModule:
     Raises
     ------
     BackendUnavailableError
-        ``"cupy"`` without CuPy or without a CUDA device.
+        ``"cupy"`` or ``"cupy-array"`` without CuPy or without a CUDA device.
     ValueError
         Another name.
     """
@@ -70,6 +73,8 @@ def array_module(name: str) -> ArrayModule:
         return NUMPY
     if name == CUPY:
         return _load_cupy()
+    if name == CUPY_ARRAY:
+        return replace(_load_cupy(), name=CUPY_ARRAY, compile=None)
     raise ValueError(f"unknown array backend {name!r}; expected one of {ARRAY_BACKENDS}")
 
 

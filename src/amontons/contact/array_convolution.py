@@ -12,7 +12,8 @@ padded     Hockney: ``p`` zero-padded to ``padded_shape`` (``m >= 2n`` per axis,
            kernel's spectrum.
 
 The plain (unpruned) transform: the row pruning of the CPU operator saves a quarter of the
-FFT work, which on a GPU is not yet measured (benchmarks/README.md, "GPU"). The operator
+FFT work, which on a GPU is not measured (an iteration's time there went to kernel
+launches first: benchmarks/README.md, "The GPU route"). The operator
 does not split into halves (``splits`` is False): :func:`.cg.polonsky_keer` then takes
 ``r = K*t`` whole and ``Σ r t`` from ``r``.
 """

@@ -80,7 +80,7 @@ STEP_TERMS = KernelSource(
 # update: one CG step in one pass (.array_kernels.ArrayKernels.update, same expressions);
 # p, m, t, u in place; clipped and joined flag the events, cval and added the pressure the
 # projection and the join added there, gj |g| at the joined points, at_bound p where
-# sigma·p >= ub
+# sigma·p >= ub (products with the flag, as the array code's masks: a NaN stays a NaN)
 UPDATE = KernelSource(
     "amontons_update",
     "float64 r, float64 h, float64 sigma, float64 d, float64 tau, float64 step, "
@@ -117,8 +117,8 @@ UPDATE = KernelSource(
     joined = join ? 1 : 0;
     cval = pc - pn;
     added = add;
-    gj = join ? fabs(g) : 0.0;
-    at_bound = (sigma * p >= ub) ? p : 0.0;
+    gj = fabs(g) * join;
+    at_bound = p * (sigma * p >= ub);
     """,
 )
 
