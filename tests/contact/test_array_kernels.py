@@ -25,6 +25,7 @@ Tolerances, and why:
 from __future__ import annotations
 
 import importlib.util
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -93,21 +94,23 @@ def _close_sum(got, want, magnitude):
     assert abs(got - want) <= SUM_RTOL * magnitude, (got, want)
 
 
+def _load_cases():
+    """tests/contact/kernel_cases.py (tests import helpers by file)."""
+    spec = importlib.util.spec_from_file_location(
+        "kernel_cases", Path(__file__).with_name("kernel_cases.py")
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+kernel_cases = _load_cases()
+
+
 @pytest.fixture
 def state():
     """A CG state with a free set of ~60 %, a direction, ``r``, bounds."""
-    rng = np.random.default_rng(5)
-    p = np.where(rng.random(N) < 0.6, rng.random(N), 0.0)
-    m = (p > 0).astype(np.uint8)
-    return {
-        "p": p,
-        "m": m,
-        "u": rng.normal(size=N),
-        "h": rng.normal(size=N),
-        "t": rng.normal(size=N) * m,
-        "r": rng.normal(size=N),
-        "p_max": np.full(N, 0.9),
-    }
+    return kernel_cases.cg_state(np.random.default_rng(5), N)
 
 
 def test_free_mask(state):
@@ -174,24 +177,9 @@ def test_step_dots(state, winkler):
 
 
 def _update_case(rng, bounded, events):
-    """A state whose step clips about ``events`` free points and adds as many violators:
-    free points step by ``tau·t`` with ``t`` small except on the chosen ones."""
-    p = np.where(rng.random(N) < 0.6, 0.2 + 0.5 * rng.random(N), 0.0)
-    m = (p > 0).astype(np.uint8)
-    t = 1e-3 * rng.normal(size=N) * m
-    free, bound = np.flatnonzero(m), np.flatnonzero(m == 0)
-    clip = rng.choice(free, events, replace=False)
-    t[clip] = 5.0 * np.sign(rng.normal(size=events)) if bounded else 5.0
-    u = np.abs(rng.normal(size=N)) + 3.0  # open everywhere (g > 0) ...
-    h = np.zeros(N)
-    join = rng.choice(bound, events, replace=False)
-    u[join] = -0.5  # ... but at the chosen constrained points
-    p_max = np.full(N, 0.9) if bounded else np.full(1, np.inf)
-    if bounded:
-        # a few constrained points at the bound, open: they fall
-        top = rng.choice(np.setdiff1d(bound, join), events, replace=False)
-        p[top] = 0.9
-    return {"p": p, "m": m, "t": t, "u": u, "h": h, "r": rng.normal(size=N), "p_max": p_max}
+    """A state whose step clips about ``events`` free points and adds as many violators
+    (tests/contact/kernel_cases.py)."""
+    return kernel_cases.update_case(rng, N, bounded, events)
 
 
 def _records(counts, idx, val):

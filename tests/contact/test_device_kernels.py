@@ -34,17 +34,15 @@ from amontons.contact.convolution import fast_padded_shape
 from amontons.contact.options import CGOptions
 
 
-def _load_harness():
-    """tests/contact/cuda_harness.py (tests import helpers by file)."""
-    spec = importlib.util.spec_from_file_location(
-        "cuda_harness", Path(__file__).with_name("cuda_harness.py")
-    )
+def _load(name):
+    """tests/contact/<name>.py (tests import helpers by file)."""
+    spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name(f"{name}.py"))
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
-harness = _load_harness()
+harness, kernel_cases = _load("cuda_harness"), _load("kernel_cases")
 COMPILER, harness_module = harness.COMPILER, harness.harness_module
 pytestmark = pytest.mark.skipif(COMPILER is None, reason="no C++ compiler (g++) here")
 
@@ -57,22 +55,10 @@ def device():
     return DeviceKernels(harness_module())
 
 
-def _state(seed=5):
-    """A CG state with a free set of ~60 % and, among the constrained points, some at the
-    bound 0.9 (for the violator test's second clause: at the bound and open)."""
-    rng = np.random.default_rng(seed)
-    p = np.where(rng.random(N) < 0.6, rng.random(N), 0.0)
-    m = (p > 0).astype(np.uint8)
-    p[(m == 0) & (rng.random(N) < 0.3)] = 0.9 / 1.1  # sigma·p at the bound in direction
-    return {
-        "p": p,
-        "m": m,
-        "u": rng.normal(size=N),
-        "h": rng.normal(size=N),
-        "t": rng.normal(size=N) * m,
-        "r": rng.normal(size=N),
-        "p_max": np.full(N, 0.9),
-    }
+def _state():
+    """A CG state (tests/contact/kernel_cases.py) with constrained points whose sigma·p
+    (sigma 1.1 in test_direction) is at the bound 0.9: the violator test's second clause."""
+    return kernel_cases.cg_state(np.random.default_rng(5), N, at_bound=0.9 / 1.1)
 
 
 def test_gap_moments(device):
@@ -107,29 +93,6 @@ def test_step_dots(device, winkler):
     assert np.array_equal(r_dev, r_arr) and got == want
 
 
-def _update_case(rng, bounded, events, closed=False):
-    """A state whose step clips about ``events`` free points and adds as many violators
-    (as tests/contact/test_array_kernels.py's); with ``closed`` the clipped points
-    penetrate, so that those clipped at the bound stay there."""
-    p = np.where(rng.random(N) < 0.6, 0.2 + 0.5 * rng.random(N), 0.0)
-    m = (p > 0).astype(np.uint8)
-    t = 1e-3 * rng.normal(size=N) * m
-    free, bound = np.flatnonzero(m), np.flatnonzero(m == 0)
-    clip = rng.choice(free, events, replace=False)
-    t[clip] = 5.0 * np.sign(rng.normal(size=events)) if bounded else 5.0
-    u = np.abs(rng.normal(size=N)) + 3.0
-    h = np.zeros(N)
-    join = rng.choice(bound, events, replace=False)
-    u[join] = -0.5
-    if closed:
-        u[clip] = -0.5
-    p_max = np.full(N, 0.9) if bounded else np.full(1, np.inf)
-    if bounded:
-        top = rng.choice(np.setdiff1d(bound, join), events, replace=False)
-        p[top] = 0.9
-    return {"p": p, "m": m, "t": t, "u": u, "h": h, "r": rng.normal(size=N), "p_max": p_max}
-
-
 @pytest.mark.parametrize("sigma", [1.2, 1.0])
 @pytest.mark.parametrize("bounded", [False, True])
 @pytest.mark.parametrize("events", [0, 4, 200])
@@ -138,7 +101,7 @@ def test_update(device, sigma, bounded, events, keep_mask, with_u):
     """At sigma 1 the points clipped at the bound, closed, stay on it, so the share at the
     bound (the third result, which bounded load control reads) is not nil."""
     rng = np.random.default_rng(events + 10 * bounded)
-    case = _update_case(rng, bounded, events, closed=sigma == 1.0)
+    case = kernel_cases.update_case(rng, N, bounded, events, closed=sigma == 1.0)
     out = {}
     for name, ks in (("device", device), ("array", A)):
         c = {k: v.copy() for k, v in case.items()}

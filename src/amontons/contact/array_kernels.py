@@ -226,14 +226,25 @@ class ArrayKernels:
             t[...] = pick(clip, 0.0, t)
         if with_u:
             u -= step * r
-        ev = xp.stack([xp.count_nonzero(clip), xp.count_nonzero(join)])
-        counts[0] = ev
         at_bound = self._masked(p_new, sigma * p_new >= p_max).sum() if bounded else xp.zeros(())
         pen = self._masked(xp.abs(g), join).max()
-        psum, pen, at_bound, n_clip, n_add = self._floats(p_new.sum(), pen, at_bound, *ev)
-        events = int(n_clip) + int(n_add)
-        complete = not (events > 0 and events > min(record_max, SLOTS))
-        if events and complete:
+        events = (clip, join, cval, added)
+        return self._step_results(p_new, pen, at_bound, events, counts, idx, val, record_max)
+
+    def _step_results(self, p_new, pen, at_bound, events, counts, idx, val, record_max):
+        """What ``update`` returns, from its arrays: ``events`` is ``(clip, join, cval,
+        added)``, the clipped and joined points (masks or 0/1 flags) and the pressure the
+        projection and the join added there. Writes the counts into ``counts[0]`` and, when
+        they fit, the records; one host read. Returns ``(Σ p_new, pen, at_bound, records
+        complete)``."""
+        xp = self.xp
+        clip, join, cval, added = events
+        counted = (xp.count_nonzero(clip), xp.count_nonzero(join))
+        counts[0] = xp.stack(counted)
+        psum, pen, at_bound, n_clip, n_add = self._floats(p_new.sum(), pen, at_bound, *counted)
+        n_events = int(n_clip) + int(n_add)
+        complete = not (n_events > 0 and n_events > min(record_max, SLOTS))
+        if n_events and complete:
             where_clip = xp.flatnonzero(clip)
             where_join = xp.flatnonzero(join)
             self._record(idx, val, where_clip, cval[where_clip], where_join, added[where_join])
@@ -386,14 +397,6 @@ class DeviceKernels(ArrayKernels):
         ub = self._bound(p_max, bounded)
         step = (r, h, sigma, d, tau, tau / sigma, ub, int(keep_mask), int(with_u))
         self._update(*step, p_new, m, t, u, clipped, joined, cval, added, gj, at_bound)
-        events = (xp.count_nonzero(clipped), xp.count_nonzero(joined))
-        counts[0] = xp.stack(events)
         on_bound = at_bound.sum() if bounded else xp.zeros(())
-        psum, pen, on_bound, n_clip, n_add = self._floats(p_new.sum(), gj.max(), on_bound, *events)
-        n_events = int(n_clip) + int(n_add)
-        complete = not (n_events > 0 and n_events > min(record_max, SLOTS))
-        if n_events and complete:
-            where_clip = xp.flatnonzero(clipped)
-            where_join = xp.flatnonzero(joined)
-            self._record(idx, val, where_clip, cval[where_clip], where_join, added[where_join])
-        return psum, pen, on_bound, complete
+        events = (clipped, joined, cval, added)
+        return self._step_results(p_new, gj.max(), on_bound, events, counts, idx, val, record_max)
