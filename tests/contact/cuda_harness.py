@@ -90,9 +90,9 @@ class HarnessKernel:
 _LIBRARIES: dict[str, ctypes.CDLL] = {}
 
 
-def compile_source(source, preamble: str) -> HarnessKernel:
+def compile_source(source) -> HarnessKernel:
     """``source`` compiled with g++ (cached per text for the session)."""
-    code = PRELUDE + preamble + c_function(source) + "\n"
+    code = PRELUDE + source.preamble + c_function(source) + "\n"
     key = hashlib.sha256(code.encode()).hexdigest()[:16]
     if key not in _LIBRARIES:
         folder = Path(tempfile.mkdtemp(prefix="amontons-harness-"))

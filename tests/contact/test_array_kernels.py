@@ -176,12 +176,6 @@ def test_step_dots(state, winkler):
     _close_sum(got[1], want[1], mag)
 
 
-def _update_case(rng, bounded, events):
-    """A state whose step clips about ``events`` free points and adds as many violators
-    (tests/contact/kernel_cases.py)."""
-    return kernel_cases.update_case(rng, N, bounded, events)
-
-
 def _records(counts, idx, val):
     per = counts.sum(axis=1)
     pairs = [
@@ -197,7 +191,7 @@ def _records(counts, idx, val):
 @pytest.mark.parametrize(("keep_mask", "with_u"), [(False, False), (False, True), (True, True)])
 def test_update(bounded, events, keep_mask, with_u):
     rng = np.random.default_rng(events + 10 * bounded)
-    case = _update_case(rng, bounded, events)
+    case = kernel_cases.update_case(rng, N, bounded, events)
     sigma, d, tau, record_max = 1.2, 0.1, 0.3, 32
     results = {}
     for name, ks in (("numba", K), ("array", A)):

@@ -39,8 +39,8 @@ class ArrayModule:
     array; ``add_at(a, idx, values)``: ``a[idx] += values`` with repeated indices summed
     (``np.add.at``, ``cupyx.scatter_add``); ``fuse``: compiles an element-wise function of
     arrays and scalars into one kernel (``cupy.fuse``; identity on numpy); ``compile``:
-    builds an element-wise kernel from its source (a :class:`.device_sources.KernelSource`)
-    and ``preamble``, callable as CuPy's are (inputs, then outputs), or None where the
+    builds an element-wise kernel from its source (a :class:`.device_sources.KernelSource`),
+    callable as CuPy's are (inputs, then outputs), or None where the
     namespace runs no CUDA source (numpy: the array set then runs its array code).
     """
 
@@ -106,8 +106,8 @@ def _load_cupy() -> ArrayModule:
     )
 
 
-def _cupy_kernel(cupy, source, preamble: str):
+def _cupy_kernel(cupy, source):
     """CuPy's element-wise kernel of ``source`` (a .device_sources.KernelSource)."""
     return cupy.ElementwiseKernel(
-        source.in_params, source.out_params, source.body, source.name, preamble=preamble
+        source.in_params, source.out_params, source.body, source.name, preamble=source.preamble
     )

@@ -349,10 +349,10 @@ class DeviceKernels(ArrayKernels):
     def __init__(self, module: ArrayModule):
         super().__init__(module)
         build = module.compile
-        self._gap_terms = build(src.GAP_TERMS, src.PREAMBLE)
-        self._direction = build(src.DIRECTION, src.PREAMBLE)
-        self._step_terms = build(src.STEP_TERMS, src.PREAMBLE)
-        self._update = build(src.UPDATE, src.PREAMBLE)
+        self._gap_terms = build(src.GAP_TERMS)
+        self._direction = build(src.DIRECTION)
+        self._step_terms = build(src.STEP_TERMS)
+        self._update = build(src.UPDATE)
 
     def _terms(self, n: int, count: int) -> list:
         """``count`` uninitialised float64 arrays of ``n`` points."""

@@ -27,17 +27,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-
-@dataclass(frozen=True)
-class KernelSource:
-    """One element-wise kernel: parameters as ``"float64 u, uint8 m"``, and its body."""
-
-    name: str
-    in_params: str
-    out_params: str
-    body: str
-
-
 # helpers of the bodies: the gap, and the violator test of .array_kernels._should_join
 PREAMBLE = """
 __device__ inline double masked_gap(double u, double sigma, double h, double shift,
@@ -48,6 +37,19 @@ __device__ inline bool should_join(double q, double g, double ub) {
     return ((q <= 0.0) && (g < 0.0) && (q < ub)) || ((q >= ub) && (g > 0.0) && (q > 0.0));
 }
 """
+
+
+@dataclass(frozen=True)
+class KernelSource:
+    """One element-wise kernel: parameters as ``"float64 u, uint8 m"``, its body, and the
+    device helpers its body calls (:data:`PREAMBLE`)."""
+
+    name: str
+    in_params: str
+    out_params: str
+    body: str
+    preamble: str = PREAMBLE
+
 
 # gap_moments' terms: a = m·(sigma·u - h - shift), a², a·t
 GAP_TERMS = KernelSource(
@@ -64,8 +66,9 @@ DIRECTION = KernelSource(
     "float64 p, float64 ub",
     "float64 t, int8 violator",
     """
-    violator = ((m == 0) && should_join(sigma * p, sigma * u - h - d, ub)) ? 1 : 0;
-    t = (sigma * u - h - d + beta * t - shift) * m;
+    const double g = sigma * u - h - d;
+    violator = ((m == 0) && should_join(sigma * p, g, ub)) ? 1 : 0;
+    t = (g + beta * t - shift) * m;
     """,
 )
 
@@ -121,5 +124,3 @@ UPDATE = KernelSource(
     at_bound = p * (sigma * p >= ub);
     """,
 )
-
-SOURCES = (GAP_TERMS, DIRECTION, STEP_TERMS, UPDATE)
