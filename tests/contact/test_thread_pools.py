@@ -1,11 +1,11 @@
 """The solver holds every BLAS pool to one thread and every OpenMP pool to its ``threads`` for
-the duration of a call, and gives the caller's limits back, also when the call raises (issue
-21: unbounded OpenBLAS threads spun against the solver's own and cost a plain process
-1.7-3.5x; bounded to 2 they made threads=2 11x slower, benchmarks/bench_thread_pools.py).
-OpenMP runs FFTW's threads and the kernels': held to one thread, as they were until
-2026-11-26, it ran a two-thread FFTW plan on one core (issue 38; benchmarks/README.md, "A
-second core"). The limits are observed from inside the call, through the CG loop and the GT
-iteration, not by timing."""
+the duration of a call, and gives the caller's limits back, also when the call raises (issue 21:
+unbounded OpenBLAS threads spun against the solver's own and cost a plain process 1.7-3.5x; bounded
+to 2 they made threads=2 11x slower, benchmarks/bench_thread_pools.py). OpenMP runs the kernels'
+threads (and ran FFTW's threaded plans until 2026-11-27): held to one thread, as it was until
+2026-11-26, it ran a two-thread FFTW plan on one core (issue 38; benchmarks/README.md, "A second
+core"). The limits are observed from inside the call, through the CG loop and the GT iteration, not
+by timing."""
 
 import os
 
@@ -138,10 +138,11 @@ def test_bad_threads_are_refused(bad):
 def test_answers_do_not_depend_on_the_bound():
     """The bound changes who computes, not what: the same pressure to 1e-10 relative.
 
-    Solved to tol 1e-10, so that 1e-10 is within what each solve promises: threads=2 plans
-    its FFTs for two threads, another plan whose round-off takes the iterates along a
-    slightly different path, and at the default tol 1e-8 two paths may stop ~1e-10 apart
-    (measured 1.0e-10 here, each within 1e-8 of the tol 1e-13 solution)."""
+    Solved to tol 1e-10, so that 1e-10 is within what each solve promises: threads=2 runs
+    its FFTs as two slabs of one-thread plans, other plans whose round-off takes the
+    iterates along a slightly different path, and at the default tol 1e-8 two paths may
+    stop ~1e-10 apart (measured 1.0e-10 here, each within 1e-8 of the tol 1e-13
+    solution)."""
     h, dx, e_star = _sphere()
     one = solve(h, dx, e_star, load=1e-3, threads=1, tol=1e-10)
     with threadpool_limits(limits=CALLER):
@@ -152,12 +153,11 @@ def test_answers_do_not_depend_on_the_bound():
 
 @pytest.mark.parametrize("periodic", [True, False])
 def test_two_threads_give_the_one_thread_answer(periodic):
-    """threads=2 plans its FFTs for two threads (FFTW_MEASURE, the default; ESTIMATE's plans
-    would not use the second); the fused kernels run on one, as 128² is one kernel chunk
-    (their sums do not depend on the thread count: tests/contact/test_fused_kernels.py), and
-    the FFT plans differ only in round-off, so the solution
-    is the one-thread one to 1e-10 in contact fraction and approach (over the rms height),
-    far below the 1e-9 solve tolerance."""
+    """threads=2 runs its FFTs as two slabs of one-thread plans (FFTW_MEASURE, the
+    default); the fused kernels run on one, as 128² is one kernel chunk (their sums do not
+    depend on the thread count: tests/contact/test_fused_kernels.py), and the FFT plans
+    differ only in round-off, so the solution is the one-thread one to 1e-10 in contact
+    fraction and approach (over the rms height), far below the 1e-9 solve tolerance."""
     n = 128
     if periodic:
         from amontons.contact import self_affine
@@ -183,10 +183,11 @@ def test_an_explicit_planner_effort_is_kept_on_two_threads():
 
 @pytest.mark.parametrize(("given", "expected"), [(None, "PASSIVE"), ("ACTIVE", "ACTIVE")])
 def test_idle_openmp_workers_sleep_unless_the_user_says_otherwise(given, expected):
-    """FFTW's threads (pyfftw) and the kernels' are OpenMP; spinning idle workers took the
-    cores from the next parallel region (1024² pair on 2 threads: 48-780 ms instead of
-    11 ms), so importing the solver sets OMP_WAIT_POLICY=PASSIVE before pyfftw loads its
-    libgomp, and keeps a value the user has set. Checked in a fresh process."""
+    """The kernels' threads are OpenMP (FFTW's threaded plans were, until 2026-11-27);
+    spinning idle workers took the cores from the next parallel region (1024² pair on 2
+    threads: 48-780 ms instead of 11 ms), so importing the solver sets
+    OMP_WAIT_POLICY=PASSIVE before pyfftw loads its libgomp, and keeps a value the user has
+    set. Checked in a fresh process."""
     import subprocess
     import sys
 

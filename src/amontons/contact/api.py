@@ -86,11 +86,12 @@ def solve(
         Conjugate-gradient iteration cap per solve on the finest grid (default
         ``1000 + 4(n0 + n1)``).
     threads : int or None
-        FFTW threads; None means every core this process may use (its CPU affinity). The
+        Threads of the solve: the transforms run as ``threads`` slabs at once
+        (:mod:`amontons.contact.fft`) and the numba kernels on ``threads`` (capped at the
+        grid's chunks); None means every core this process may use (its CPU affinity). The
         numpy FFT backend is serial (a warning says so when threads > 1). For the duration of
-        the call the OpenMP pools (FFTW's threads) run ``threads`` threads and the BLAS
-        pools one (the numba kernels take ``threads`` through numba, capped at the grid's
-        chunks), and the caller's limits are restored after it, also on an exception:
+        the call the OpenMP pools run ``threads`` threads and the BLAS pools one, and the
+        caller's limits are restored after it, also on an exception:
         the CG's BLAS calls are level 1, and their threads cost more than they bring. A
         second thread pays from about 512² (benchmarks/README.md, "A second core").
     warm_start : array_like, optional
@@ -203,7 +204,7 @@ def solve(
         coarse_to_fine=coarse_to_fine,
         warm_start=warm_start is not None,
     )
-    # BLAS pools on one thread, OpenMP pools (FFTW's threads) on ``threads``, the caller's
+    # BLAS pools on one thread, OpenMP pools (the kernels') on ``threads``, the caller's
     # limits back after the call (.pools says why)
     with solve_pools(opts.threads):
         return _solve_step(

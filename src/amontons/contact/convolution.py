@@ -86,7 +86,8 @@ class PeriodicConvolution(_MultiplierMixin):
         Contact modulus, Pa.
     backend : {"pyfftw", "numpy", None}
     threads : int
-        FFTW threads.
+        Threads of the transforms (:func:`amontons.contact.fft.real_fft2`) and of the
+        spectrum multiply.
     planner_effort : str
         FFTW planner effort, one of :data:`amontons.contact.fft.PLANNER_EFFORTS`
         (default ``"FFTW_MEASURE"``, with the machine's wisdom on disk:
@@ -118,8 +119,8 @@ class PeriodicConvolution(_MultiplierMixin):
             self._real = _fft.empty(self.shape, np.float64, self.backend)
             self._spec = _fft.empty(spec_shape, np.complex128, self.backend)
             kw = {"threads": threads, "planner_effort": planner_effort}
-            self._fwd = _fft.fftw_plan(self._real, self._spec, (0, 1), **kw)
-            self._inv = _fft.fftw_plan(self._spec, self._real, (0, 1), inverse=True, **kw)
+            self._fwd = _fft.real_fft2(self._real, self._spec, **kw)
+            self._inv = _fft.real_fft2(self._spec, self._real, inverse=True, **kw)
             # plans run through execute(), which does not normalise the inverse: fold the
             # 1/(n0 n1) of the inverse DFT into the multiplier instead of an extra pass
             self._scale = 1.0 / (self.shape[0] * self.shape[1])
@@ -236,7 +237,8 @@ class NonPeriodicConvolution(_MultiplierMixin):
         Contact modulus, Pa.
     backend : {"pyfftw", "numpy", None}
     threads : int
-        FFTW threads.
+        Threads of the transforms (:func:`amontons.contact.fft.axis_fft`) and of the
+        spectrum multiply.
     pruned : bool
         Use the pruned transform (default) or the plain ``m0 × m1`` one.
     planner_effort : str
@@ -291,10 +293,10 @@ class NonPeriodicConvolution(_MultiplierMixin):
             self._spec = _fft.empty(spec_shape, np.complex128, be)
             self._out = _fft.empty((n0, m1), np.float64, be)
             kw = {"threads": threads, "planner_effort": planner_effort}
-            self._row_fwd = _fft.fftw_plan(self._rows, self._spec[:n0], (1,), **kw)
-            self._col_fwd = _fft.fftw_plan(self._spec, self._spec, (0,), **kw)
-            self._col_inv = _fft.fftw_plan(self._spec, self._spec, (0,), inverse=True, **kw)
-            self._row_inv = _fft.fftw_plan(self._spec[:n0], self._out, (1,), inverse=True, **kw)
+            self._row_fwd = _fft.axis_fft(self._rows, self._spec[:n0], 1, **kw)
+            self._col_fwd = _fft.axis_fft(self._spec, self._spec, 0, **kw)
+            self._col_inv = _fft.axis_fft(self._spec, self._spec, 0, inverse=True, **kw)
+            self._row_inv = _fft.axis_fft(self._spec[:n0], self._out, 1, inverse=True, **kw)
             # planning (FFTW_MEASURE and above) scribbles over the arrays: set the padding
             # afterwards
             self._rows[...] = 0.0
@@ -307,8 +309,8 @@ class NonPeriodicConvolution(_MultiplierMixin):
             self._real = _fft.empty((m0, m1), np.float64, be)
             self._spec = _fft.empty(spec_shape, np.complex128, be)
             kw = {"threads": threads, "planner_effort": planner_effort}
-            self._fwd = _fft.fftw_plan(self._real, self._spec, (0, 1), **kw)
-            self._inv = _fft.fftw_plan(self._spec, self._real, (0, 1), inverse=True, **kw)
+            self._fwd = _fft.real_fft2(self._real, self._spec, **kw)
+            self._inv = _fft.real_fft2(self._spec, self._real, inverse=True, **kw)
             self._real[...] = 0.0
             self._scale = 1.0 / (m0 * m1)
             self._mult_scaled = _scaled(self._multiplier, self._scale)

@@ -14,11 +14,22 @@ the same from run to run, and planning is paid once per transform and machine.
 ``FFTW_ESTIMATE`` picks plans by heuristics without timing anything or
 touching the disk; its pairs are slower (benchmarks/README.md, "FFTW planner effort").
 ``FFTW_PATIENT`` and ``FFTW_EXHAUSTIVE`` time more candidates (minutes of planning at 2048²).
+
+On two threads or more a transform does not use FFTW's threaded plans. It is cut into
+slabs, one per thread, along the axis it does not transform; a one-thread plan per slab
+runs them all at once (:class:`SlabTransform`, :func:`real_fft2`, :func:`axis_fft`). That
+wakes each thread once per pass. Many of the threaded plans MEASURE picks wake the threads
+for every small block of columns, and those ran at one-thread speed for minutes at a time
+on a virtual machine (benchmarks/README.md, "A second core").
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
+import itertools
+import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -71,10 +82,9 @@ def fftw_plan(
     axes,
     *,
     inverse: bool = False,
-    threads: int = 1,
     planner_effort: str = DEFAULT_PLANNER_EFFORT,
 ):
-    """Build an FFTW plan ``src -> dst`` over ``axes`` (pyfftw only).
+    """Build a one-thread FFTW plan ``src -> dst`` over ``axes`` (pyfftw only).
 
     The plan's kind (r2c, c2r, c2c) follows from the dtypes. Inverse transforms are
     normalised like :func:`numpy.fft.ifft` (divide by the transform length) when called,
@@ -91,13 +101,181 @@ def fftw_plan(
     # ESTIMATE times nothing: nothing to share between processes
     timed = effort != "FFTW_ESTIMATE"
     with shared_wisdom() if timed else contextlib.nullcontext():
-        return pyfftw.FFTW(
-            src, dst, axes=tuple(axes), direction=direction, flags=flags, threads=int(threads)
-        )
+        return pyfftw.FFTW(src, dst, axes=tuple(axes), direction=direction, flags=flags)
+
+
+# Slab edges fall on multiples of this many bytes of every array a slab transform touches:
+# a cache line, so two threads never write one line, and a multiple of SIMD alignment, so
+# every slab's plan is as aligned as a whole-array plan.
+SLAB_ALIGNMENT = 64
+
+
+def slab_edges(length: int, parts: int, step: int) -> list[tuple[int, int]]:
+    """``[(start, stop), ...]``: ``range(length)`` cut into at most ``parts`` slabs of
+    nearly equal size whose inner edges are multiples of ``step``; no slab is empty."""
+    cuts = [0]
+    for k in range(1, parts):
+        edge = step * round(length * k / parts / step)
+        if cuts[-1] < edge < length:
+            cuts.append(edge)
+    cuts.append(length)
+    return list(itertools.pairwise(cuts))
+
+
+def _slab_step(arrays, axis: int) -> int:
+    """The smallest number of indices along ``axis`` that spans a multiple of
+    :data:`SLAB_ALIGNMENT` bytes in each of ``arrays``."""
+    step = 1
+    for a in arrays:
+        stride = abs(a.strides[axis])
+        step = math.lcm(step, SLAB_ALIGNMENT // math.gcd(stride, SLAB_ALIGNMENT))
+    return step
+
+
+@functools.cache
+def _workers(count: int) -> ThreadPoolExecutor:
+    """The process's pool of ``count`` threads that run slabs beside the calling thread."""
+    return ThreadPoolExecutor(max_workers=count, thread_name_prefix="amontons-fft")
+
+
+class SlabTransform:
+    """One FFTW transform along ``axis`` of a 2-D array, on ``threads`` threads.
+
+    The other axis is cut into ``threads`` slabs (:func:`slab_edges`); each slab has a
+    one-thread plan (:func:`fftw_plan`), and :meth:`execute` runs the first in the calling
+    thread and the others in a pool at the same time (pyfftw lets go of the GIL while a plan
+    runs). Every slab's 1-D transforms are the ones a whole-array plan computes, so the
+    result is the same to round-off. ``src`` and ``dst`` have the same length along the
+    other axis (they may be one array: an in-place transform).
+    """
+
+    def __init__(
+        self,
+        src,
+        dst,
+        axis: int,
+        *,
+        inverse: bool = False,
+        threads: int = 2,
+        planner_effort: str = DEFAULT_PLANNER_EFFORT,
+    ):
+        other = 1 - axis
+        if src.shape[other] != dst.shape[other]:
+            raise ValueError(
+                f"a slab transform along axis {axis} needs arrays of one length along axis "
+                f"{other}, got shapes {src.shape} and {dst.shape}"
+            )
+        self._other = other
+        step = _slab_step((src, dst), other)
+        self._edges = slab_edges(src.shape[other], int(threads), step)
+        self._plans = [
+            fftw_plan(
+                self._slab(src, edge),
+                self._slab(dst, edge),
+                (axis,),
+                inverse=inverse,
+                planner_effort=planner_effort,
+            )
+            for edge in self._edges
+        ]
+        self._pool = _workers(len(self._plans) - 1) if len(self._plans) > 1 else None
+
+    def _slab(self, a, edge):
+        start, stop = edge
+        return a[start:stop] if self._other == 0 else a[:, start:stop]
+
+    def execute(self) -> None:
+        """Transform every slab; returns when all are done."""
+        first, *others = self._plans
+        running = [self._pool.submit(plan.execute) for plan in others]
+        first.execute()
+        for slab in running:
+            slab.result()
+
+    def update_arrays(self, src, dst) -> None:
+        """Run on ``src`` and ``dst`` from now on: arrays like the planned ones (shape,
+        strides, alignment; pyfftw checks)."""
+        for plan, edge in zip(self._plans, self._edges, strict=True):
+            plan.update_arrays(self._slab(src, edge), self._slab(dst, edge))
+
+
+class TwoPassRealFFT2:
+    """A real 2-D FFT as two passes of :class:`SlabTransform`: forward, r2c along the rows
+    (axis 1) into ``dst`` and c2c along its columns in place; inverse, c2c along the
+    columns of ``src`` in place (``src`` is scratch, as for an inverse plan) and c2r along
+    the rows into ``dst``. The same 1-D transforms as a 2-D plan, in the same order."""
+
+    def __init__(
+        self,
+        src,
+        dst,
+        *,
+        inverse: bool = False,
+        threads: int = 2,
+        planner_effort: str = DEFAULT_PLANNER_EFFORT,
+    ):
+        kw = {"inverse": inverse, "threads": threads, "planner_effort": planner_effort}
+        self._inverse = inverse
+        if inverse:
+            self._passes = (SlabTransform(src, src, 0, **kw), SlabTransform(src, dst, 1, **kw))
+        else:
+            self._passes = (SlabTransform(src, dst, 1, **kw), SlabTransform(dst, dst, 0, **kw))
+
+    def execute(self) -> None:
+        """Both passes, one after the other."""
+        for step in self._passes:
+            step.execute()
+
+    def update_arrays(self, src, dst) -> None:
+        """Run on ``src`` and ``dst`` from now on (as :meth:`SlabTransform.update_arrays`)."""
+        first, second = self._passes
+        if self._inverse:
+            first.update_arrays(src, src)
+            second.update_arrays(src, dst)
+        else:
+            first.update_arrays(src, dst)
+            second.update_arrays(dst, dst)
+
+
+def real_fft2(
+    src,
+    dst,
+    *,
+    inverse: bool = False,
+    threads: int = 1,
+    planner_effort: str = DEFAULT_PLANNER_EFFORT,
+):
+    """A real 2-D FFT ``src -> dst`` (r2c forward, c2r inverse; not normalised) with
+    ``execute()`` and ``update_arrays()``: one FFTW plan on one thread,
+    :class:`TwoPassRealFFT2` on more (module doc)."""
+    if int(threads) == 1:
+        return fftw_plan(src, dst, (0, 1), inverse=inverse, planner_effort=planner_effort)
+    return TwoPassRealFFT2(
+        src, dst, inverse=inverse, threads=threads, planner_effort=planner_effort
+    )
+
+
+def axis_fft(
+    src,
+    dst,
+    axis: int,
+    *,
+    inverse: bool = False,
+    threads: int = 1,
+    planner_effort: str = DEFAULT_PLANNER_EFFORT,
+):
+    """A 1-D FFT along ``axis`` of 2-D arrays with ``execute()`` and ``update_arrays()``:
+    one FFTW plan on one thread, :class:`SlabTransform` on more (module doc)."""
+    if int(threads) == 1:
+        return fftw_plan(src, dst, (axis,), inverse=inverse, planner_effort=planner_effort)
+    return SlabTransform(
+        src, dst, axis, inverse=inverse, threads=threads, planner_effort=planner_effort
+    )
 
 
 class RealFFT2Pair:
-    """One forward + one inverse real 2-D FFT of a fixed shape (the benchmark floor).
+    """One forward + one inverse real 2-D FFT of a fixed shape, as the periodic operator
+    runs them (:func:`real_fft2`): the benchmark floor.
 
     Parameters
     ----------
@@ -123,15 +301,16 @@ class RealFFT2Pair:
         self.spec = empty(spec_shape, np.complex128, self.backend)
         if self.backend == "pyfftw":
             kw = {"threads": threads, "planner_effort": planner_effort}
-            self._fwd = fftw_plan(self.real, self.spec, (0, 1), **kw)
-            self._inv = fftw_plan(self.spec, self.real, (0, 1), inverse=True, **kw)
+            self._fwd = real_fft2(self.real, self.spec, **kw)
+            self._inv = real_fft2(self.spec, self.real, inverse=True, **kw)
         self.real[...] = 0.0
 
     def __call__(self) -> None:
-        """Transform ``self.real`` forward into ``self.spec`` and back."""
+        """Transform ``self.real`` forward into ``self.spec`` and back (with pyfftw not
+        normalised, as the operators run it: ``self.real`` comes back times its size)."""
         if self.backend == "pyfftw":
-            self._fwd()
-            self._inv()
+            self._fwd.execute()
+            self._inv.execute()
         else:
             self.spec[...] = np.fft.rfft2(self.real)
             self.real[...] = np.fft.irfft2(self.spec, s=self.shape)

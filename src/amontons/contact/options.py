@@ -13,9 +13,9 @@ import math
 import os
 from dataclasses import dataclass
 
-# pyfftw's wheels run FFTW's threads on OpenMP (a vendored libgomp), and so do the numba
-# kernels (.kernels). libgomp's default lets idle workers spin after each parallel region;
-# on a 2-core machine those spinning threads take the cores from the next region's
+# The numba kernels (.kernels) run on OpenMP (the libgomp pyfftw's wheels vendor). libgomp's
+# default lets idle workers spin after each parallel region; on a 2-core machine those
+# spinning threads take the cores from the next region and from the transforms' threads
 # (benchmarks/README.md, "A second core"). PASSIVE makes idle workers sleep. libgomp reads
 # it when it is loaded, so it is set before pyfftw is imported; a value the user has set is
 # kept.
@@ -164,7 +164,7 @@ class CGOptions:
     problem: the residual ``tol`` (dimensionless), the iteration cap ``max_iter``, a fresh
     ``u = K*p`` at least every ``refresh`` iterations, whether a solve that stops unconverged
     raises (``raise_on_failure``; else its outcome carries the status), the kernels'
-    ``threads`` (None: the operator's FFTW threads, else 1), the kernel set of bounded
+    ``threads`` (None: the operator's threads, else 1), the kernel set of bounded
     load control (``bounded_load_sweep``, as :class:`SolveOptions`'s) and the kernel set
     of the loop (``array_module``: None for the fused numba kernels, else the array
     kernels on that namespace, a name of :data:`.array_backends.ARRAY_BACKENDS`; the

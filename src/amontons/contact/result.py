@@ -150,7 +150,7 @@ class SolveInfo:
         Backend used: an FFT backend of the CPU solver, or the array kernel set's
         namespace (``"cupy"`` on the GPU).
     threads : int
-        FFTW threads.
+        Threads of the transforms and the kernels.
     planner_effort : str
         FFTW planner effort of the convolution plans (unused by the numpy backend).
     tol : float

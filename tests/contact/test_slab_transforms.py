@@ -1,0 +1,139 @@
+"""Transforms on several threads (amontons.contact.fft): slabs of one-thread FFTW plans.
+
+Each slab computes the 1-D transforms a whole-array plan computes, so every comparison
+with numpy.fft below is round-off: 1e-12 of the largest coefficient (float64, transform
+lengths below 10³: FFT round-off grows like log2(n) times 1e-16)."""
+
+import numpy as np
+import pytest
+
+from amontons.contact.fft import (
+    HAVE_PYFFTW,
+    SLAB_ALIGNMENT,
+    SlabTransform,
+    TwoPassRealFFT2,
+    axis_fft,
+    empty,
+    real_fft2,
+    slab_edges,
+)
+
+pytestmark = pytest.mark.skipif(not HAVE_PYFFTW, reason="pyfftw not installed")
+
+RTOL = 1e-12
+
+
+def _close(a, b):
+    return np.abs(a - b).max() <= RTOL * np.abs(b).max()
+
+
+@pytest.mark.parametrize("length", [1, 5, 64, 257, 513, 1025])
+@pytest.mark.parametrize("parts", [1, 2, 3, 8, 16])
+@pytest.mark.parametrize("step", [1, 2, 4])
+def test_slab_edges_cover_the_axis_once_in_near_equal_aligned_slabs(length, parts, step):
+    edges = slab_edges(length, parts, step)
+    starts, stops = zip(*edges, strict=True)
+    assert starts[0] == 0 and stops[-1] == length
+    assert list(starts[1:]) == list(stops[:-1])  # contiguous, no overlap, no gap
+    assert all(stop > start for start, stop in edges)  # no empty slab
+    assert len(edges) <= parts
+    assert all(edge % step == 0 for edge in starts[1:])
+    sizes = [stop - start for start, stop in edges]
+    if length >= parts * step:  # room for every part: they differ by at most one step
+        assert len(edges) == parts
+        assert max(sizes) - min(sizes) <= step
+
+
+def _spectrum_pair(shape):
+    real = empty(shape, np.float64, "pyfftw")
+    spec = empty((shape[0], shape[1] // 2 + 1), np.complex128, "pyfftw")
+    return real, spec
+
+
+@pytest.mark.parametrize("shape", [(64, 64), (96, 80), (33, 50), (130, 126)])
+@pytest.mark.parametrize("threads", [2, 3, 16])
+def test_a_two_pass_real_fft_is_numpys_rfft2_and_back(shape, threads):
+    """Forward: rfft2. Inverse: irfft2 times the size (plans run unnormalised, as the
+    operators run them). 16 threads on 33 rows: fewer slabs than threads."""
+    real, spec = _spectrum_pair(shape)
+    fwd = real_fft2(real, spec, threads=threads)
+    inv = real_fft2(spec, real, inverse=True, threads=threads)
+    assert isinstance(fwd, TwoPassRealFFT2) and isinstance(inv, TwoPassRealFFT2)
+    x = np.random.default_rng(shape[0] + threads).random(shape)
+    real[...] = x
+    fwd.execute()
+    assert _close(spec, np.fft.rfft2(x))
+    inv.execute()
+    assert _close(real, x * x.size)
+
+
+@pytest.mark.parametrize("threads", [2, 5])
+def test_slab_transforms_run_on_other_arrays_like_the_planned_ones(threads):
+    """update_arrays moves every slab's plan onto the same slab of new aligned arrays (the
+    periodic operator runs on the solver's own arrays without copies)."""
+    shape = (48, 40)
+    real, spec = _spectrum_pair(shape)
+    fwd = real_fft2(real, spec, threads=threads)
+    inv = real_fft2(spec, real, inverse=True, threads=threads)
+    other_real, other_spec = _spectrum_pair(shape)
+    x = np.random.default_rng(7).random(shape)
+    other_real[...] = x
+    real[...] = 0.0
+    spec[...] = 0.0
+    fwd.update_arrays(other_real, other_spec)
+    fwd.execute()
+    assert _close(other_spec, np.fft.rfft2(x))
+    inv.update_arrays(other_spec, other_real)
+    inv.execute()
+    assert _close(other_real, x * x.size)
+    assert not np.any(real) and not np.any(spec)  # the planned arrays were left alone
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+@pytest.mark.parametrize("threads", [2, 4])
+def test_an_axis_transform_in_place_is_numpys_fft_along_that_axis(axis, threads):
+    shape = (40, 36)
+    a = empty(shape, np.complex128, "pyfftw")
+    rng = np.random.default_rng(axis + 10 * threads)
+    x = rng.random(shape) + 1j * rng.random(shape)
+    fwd = axis_fft(a, a, axis, threads=threads)
+    inv = axis_fft(a, a, axis, inverse=True, threads=threads)
+    assert isinstance(fwd, SlabTransform)
+    a[...] = x  # after planning: FFTW_MEASURE writes over the arrays
+    fwd.execute()
+    assert _close(a, np.fft.fft(x, axis=axis))
+    inv.execute()
+    assert _close(a, x * shape[axis])
+
+
+def test_every_slab_plan_is_as_aligned_as_the_whole_array():
+    """Slab edges a multiple of SLAB_ALIGNMENT bytes from the array's start: no slab plan
+    falls back to FFTW_UNALIGNED (no SIMD), on rows of real and of complex numbers (spectrum
+    rows of 33 complex = 528 bytes, so row slabs start on multiples of 4 rows) and on
+    columns."""
+    real, spec = _spectrum_pair((64, 64))
+    for transform, src, dst in (
+        (SlabTransform(real, spec, 1, threads=3), real, spec),
+        (SlabTransform(spec, spec, 0, threads=3), spec, spec),
+    ):
+        assert len(transform._plans) == 3
+        for plan in transform._plans:
+            for a, whole in ((plan.input_array, src), (plan.output_array, dst)):
+                assert (a.ctypes.data - whole.ctypes.data) % SLAB_ALIGNMENT == 0
+            assert "FFTW_UNALIGNED" not in plan.flags
+
+
+def test_a_slab_transform_needs_arrays_of_one_length_across_it():
+    real = empty((8, 16), np.float64, "pyfftw")
+    spec = empty((6, 9), np.complex128, "pyfftw")
+    with pytest.raises(ValueError, match=r"one length along axis 0.*\(8, 16\).*\(6, 9\)"):
+        SlabTransform(real, spec, 1, threads=2)
+
+
+def test_one_thread_is_one_fftw_plan():
+    """On one thread the operators keep one whole-array FFTW plan (the same plans, bits and
+    speed as before slabs existed)."""
+    real, spec = _spectrum_pair((16, 16))
+    plan = real_fft2(real, spec, threads=1)
+    assert type(plan).__name__ == "FFTW"
+    assert plan.axes == (0, 1)
