@@ -10,6 +10,7 @@ import pytest
 from amontons.contact.fft import (
     HAVE_PYFFTW,
     SLAB_ALIGNMENT,
+    SLAB_POINTS,
     SlabTransform,
     TwoPassRealFFT2,
     axis_fft,
@@ -56,9 +57,8 @@ def test_a_two_pass_real_fft_is_numpys_rfft2_and_back(shape, threads):
     """Forward: rfft2. Inverse: irfft2 times the size (plans run unnormalised, as the
     operators run them). 16 threads on 33 rows: fewer slabs than threads."""
     real, spec = _spectrum_pair(shape)
-    fwd = real_fft2(real, spec, threads=threads)
-    inv = real_fft2(spec, real, inverse=True, threads=threads)
-    assert isinstance(fwd, TwoPassRealFFT2) and isinstance(inv, TwoPassRealFFT2)
+    fwd = TwoPassRealFFT2(real, spec, threads=threads, min_points=1)
+    inv = TwoPassRealFFT2(spec, real, inverse=True, threads=threads, min_points=1)
     x = np.random.default_rng(shape[0] + threads).random(shape)
     real[...] = x
     fwd.execute()
@@ -73,8 +73,8 @@ def test_slab_transforms_run_on_other_arrays_like_the_planned_ones(threads):
     periodic operator runs on the solver's own arrays without copies)."""
     shape = (48, 40)
     real, spec = _spectrum_pair(shape)
-    fwd = real_fft2(real, spec, threads=threads)
-    inv = real_fft2(spec, real, inverse=True, threads=threads)
+    fwd = TwoPassRealFFT2(real, spec, threads=threads, min_points=1)
+    inv = TwoPassRealFFT2(spec, real, inverse=True, threads=threads, min_points=1)
     other_real, other_spec = _spectrum_pair(shape)
     x = np.random.default_rng(7).random(shape)
     other_real[...] = x
@@ -96,9 +96,8 @@ def test_an_axis_transform_in_place_is_numpys_fft_along_that_axis(axis, threads)
     a = empty(shape, np.complex128, "pyfftw")
     rng = np.random.default_rng(axis + 10 * threads)
     x = rng.random(shape) + 1j * rng.random(shape)
-    fwd = axis_fft(a, a, axis, threads=threads)
-    inv = axis_fft(a, a, axis, inverse=True, threads=threads)
-    assert isinstance(fwd, SlabTransform)
+    fwd = SlabTransform(a, a, axis, threads=threads, min_points=1)
+    inv = SlabTransform(a, a, axis, inverse=True, threads=threads, min_points=1)
     a[...] = x  # after planning: FFTW_MEASURE writes over the arrays
     fwd.execute()
     assert _close(a, np.fft.fft(x, axis=axis))
@@ -113,8 +112,8 @@ def test_every_slab_plan_is_as_aligned_as_the_whole_array():
     columns."""
     real, spec = _spectrum_pair((64, 64))
     for transform, src, dst in (
-        (SlabTransform(real, spec, 1, threads=3), real, spec),
-        (SlabTransform(spec, spec, 0, threads=3), spec, spec),
+        (SlabTransform(real, spec, 1, threads=3, min_points=1), real, spec),
+        (SlabTransform(spec, spec, 0, threads=3, min_points=1), spec, spec),
     ):
         assert len(transform._plans) == 3
         for plan in transform._plans:
@@ -137,3 +136,21 @@ def test_one_thread_is_one_fftw_plan():
     plan = real_fft2(real, spec, threads=1)
     assert type(plan).__name__ == "FFTW"
     assert plan.axes == (0, 1)
+
+
+def test_slabs_have_at_least_slab_points_points():
+    """Below SLAB_POINTS a slab costs more to wake than it saves: a 128² transform stays
+    one slab on 16 threads; 512² (its spectrum 512 × 257 = 131584 points) takes 8 slabs for
+    its columns and 16 for its real rows."""
+    real, spec = _spectrum_pair((128, 128))
+    assert len(SlabTransform(real, spec, 1, threads=16)._plans) == 1
+    real, spec = _spectrum_pair((512, 512))
+    assert SLAB_POINTS == 16384
+    assert len(SlabTransform(spec, spec, 0, threads=16)._plans) == 8
+    assert len(SlabTransform(real, spec, 1, threads=16)._plans) == 16
+    two = axis_fft(spec, spec, 0, threads=2)
+    assert isinstance(two, SlabTransform) and len(two._plans) == 2
+    assert isinstance(real_fft2(real, spec, threads=2), TwoPassRealFFT2)
+    # 128²: its spectrum (8320 points) is less than two slabs: the whole-array plan
+    small_real, small_spec = _spectrum_pair((128, 128))
+    assert type(real_fft2(small_spec, small_real, inverse=True, threads=16)).__name__ == "FFTW"
