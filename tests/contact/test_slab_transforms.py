@@ -4,6 +4,8 @@ Each slab computes the 1-D transforms a whole-array plan computes, so every comp
 with numpy.fft below is round-off: 1e-12 of the largest coefficient (float64, transform
 lengths below 10³: FFT round-off grows like log2(n) times 1e-16)."""
 
+import multiprocessing
+
 import numpy as np
 import pytest
 
@@ -154,3 +156,35 @@ def test_slabs_have_at_least_slab_points_points():
     # 128²: its spectrum (8320 points) is less than two slabs: the whole-array plan
     small_real, small_spec = _spectrum_pair((128, 128))
     assert type(real_fft2(small_spec, small_real, inverse=True, threads=16)).__name__ == "FFTW"
+
+
+def _transform_in_child(transform, spec, x, queue):
+    spec[...] = x
+    transform.execute()
+    queue.put(np.abs(spec - np.fft.fft(x, axis=0)).max() / np.abs(spec).max())
+
+
+@pytest.mark.skipif(
+    "fork" not in multiprocessing.get_all_start_methods(), reason="no fork on this platform"
+)
+# Python 3.12+ warns that forking a multi-threaded process may deadlock: what this checks
+@pytest.mark.filterwarnings("ignore:This process .* is multi-threaded:DeprecationWarning")
+def test_a_forked_child_runs_a_slab_transform_its_parent_ran():
+    """A child forked after its parent ran a transform on slabs inherits the parent's pool
+    object but none of its threads; it must start its own rather than wait forever (a
+    pipeline or a user's multiprocessing pool forks after a solve)."""
+    spec = empty((64, 64), np.complex128, "pyfftw")
+    transform = SlabTransform(spec, spec, 0, threads=2, min_points=1)
+    x = np.random.default_rng(5).random((64, 64)) + 0j
+    spec[...] = x
+    transform.execute()  # the parent's pool now exists, with its threads
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=_transform_in_child, args=(transform, spec, x, queue))
+    child.start()
+    child.join(timeout=60)
+    if child.is_alive():
+        child.kill()
+        pytest.fail("the forked child's slab transform did not finish in 60 s")
+    assert child.exitcode == 0
+    assert queue.get(timeout=5) <= RTOL

@@ -29,6 +29,7 @@ import contextlib
 import functools
 import itertools
 import math
+import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -138,10 +139,16 @@ def _slab_step(arrays, axis: int) -> int:
     return step
 
 
-@functools.cache
 def _workers(count: int) -> ThreadPoolExecutor:
-    """The process's pool of ``count`` threads that run slabs beside the calling thread."""
-    return ThreadPoolExecutor(max_workers=count, thread_name_prefix="amontons-fft")
+    """This process's pool of ``count`` threads that run slabs beside the calling thread."""
+    # keyed by process: a child forked after a threaded transform inherits the pool object
+    # but none of its threads, and would wait forever on it
+    return _pool(count, os.getpid())
+
+
+@functools.cache
+def _pool(count: int, pid: int) -> ThreadPoolExecutor:
+    return ThreadPoolExecutor(max_workers=count, thread_name_prefix=f"amontons-fft-{pid}")
 
 
 class SlabTransform:
@@ -187,7 +194,6 @@ class SlabTransform:
             )
             for edge in self._edges
         ]
-        self._pool = _workers(len(self._plans) - 1) if len(self._plans) > 1 else None
 
     def _slab(self, a, edge):
         start, stop = edge
@@ -196,7 +202,8 @@ class SlabTransform:
     def execute(self) -> None:
         """Transform every slab; returns when all are done."""
         first, *others = self._plans
-        running = [self._pool.submit(plan.execute) for plan in others]
+        pool = _workers(len(others)) if others else None
+        running = [pool.submit(plan.execute) for plan in others]
         first.execute()
         for slab in running:
             slab.result()
