@@ -139,6 +139,14 @@ def _slab_step(arrays, axis: int) -> int:
     return step
 
 
+def slab_count(arrays, threads: int, min_points: int = SLAB_POINTS) -> int:
+    """How many slabs a transform touching ``arrays`` runs as on ``threads`` threads: one
+    per thread, fewer if a slab would hold less than ``min_points`` points of the largest
+    array; 1 means one whole-array plan."""
+    largest = max(a.size for a in arrays)
+    return min(int(threads), max(1, largest // int(min_points)))
+
+
 def _workers(count: int) -> ThreadPoolExecutor:
     """This process's pool of ``count`` threads that run slabs beside the calling thread."""
     # keyed by process: a child forked after a threaded transform inherits the pool object
@@ -182,7 +190,7 @@ class SlabTransform:
             )
         self._other = other
         step = _slab_step((src, dst), other)
-        parts = min(int(threads), max(1, max(src.size, dst.size) // int(min_points)))
+        parts = slab_count((src, dst), threads, min_points)
         self._edges = slab_edges(src.shape[other], parts, step)
         self._plans = [
             fftw_plan(
@@ -271,9 +279,9 @@ def real_fft2(
     """A real 2-D FFT ``src -> dst`` (r2c forward, c2r inverse; not normalised) with
     ``execute()`` and ``update_arrays()``: :class:`TwoPassRealFFT2` on two threads or more
     (module doc), one FFTW plan on one thread or when the spectrum is too small for two
-    slabs of :data:`SLAB_POINTS` (the passes would run on one thread each)."""
+    slabs (:func:`slab_count`; its column pass would run on one thread)."""
     spectrum = src if inverse else dst
-    if int(threads) == 1 or spectrum.size < 2 * SLAB_POINTS:
+    if slab_count((spectrum,), threads) == 1:
         return fftw_plan(src, dst, (0, 1), inverse=inverse, planner_effort=planner_effort)
     return TwoPassRealFFT2(
         src, dst, inverse=inverse, threads=threads, planner_effort=planner_effort
@@ -290,8 +298,9 @@ def axis_fft(
     planner_effort: str = DEFAULT_PLANNER_EFFORT,
 ):
     """A 1-D FFT along ``axis`` of 2-D arrays with ``execute()`` and ``update_arrays()``:
-    one FFTW plan on one thread, :class:`SlabTransform` on more (module doc)."""
-    if int(threads) == 1:
+    :class:`SlabTransform` on two threads or more (module doc), one FFTW plan where it
+    would be one slab (:func:`slab_count`)."""
+    if slab_count((src, dst), threads) == 1:
         return fftw_plan(src, dst, (axis,), inverse=inverse, planner_effort=planner_effort)
     return SlabTransform(
         src, dst, axis, inverse=inverse, threads=threads, planner_effort=planner_effort
