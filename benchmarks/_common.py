@@ -26,6 +26,7 @@ import statistics
 import time
 
 import numpy as np
+import psutil
 
 from amontons.contact import self_affine, sphere
 
@@ -90,6 +91,29 @@ def median_time(fn, repeats: int, warmup: int = 1, cold: bool = False) -> float:
         fn()
         ts.append(time.perf_counter() - t0)
     return statistics.median(ts)
+
+
+class HostSteal:
+    """Share of this machine's CPU time the host took while a block ran, %: the steal time
+    of a virtual machine (Linux's ``/proc/stat``, through psutil; 0 where the system does not
+    count it), over all cores. A virtual CPU that is runnable while the host runs something
+    else on it is stolen: a benchmark round with steal in it timed a smaller machine.
+
+    ``with HostSteal() as steal: ...`` then ``steal.percent``.
+    """
+
+    percent = float("nan")
+
+    def __enter__(self):
+        self._before = psutil.cpu_times()
+        return self
+
+    def __exit__(self, *exc):
+        after = psutil.cpu_times()
+        total = sum(after) - sum(self._before)
+        stolen = getattr(after, "steal", 0.0) - getattr(self._before, "steal", 0.0)
+        self.percent = 100.0 * stolen / total if total > 0 else 0.0
+        return False
 
 
 def rough_surface(n: int, seed: int = 1) -> np.ndarray:

@@ -16,7 +16,8 @@ FFTW_MEASURE on the same threads, back to back, whatever effort the solver plans
 "sweep floor" is what the element-wise work cannot go below on this machine: the bytes the
 three sweeps of a periodic iteration must move (SWEEP_BYTES per point) at the memory
 bandwidth of a three-array ``np.add`` timed in the same process, in MEASURE pairs.
-Medians of --repeats.
+"host steal %" is the share of the machine's CPU time a virtual machine's host took while
+the row's repeats ran (:class:`_common.HostSteal`). Medians of --repeats.
 
 Paths: ``fused`` (numba kernels, the solver's one loop) and ``numpy`` (the reference loop
 the tests compare with, tests/contact/numpy_oracle.py). The solve runs inside
@@ -39,6 +40,7 @@ from pathlib import Path
 import numpy as np
 from _common import (
     E_STAR,
+    HostSteal,
     header,
     median_time,
     parser,
@@ -137,21 +139,23 @@ def _measure(n, periodic, path, threads, effort, repeats):
     ratios, per_it, pairs, in_conv, cold_ratios = [], [], [], [], []
     measured_pairs, measured_ratios, measured_conv = [], [], []
     bandwidth = _stream_bandwidth(h.size)
-    for _ in range(repeats):
-        pair_t = _pair_time(pair)
-        cold_t = _pair_time(pair, cold=True)
-        measured_t = _pair_time(measured)
-        dt, conv_s, out = solve_once(op, h, load, kernels, threads)
-        pair_t = 0.5 * (pair_t + _pair_time(pair))
-        it = out.iterations
-        per_it.append(dt / it)
-        pairs.append(pair_t)
-        cold_ratios.append(dt / it / cold_t)
-        ratios.append(dt / it / pair_t)
-        in_conv.append(conv_s / it / pair_t)
-        measured_pairs.append(measured_t)
-        measured_ratios.append(dt / it / measured_t)
-        measured_conv.append(conv_s / it / measured_t)
+    steal = HostSteal()
+    with steal:  # the host's share of the row's timed work
+        for _ in range(repeats):
+            pair_t = _pair_time(pair)
+            cold_t = _pair_time(pair, cold=True)
+            measured_t = _pair_time(measured)
+            dt, conv_s, out = solve_once(op, h, load, kernels, threads)
+            pair_t = 0.5 * (pair_t + _pair_time(pair))
+            it = out.iterations
+            per_it.append(dt / it)
+            pairs.append(pair_t)
+            cold_ratios.append(dt / it / cold_t)
+            ratios.append(dt / it / pair_t)
+            in_conv.append(conv_s / it / pair_t)
+            measured_pairs.append(measured_t)
+            measured_ratios.append(dt / it / measured_t)
+            measured_conv.append(conv_s / it / measured_t)
     conv_per_it = out.convolutions / out.iterations
     ratio = statistics.median(ratios)
     conv = statistics.median(in_conv)
@@ -177,6 +181,7 @@ def _measure(n, periodic, path, threads, effort, repeats):
             [r - c for r, c in zip(measured_ratios, measured_conv, strict=True)]
         ),
         "memory GB/s": bandwidth / 1e9,
+        "host steal %": steal.percent,
         "sweep floor (MEASURE pairs)": SWEEP_BYTES
         * h.size
         / bandwidth
