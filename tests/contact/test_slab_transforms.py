@@ -5,16 +5,22 @@ with numpy.fft below is round-off: 1e-12 of the largest coefficient (float64, tr
 lengths below 10³: FFT round-off grows like log2(n) times 1e-16)."""
 
 import multiprocessing
+import os
+import threading
+import time
 
 import numpy as np
 import pytest
 
+from amontons.contact import fft
+from amontons.contact.convolution import NonPeriodicConvolution, PeriodicConvolution
 from amontons.contact.fft import (
     HAVE_PYFFTW,
     SLAB_ALIGNMENT,
     SLAB_POINTS,
     SlabTransform,
     TwoPassRealFFT2,
+    aligned,
     axis_fft,
     empty,
     real_fft2,
@@ -188,3 +194,110 @@ def test_a_forked_child_runs_a_slab_transform_its_parent_ran():
         pytest.fail("the forked child's slab transform did not finish in 60 s")
     assert child.exitcode == 0
     assert queue.get(timeout=5) <= RTOL
+
+
+# The smallest grids on which the operators' own transforms (SLAB_POINTS per slab) run as
+# two slabs: a 256² spectrum has 256 × 129 = 33024 points; 257 × 255 is odd on both axes; a
+# 128² window pads to 256².
+OPERATOR_CASES = [
+    ((256, 256), True, None),
+    ((257, 255), True, None),
+    ((128, 128), False, True),
+    ((128, 128), False, False),
+]
+
+
+def _slab_operators(shape, periodic, pruned):
+    """The numpy-backed operator and a two-thread pyfftw one, whose transforms are checked
+    to be slabs (on smaller grids threads=2 runs one whole-array plan)."""
+    kw = {} if periodic else {"pruned": pruned}
+    cls = PeriodicConvolution if periodic else NonPeriodicConvolution
+    ref = cls(shape, 0.5, 2.0, backend="numpy", **kw)
+    two = cls(shape, 0.5, 2.0, backend="pyfftw", threads=2, planner_effort="FFTW_ESTIMATE", **kw)
+    if pruned:
+        transforms = (two._row_fwd, two._col_fwd, two._col_inv, two._row_inv)
+        assert all(isinstance(t, SlabTransform) for t in transforms)
+    else:
+        assert isinstance(two._fwd, TwoPassRealFFT2) and isinstance(two._inv, TwoPassRealFFT2)
+    return ref, two
+
+
+@pytest.mark.parametrize(("shape", "periodic", "pruned"), OPERATOR_CASES)
+def test_operators_on_slabs_give_numpys_convolution(shape, periodic, pruned):
+    """A two-thread operator on slabs gives the numpy backend's K*p to round-off (1e-12 of
+    the peak) by every way the solver calls it, one after the other so that each rebinds
+    the plans the last one moved: on the caller's aligned arrays (no copy), through its own
+    arrays (a strided input), and in halves (forward, multiply_energy, inverse), whose
+    energy is Σ p·(K*p) to 1e-12 relative."""
+    ref, two = _slab_operators(shape, periodic, pruned)
+    rng = np.random.default_rng(sum(shape))
+    for _ in range(2):
+        p = empty(shape, np.float64, "pyfftw")
+        p[...] = rng.random(shape)
+        expected = ref(p)
+        out = empty(shape, np.float64, "pyfftw")
+        assert _close(two(p, out), expected)
+        strided = np.asfortranarray(p)
+        assert _close(two(strided), expected)
+        two.forward(p)
+        energy = two.multiply_energy()
+        assert _close(two.inverse(np.empty(shape)), expected)
+        assert energy == pytest.approx(float(np.sum(p * expected)), rel=1e-12)
+
+
+def test_a_row_of_a_taller_array_is_not_taken_as_the_plans_array():
+    """numpy calls a one-row slice of a taller array C-contiguous, but its row stride is not
+    the planned one (pyfftw would refuse it): it goes through the operator's own arrays."""
+    tall = empty((2, 16), np.float64, "pyfftw")
+    tall[...] = np.random.default_rng(3).random((2, 16))
+    row, out = tall[::2], empty((2, 16), np.float64, "pyfftw")[::2]
+    assert row.flags.c_contiguous and not aligned(row, (1, 16))
+    expected = PeriodicConvolution((1, 16), 0.5, 2.0, backend="numpy")(row)
+    got = PeriodicConvolution((1, 16), 0.5, 2.0, backend="pyfftw")(row, out)
+    assert _close(got, expected)
+
+
+def _slab_threads():
+    prefix = f"amontons-fft-{os.getpid()}"
+    return [t for t in threading.enumerate() if t.name.startswith(prefix)]
+
+
+def test_one_pool_serves_transforms_of_every_width():
+    """The slabs of every transform share one pool per process: after transforms on 8, then
+    2 to 7 threads, the process holds no more slab threads than the widest needs (7, or an
+    earlier test's wider pool), not a pool per width (1 + 2 + ... + 7 = 28 threads)."""
+    spec = empty((64, 64), np.complex128, "pyfftw")
+    for threads in (8, 2, 3, 4, 5, 6, 7):
+        SlabTransform(spec, spec, 0, threads=threads, min_points=1).execute()
+    room = fft._POOLS[os.getpid()][0]
+    assert room >= 7
+    assert len(_slab_threads()) <= room
+
+
+class _SlowSlab:
+    """A stand-in for a slab's plan that takes a while and says when it is done."""
+
+    def __init__(self):
+        self.done = False
+
+    def execute(self):
+        time.sleep(0.2)
+        self.done = True
+
+
+class _FailingSlab:
+    def execute(self):
+        raise RuntimeError("this slab failed")
+
+
+def test_a_failing_slab_returns_only_once_every_slab_has_finished():
+    """If the calling thread's slab raises, the others still run in the pool; execute waits
+    for them before it raises, so that none writes into the arrays after the caller has
+    them back."""
+    spec = empty((64, 64), np.complex128, "pyfftw")
+    transform = SlabTransform(spec, spec, 0, threads=3, min_points=1)
+    slow = [_SlowSlab(), _SlowSlab()]
+    transform._plans = [_FailingSlab(), *slow]
+    with pytest.raises(RuntimeError, match="this slab failed"):
+        transform.execute()
+    assert all(slab.done for slab in slow)

@@ -138,11 +138,12 @@ def test_bad_threads_are_refused(bad):
 def test_answers_do_not_depend_on_the_bound():
     """The bound changes who computes, not what: the same pressure to 1e-10 relative.
 
-    Solved to tol 1e-10, so that 1e-10 is within what each solve promises: threads=2 runs
-    its FFTs as two slabs of one-thread plans, other plans whose round-off takes the
-    iterates along a slightly different path, and at the default tol 1e-8 two paths may
-    stop ~1e-10 apart (measured 1.0e-10 here, each within 1e-8 of the tol 1e-13
-    solution)."""
+    Solved to tol 1e-10, so that 1e-10 is within what each solve promises where the two
+    thread counts run other plans, whose round-off takes the iterates along a slightly
+    different path: at the default tol 1e-8 two paths may stop ~1e-10 apart (measured
+    1.0e-10 here with FFTW's threaded plans, each within 1e-8 of the tol 1e-13 solution).
+    Since 2026-11-27 this 64² window (a 128² padded grid, under two slabs and one kernel
+    chunk) runs the one-thread plans and kernels on two threads as well."""
     h, dx, e_star = _sphere()
     one = solve(h, dx, e_star, load=1e-3, threads=1, tol=1e-10)
     with threadpool_limits(limits=CALLER):
@@ -153,11 +154,13 @@ def test_answers_do_not_depend_on_the_bound():
 
 @pytest.mark.parametrize("periodic", [True, False])
 def test_two_threads_give_the_one_thread_answer(periodic):
-    """threads=2 runs its FFTs as two slabs of one-thread plans (FFTW_MEASURE, the
-    default); the fused kernels run on one, as 128² is one kernel chunk (their sums do not
-    depend on the thread count: tests/contact/test_fused_kernels.py), and the FFT plans
-    differ only in round-off, so the solution is the one-thread one to 1e-10 in contact
-    fraction and approach (over the rms height), far below the 1e-9 solve tolerance."""
+    """threads=2 runs the padded sphere's FFTs (a 256² grid) as two slabs of one-thread
+    plans (FFTW_MEASURE, the default) and the periodic 128² ones on its whole-array plan
+    (its spectrum is under two slabs: amontons.contact.fft.slab_count); the fused kernels
+    run on one, as 128² is one kernel chunk (their sums do not depend on the thread count:
+    tests/contact/test_fused_kernels.py), and the FFT plans differ only in round-off, so
+    the solution is the one-thread one to 1e-10 in contact fraction and approach (over the
+    rms height), far below the 1e-9 solve tolerance."""
     n = 128
     if periodic:
         from amontons.contact import self_affine

@@ -17,16 +17,16 @@ pytestmark = pytest.mark.skipif(not HAVE_PYFFTW, reason="pyfftw not installed")
 CHILD = """
 import hashlib
 from amontons.contact import self_affine, solve
-rough = self_affine((96, 96), 1.0, 0.8, rms_slope=0.1, rng=3)
-res = solve(rough, 1.0, 1.0, load=0.005 * 96**2, periodic=True, threads={threads})
+rough = self_affine(({n}, {n}), 1.0, 0.8, rms_slope=0.1, rng=3)
+res = solve(rough, 1.0, 1.0, load=0.005 * {n}**2, periodic=True, threads={threads})
 print(hashlib.sha256(res.pressure.tobytes()).hexdigest())
 """
 
 
-def _start(wisdom, threads=1):
+def _start(wisdom, threads=1, n=96):
     env = dict(os.environ, **{WISDOM_ENV: str(wisdom)})
     return subprocess.Popen(
-        [sys.executable, "-c", CHILD.format(threads=threads)],
+        [sys.executable, "-c", CHILD.format(threads=threads, n=n)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -50,7 +50,8 @@ def _plan_new_shape(shape):
 def test_processes_started_together_share_one_plan(tmp_path):
     """Two processes planning at the same time wait for each other (file lock): the second
     to get the lock imports the first's choice, so both give the same bytes, on one thread
-    and on two, and the file is valid wisdom afterwards (written in one rename)."""
+    and on two (at 96² both run one whole-array plan: the next test has slabs), and the
+    file is valid wisdom afterwards (written in one rename)."""
     wisdom = tmp_path / "wisdom.json"
     for threads in (1, 2):
         procs = [_start(wisdom, threads) for _ in range(2)]
@@ -59,6 +60,17 @@ def test_processes_started_together_share_one_plan(tmp_path):
     strings = json.loads(wisdom.read_text())
     assert len(strings) == 3 and strings[0].startswith("(fftw-3")
     assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_processes_started_together_share_their_slab_plans(tmp_path):
+    """The same on two threads at 256², whose transforms run as slabs of one-thread plans
+    (amontons.contact.fft.SlabTransform), each slab shape planned and shared: both
+    processes give the same bytes."""
+    wisdom = tmp_path / "wisdom.json"
+    procs = [_start(wisdom, threads=2, n=256) for _ in range(2)]
+    first, second = (_digest(p) for p in procs)
+    assert first == second
+    assert json.loads(wisdom.read_text())[0].startswith("(fftw-3")
 
 
 def test_a_corrupt_wisdom_file_is_an_error_naming_it(tmp_path, monkeypatch):

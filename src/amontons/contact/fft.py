@@ -26,11 +26,10 @@ on a virtual machine (benchmarks/README.md, "A second core").
 from __future__ import annotations
 
 import contextlib
-import functools
 import itertools
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 
 import numpy as np
 
@@ -67,14 +66,21 @@ def zeros(shape, dtype, backend: str) -> np.ndarray:
 
 def aligned(a: np.ndarray, shape) -> bool:
     """True if ``a`` is a C-contiguous float64 array of ``shape`` usable by FFTW in place of
-    the arrays a plan was built on (same SIMD alignment)."""
+    the arrays a plan was built on (same strides and SIMD alignment)."""
     return (
         a.dtype == np.float64
         and a.shape == tuple(shape)
-        and a.flags.c_contiguous
+        # numpy calls a one-row slice of a taller array C-contiguous whatever its row
+        # stride; a plan takes only the strides it was made for
+        and a.strides == _c_strides(a)
         and HAVE_PYFFTW
         and a.ctypes.data % pyfftw.simd_alignment == 0
     )
+
+
+def _c_strides(a: np.ndarray) -> tuple[int, ...]:
+    """The strides, bytes, of a C-ordered array of ``a``'s shape and item size."""
+    return tuple(a.itemsize * math.prod(a.shape[k + 1 :]) for k in range(a.ndim))
 
 
 def fftw_plan(
@@ -105,7 +111,8 @@ def fftw_plan(
         return pyfftw.FFTW(src, dst, axes=tuple(axes), direction=direction, flags=flags)
 
 
-# A slab has at least this many points (of the larger of its two arrays): below it a second
+# A slab has about this many points or more (of the larger of its two arrays; the edges'
+# alignment may take up to one step off): below it a second
 # thread costs more to wake than it takes off the transform (2026-11-27, this 2-core VM: a
 # 128² pair on two slabs per pass took 0.30 ms against 0.12 ms on one thread; 256², whose
 # column pass is 33k points, gained 1.2×). The kernels' chunk is the same size.
@@ -148,15 +155,23 @@ def slab_count(arrays, threads: int, min_points: int = SLAB_POINTS) -> int:
 
 
 def _workers(count: int) -> ThreadPoolExecutor:
-    """This process's pool of ``count`` threads that run slabs beside the calling thread."""
+    """This process's pool of threads that run slabs beside the calling thread, with room
+    for ``count`` at once. One pool serves every transform: it starts a thread only when
+    none is idle, so it holds as many as the widest transform has needed."""
     # keyed by process: a child forked after a threaded transform inherits the pool object
     # but none of its threads, and would wait forever on it
-    return _pool(count, os.getpid())
+    pid = os.getpid()
+    size, pool = _POOLS.get(pid, (0, None))
+    if size < count:
+        # a wider pool takes over; the old one is dropped, not shut down, as a transform on
+        # another thread may still be submitting to it. Its threads end once it is collected.
+        pool = ThreadPoolExecutor(max_workers=count, thread_name_prefix=f"amontons-fft-{pid}")
+        _POOLS[pid] = (count, pool)
+    return pool
 
 
-@functools.cache
-def _pool(count: int, pid: int) -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(max_workers=count, thread_name_prefix=f"amontons-fft-{pid}")
+# process id -> (room, pool) of :func:`_workers`
+_POOLS: dict[int, tuple[int, ThreadPoolExecutor]] = {}
 
 
 class SlabTransform:
@@ -212,7 +227,12 @@ class SlabTransform:
         first, *others = self._plans
         pool = _workers(len(others)) if others else None
         running = [pool.submit(plan.execute) for plan in others]
-        first.execute()
+        try:
+            first.execute()
+        finally:
+            # every slab has finished before this returns or raises: none writes into the
+            # arrays after the caller has them back
+            wait(running)
         for slab in running:
             slab.result()
 
