@@ -12,8 +12,10 @@
 # 512² and 2048², elastic and penetration hardness (the CPU solve timed once); 4096² on the
 # device alone; the array code without the CUDA kernels (backend cupy-array) at 2048² and
 # 4096², their baseline on the same device; a profile of the host's time in the 2048²
-# device solves; the CuPy tests last, their kernels compiled by then. STEPS=scaling (170 s
-# more; measured on 2026-11-26) runs benchmark 1 at 2048² on 1, 8, 16, 4 and 2 threads.
+# device solves; the CuPy tests last, their kernels compiled by then. STEPS="dispatch
+# scaling" (190 s more; scaling measured on 2026-11-26) times a pass of slabs' dispatch on
+# 1-16 threads (bench_slab_dispatch.py), then runs benchmark 1 at 2048² on 1, 8, 16, 4 and 2
+# threads.
 # Each step has its own time limit, so that a slow one leaves the others their time, and
 # writes its log to $OUT/<step>.log as it runs: what a stopped step printed still comes
 # back. Steps run in the order below, whatever the order in STEPS.
@@ -73,6 +75,7 @@ step baseline 60 "$python" bench_gpu.py --backend "${BACKEND_BASELINE:-cupy-arra
 # where the host's time goes in the GPU route's solves: the 45 costliest functions
 step profile 40 bash -c "\"$python\" -m cProfile -s tottime bench_gpu.py --backend $backend \
     --device-only --sizes $profile_size --repeats 3 | head -75"
+step dispatch 20 "$python" bench_slab_dispatch.py --thread-counts "${threads[@]}" --calls 1000
 step scaling 170 "$python" bench_iteration.py --sizes "$scaling_size" --bc periodic \
     --paths fused --thread-counts "${threads[@]}" --repeats "$repeats"
 cd .. || exit 1
