@@ -245,6 +245,39 @@ def test_operators_on_slabs_give_numpys_convolution(shape, periodic, pruned):
         assert energy == pytest.approx(float(np.sum(p * expected)), rel=1e-12)
 
 
+def test_hooks_run_around_each_slab_in_its_own_thread():
+    """execute(before, after): ``before`` fills each slab's input and ``after`` takes its
+    output, once per slab, in the slab's own thread, around its transform (the result is
+    numpy's only if each ran on its side of it); together they cover the axis once. (Which
+    pool thread takes which other slab is the pool's business: a quick slab's thread may
+    take the next.)"""
+    a = empty((32, 96), np.complex128, "pyfftw")
+    transform = SlabTransform(a, a, 0, threads=3, min_points=1)
+    rng = np.random.default_rng(9)
+    x = rng.random(a.shape) + 1j * rng.random(a.shape)
+    out = np.zeros_like(x)
+    a[...] = 0.0
+    seen = []
+
+    def before(start, stop):
+        a[:, start:stop] = x[:, start:stop]
+        seen.append((start, stop, threading.current_thread().name))
+
+    def after(start, stop):
+        out[:, start:stop] = a[:, start:stop]
+        seen.append((start, stop, threading.current_thread().name))
+
+    transform.execute(before=before, after=after)
+    assert _close(out, np.fft.fft(x, axis=0))
+    slabs = sorted({(start, stop) for start, stop, _ in seen})
+    assert len(seen) == 6 and len(slabs) == 3
+    assert slabs[0][0] == 0 and slabs[-1][1] == 96
+    assert all(stop == start for (_, stop), (start, _) in zip(slabs, slabs[1:], strict=False))
+    threads = [{name for start, stop, name in seen if (start, stop) == e} for e in slabs]
+    assert all(len(names) == 1 for names in threads)  # each slab's two hooks in one thread
+    assert threads[0] == {threading.current_thread().name}  # the first: the caller's
+
+
 def test_a_row_of_a_taller_array_is_not_taken_as_the_plans_array():
     """numpy calls a one-row slice of a taller array C-contiguous, but its row stride is not
     the planned one (pyfftw would refuse it): it goes through the operator's own arrays."""

@@ -24,7 +24,10 @@ displacement (m) on the same grid:
 
     The row transforms touch n0 of the m0 rows of the plain ``m0 × m1`` transform, so the
     FFT work is about 3/4 of the plain one (ideal speed-up 4/3). ``pruned=False`` gives the
-    plain transform, kept for tests and benchmarks.
+    plain transform, kept for tests and benchmarks. The window's copy into the padded rows,
+    the zeroing of the spectrum's padding rows and the copy out run inside the row passes,
+    each row slab's share in its own thread (:meth:`.fft.SlabTransform.execute`): on several
+    threads no serial pass is left between the transforms.
 
 Operators own aligned work arrays and FFTW plans; :func:`get_operator` caches them per
 (shape, spacing, E*, periodic, backend, threads, pruned, planner effort). Operators are not
@@ -33,7 +36,7 @@ thread-safe (shared work arrays); use one process per concurrent solve.
 
 from __future__ import annotations
 
-from functools import lru_cache
+import functools
 
 import numpy as np
 
@@ -335,15 +338,34 @@ class NonPeriodicConvolution(_MultiplierMixin):
         (as :meth:`PeriodicConvolution.forward`; pyfftw backend only)."""
         n0, n1 = self.shape
         if self.pruned:
-            self._rows[:, :n1] = p
-            self._row_fwd.execute()
-            self._spec[n0:] = 0.0  # zero padding rows, overwritten by the last call
+            self._row_fwd.execute(
+                before=functools.partial(self._fill_rows, p), after=self._zero_padding
+            )
             self._col_fwd.execute()
         else:
             self._real[:n0, :n1] = p
             self._real[n0:, :] = 0.0  # the c2r inverse overwrote the padding
             self._real[:n0, n1:] = 0.0
             self._fwd.execute()
+
+    def _fill_rows(self, p, start: int, stop: int) -> None:
+        """Before the row slab ``[start, stop)`` of the forward transform, in its thread:
+        the window's rows of ``p`` (Pa) into the padded rows."""
+        self._rows[start:stop, : self.shape[1]] = p[start:stop]
+
+    def _zero_padding(self, start: int, stop: int) -> None:
+        """After the row slab ``[start, stop)`` of the forward transform, in its thread: the
+        same share of the spectrum's padding rows zeroed (the last inverse column pass wrote
+        over them). After, not before: the slab's rows are still in cache for its
+        transform, as they were when this was a pass of its own."""
+        n0 = self.shape[0]
+        pad = self.padded_shape[0] - n0
+        self._spec[n0 + start * pad // n0 : n0 + stop * pad // n0] = 0.0
+
+    def _take_rows(self, out, start: int, stop: int) -> None:
+        """After the row slab ``[start, stop)`` of the inverse transform, in its thread: its
+        window's part into ``out`` (m)."""
+        out[start:stop] = self._out[start:stop, : self.shape[1]]
 
     def multiply_energy(self) -> float:
         """The work spectrum times the kernel's; returns ``Σ p·(K*p)`` (m·Pa) over the
@@ -358,8 +380,7 @@ class NonPeriodicConvolution(_MultiplierMixin):
         n1 = self.shape[1]
         if self.pruned:
             self._col_inv.execute()
-            self._row_inv.execute()
-            out[...] = self._out[:, :n1]
+            self._row_inv.execute(after=functools.partial(self._take_rows, out))
         else:
             self._inv.execute()
             out[...] = self._real[: self.shape[0], :n1]
@@ -391,7 +412,7 @@ class NonPeriodicConvolution(_MultiplierMixin):
         return out
 
 
-@lru_cache(maxsize=8)
+@functools.lru_cache(maxsize=8)
 def _cached_operator(shape, spacing, e_star, periodic, backend, threads, pruned, effort):
     if periodic:
         return PeriodicConvolution(shape, spacing, e_star, backend, threads, effort)
@@ -444,7 +465,7 @@ def get_operator(
     )
 
 
-@lru_cache(maxsize=8)
+@functools.lru_cache(maxsize=8)
 def array_operator(shape, spacing, e_star, periodic, backend) -> ArrayConvolution:
     """The cached :class:`.array_convolution.ArrayConvolution` of an array backend
     (:data:`.array_backends.ARRAY_BACKENDS`), padded to :func:`fast_padded_shape` when not

@@ -26,6 +26,7 @@ on a virtual machine (benchmarks/README.md, "A second core").
 from __future__ import annotations
 
 import contextlib
+import functools
 import itertools
 import math
 import os
@@ -222,13 +223,27 @@ class SlabTransform:
         start, stop = edge
         return a[start:stop] if self._other == 0 else a[:, start:stop]
 
-    def execute(self) -> None:
-        """Transform every slab; returns when all are done."""
-        first, *others = self._plans
+    def execute(self, before=None, after=None) -> None:
+        """Transform every slab; returns when all are done.
+
+        ``before(start, stop)`` and ``after(start, stop)``, when given, run in a slab's
+        thread just before and just after its transform, with the slab's index range along
+        the axis not transformed. An operator's copies into and out of its work arrays then
+        run on the solve's threads, each beside the slab it feeds, not as a serial pass
+        between transforms.
+        """
+        if before is None and after is None:
+            tasks = [plan.execute for plan in self._plans]
+        else:
+            tasks = [
+                functools.partial(_slab_with_hooks, plan, edge, before, after)
+                for plan, edge in zip(self._plans, self._edges, strict=True)
+            ]
+        first, *others = tasks
         pool = _workers(len(others)) if others else None
-        running = [pool.submit(plan.execute) for plan in others]
+        running = [pool.submit(task) for task in others]
         try:
-            first.execute()
+            first()
         finally:
             # every slab has finished before this returns or raises: none writes into the
             # arrays after the caller has them back
@@ -241,6 +256,15 @@ class SlabTransform:
         strides, alignment; pyfftw checks)."""
         for plan, edge in zip(self._plans, self._edges, strict=True):
             plan.update_arrays(self._slab(src, edge), self._slab(dst, edge))
+
+
+def _slab_with_hooks(plan, edge, before, after) -> None:
+    """One slab of :meth:`SlabTransform.execute` with its hooks."""
+    if before is not None:
+        before(*edge)
+    plan.execute()
+    if after is not None:
+        after(*edge)
 
 
 class TwoPassRealFFT2:
@@ -317,11 +341,9 @@ def axis_fft(
     threads: int = 1,
     planner_effort: str = DEFAULT_PLANNER_EFFORT,
 ):
-    """A 1-D FFT along ``axis`` of 2-D arrays with ``execute()`` and ``update_arrays()``:
-    :class:`SlabTransform` on two threads or more (module doc), one FFTW plan where it
-    would be one slab (:func:`slab_count`)."""
-    if slab_count((src, dst), threads) == 1:
-        return fftw_plan(src, dst, (axis,), inverse=inverse, planner_effort=planner_effort)
+    """A 1-D FFT along ``axis`` of 2-D arrays: a :class:`SlabTransform`, a slab per thread
+    (module doc), or one slab, the whole-array FFTW plan, on one thread or where a second
+    slab would be too small (:func:`slab_count`)."""
     return SlabTransform(
         src, dst, axis, inverse=inverse, threads=threads, planner_effort=planner_effort
     )
