@@ -15,7 +15,8 @@
 # device solves; the CuPy tests last, their kernels compiled by then. STEPS="dispatch
 # scaling" (190 s more; scaling measured on 2026-11-26) times a pass of slabs' dispatch on
 # 1-16 threads (bench_slab_dispatch.py), then runs benchmark 1 at 2048² on 1, 8, 16, 4 and 2
-# threads.
+# threads; scaling_padded (120 s more, not yet run on a device) a padded 1024² window on 1
+# and 8 threads.
 # Each step has its own time limit, so that a slow one leaves the others their time, and
 # writes its log to $OUT/<step>.log as it runs: what a stopped step printed still comes
 # back. Steps run in the order below, whatever the order in STEPS.
@@ -41,9 +42,11 @@ export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
 
 if [[ ${QUICK:-0} == 1 ]]; then
     gpu_sizes=(64 128) large_sizes=(256) scaling_size=256 repeats=1 threads=(1 2)
+    padded_size=128 padded_threads=(1 2)
     profile_size=128 baseline_sizes=(128)
 else
     gpu_sizes=(512 2048) large_sizes=(4096) scaling_size=2048 repeats=3 threads=(1 8 16 4 2)
+    padded_size=1024 padded_threads=(1 8)
     profile_size=2048 baseline_sizes=(2048 4096)
 fi
 
@@ -78,6 +81,8 @@ step profile 40 bash -c "\"$python\" -m cProfile -s tottime bench_gpu.py --backe
 step dispatch 20 "$python" bench_slab_dispatch.py --thread-counts "${threads[@]}" --calls 1000
 step scaling 170 "$python" bench_iteration.py --sizes "$scaling_size" --bc periodic \
     --paths fused --thread-counts "${threads[@]}" --repeats "$repeats"
+step scaling_padded 120 "$python" bench_iteration.py --sizes "$padded_size" --bc non-periodic \
+    --paths fused --thread-counts "${padded_threads[@]}" --repeats "$repeats"
 cd .. || exit 1
 step tests 80 "$python" -m pytest -q -p no:cacheprovider \
     tests/contact/test_array_kernels.py tests/contact/test_device_kernels.py \
