@@ -215,10 +215,11 @@ def _slab_operators(shape, periodic, pruned):
     ref = cls(shape, 0.5, 2.0, backend="numpy", **kw)
     two = cls(shape, 0.5, 2.0, backend="pyfftw", threads=2, planner_effort="FFTW_ESTIMATE", **kw)
     if pruned:
-        transforms = (two._row_fwd, two._col_fwd, two._col_inv, two._row_inv)
-        assert all(isinstance(t, SlabTransform) for t in transforms)
+        passes = (two._row_fwd, two._col_fwd, two._col_inv, two._row_inv)
     else:
         assert isinstance(two._fwd, TwoPassRealFFT2) and isinstance(two._inv, TwoPassRealFFT2)
+        passes = (*two._fwd._passes, *two._inv._passes)
+    assert all(len(one_pass._plans) == 2 for one_pass in passes)
     return ref, two
 
 
@@ -278,6 +279,19 @@ def test_hooks_run_around_each_slab_in_its_own_thread():
     assert threads[0] == {threading.current_thread().name}  # the first: the caller's
 
 
+def test_the_padded_operator_takes_what_one_assignment_would():
+    """The window's rows are copied slab by slab, but the operator takes what one numpy
+    assignment of the whole field took: a field that broadcasts to the window (a constant
+    pressure) gives the numpy backend's answer on two slabs as on one, and a field or an
+    ``out`` of another shape is refused, not cut to the window."""
+    ref, two = _slab_operators((128, 128), False, True)
+    assert _close(two(np.full((1, 128), 3.0)), ref(np.full((128, 128), 3.0)))
+    with pytest.raises(ValueError, match="broadcast"):
+        two(np.ones((130, 128)))
+    with pytest.raises(ValueError, match=r"out has shape \(140, 128\); the window is"):
+        two(np.ones((128, 128)), np.empty((140, 128)))
+
+
 def test_a_row_of_a_taller_array_is_not_taken_as_the_plans_array():
     """numpy calls a one-row slice of a taller array C-contiguous, but its row stride is not
     the planned one (pyfftw would refuse it): it goes through the operator's own arrays."""
@@ -304,6 +318,10 @@ def test_one_pool_serves_transforms_of_every_width():
         SlabTransform(spec, spec, 0, threads=threads, min_points=1).execute()
     room = fft._POOLS[os.getpid()][0]
     assert room >= 7
+    # the threads of a narrower pool this one replaced end once idle: give them a moment
+    deadline = time.monotonic() + 5.0
+    while len(_slab_threads()) > room and time.monotonic() < deadline:
+        time.sleep(0.05)
     assert len(_slab_threads()) <= room
 
 

@@ -338,8 +338,11 @@ class NonPeriodicConvolution(_MultiplierMixin):
         (as :meth:`PeriodicConvolution.forward`; pyfftw backend only)."""
         n0, n1 = self.shape
         if self.pruned:
+            # what one assignment of p would take (a field of the window's shape or one that
+            # broadcasts to it), whole, before any slab copies its rows
+            window = np.broadcast_to(p, self.shape)
             self._row_fwd.execute(
-                before=functools.partial(self._fill_rows, p), after=self._zero_padding
+                before=functools.partial(self._fill_rows, window), after=self._zero_padding
             )
             self._col_fwd.execute()
         else:
@@ -379,6 +382,8 @@ class NonPeriodicConvolution(_MultiplierMixin):
         """Last part: ``out = K*p`` (m) on the window from the multiplied work spectrum."""
         n1 = self.shape[1]
         if self.pruned:
+            if out.shape != self.shape:
+                raise ValueError(f"out has shape {out.shape}; the window is {self.shape}")
             self._col_inv.execute()
             self._row_inv.execute(after=functools.partial(self._take_rows, out))
         else:
