@@ -29,6 +29,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import median_time
 
 from amontons.contact.fft import RealFFT2Pair
 from amontons.contact.pools import solve_pools
@@ -59,14 +60,7 @@ def _fftw_threaded_pair(n: int, threads: int, flags):
 
 def _median_pair_ms(run, real) -> float:
     real[...] = np.random.default_rng(0).random(real.shape)
-    for _ in range(3):
-        run()
-    times = []
-    for _ in range(PAIRS):
-        start = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - start)
-    return 1e3 * statistics.median(times)
+    return 1e3 * median_time(run, PAIRS, warmup=3)
 
 
 def _fftw_library():

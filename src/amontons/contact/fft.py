@@ -232,14 +232,10 @@ class SlabTransform:
         run on the solve's threads, each beside the slab it feeds, not as a serial pass
         between transforms.
         """
-        if before is None and after is None:
-            tasks = [plan.execute for plan in self._plans]
-        else:
-            tasks = [
-                functools.partial(_slab_with_hooks, plan, edge, before, after)
-                for plan, edge in zip(self._plans, self._edges, strict=True)
-            ]
-        first, *others = tasks
+        first, *others = [
+            functools.partial(_slab_with_hooks, plan, edge, before, after)
+            for plan, edge in zip(self._plans, self._edges, strict=True)
+        ]
         pool = _workers(len(others)) if others else None
         running = [pool.submit(task) for task in others]
         try:
