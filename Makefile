@@ -7,7 +7,9 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 CORES  ?= all
 
-.PHONY: reproduce test install clean-venv
+BASE   ?= HEAD
+
+.PHONY: reproduce test install golden-bits clean-venv
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -29,6 +31,11 @@ reproduce: $(STAMP)
 
 test: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest
+
+# A rebuild's same-machine check: the golden cases solved by BASE's solver and by the working
+# tree's, here, compared to the last bit (tests/contact/golden/same_bits.py).
+golden-bits: $(STAMP)
+	$(BIN)/python tests/contact/golden/same_bits.py --base $(BASE)
 
 clean-venv:
 	rm -rf $(VENV)

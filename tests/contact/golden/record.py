@@ -1,10 +1,18 @@
-"""The golden record of the contact solver: a fixed set of solves whose fields the rebuild of
-issue 38 must reproduce to the last bit (tests/contact/test_golden.py).
+"""The golden record of the contact solver: a fixed set of solves that every later version
+must reproduce, to the last bit on the machine that recorded them and to stated tolerances on
+any other (tests/contact/test_golden.py; the tolerances and why: compare.py).
 
-Recorded on 26f01d4, before the rebuild. Run from the repository root to re-record (only
-when a change of the numbers is intended, and say so in the commit):
+The solves are 26f01d4's, before the rebuild of issue 38; re-recorded from that commit's code
+on the machine named in golden.machine.json (same_bits.py --base 26f01d4 --keep). Run from
+the repository root to re-record (only when a change of the numbers is intended, and say so
+in the commit):
 
     python tests/contact/golden/record.py
+
+It writes golden.npz and, beside it, golden.machine.json: the CPU, its vector features and
+the numerical libraries' versions, which decide whether a machine must match the record to
+the last bit. A rebuild that must keep the bits checks them with same_bits.py (``make
+golden-bits BASE=<commit before the change>``).
 
 Every solve plans its transforms with FFTW_ESTIMATE in a process that imports no FFTW wisdom
 (``AMONTONS_FFTW_WISDOM`` empty, set below before the solver is imported): an ESTIMATE plan
@@ -18,16 +26,19 @@ with ``--out`` and compares what it writes with the record.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
 
 import numpy as np
+from compare import machine  # beside this script, which always runs as a script
 
 # No wisdom in this process: the plans are FFTW_ESTIMATE's alone (see above).
 os.environ["AMONTONS_FFTW_WISDOM"] = ""
 
-from amontons.contact import (  # noqa: E402 (after the wisdom setting)
+import amontons  # noqa: E402 (after the wisdom setting)
+from amontons.contact import (  # noqa: E402
     ContactHardening,
     PenetrationHardness,
     self_affine,
@@ -158,6 +169,11 @@ def cases():
     }
 
 
+def machine_path(npz: Path) -> Path:
+    """The machine record beside ``npz``: golden.npz -> golden.machine.json."""
+    return npz.with_suffix(".machine.json")
+
+
 def flatten(result) -> list:
     """A case's results as a flat list (a series is a list, a scan a list of lists)."""
     if isinstance(result, list):
@@ -189,8 +205,10 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description="solve the golden cases and store them")
     parser.add_argument("--out", type=Path, default=PATH, help="npz to write (the record)")
     args = parser.parse_args(argv)
+    print(f"solving with {Path(amontons.__file__).parent}", file=sys.stderr)
     data = compute()
     np.savez_compressed(args.out, **data)
+    machine_path(args.out).write_text(json.dumps(machine(), indent=1) + "\n")
     size = args.out.stat().st_size
     print(f"{len(data)} arrays in {args.out} ({size / 1e6:.2f} MB)", file=sys.stderr)
 
