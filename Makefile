@@ -29,8 +29,14 @@ reproduce: $(STAMP)
 	$(BIN)/snakemake --profile profiles/default --cores $(CORES) --configfile config/config.yaml \
 		--report results/full/report.html
 
+# Every core runs tests (pytest-xdist): one test module per worker at a time, the modules that
+# start long Snakemake runs first (tests/conftest.py), so that a module's fixtures run once.
 test: $(STAMP)
-	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest
+	# the solver's kernels into numba's cache (if cold) once, before the test processes and
+	# their Snakemake jobs need them: a process that finds the cache cold compiles its own
+	$(BIN)/python -c "from amontons.contact.kernel_cache import main; main()"
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest -n auto --dist loadscope \
+		--no-loadscope-reorder
 
 # A rebuild's same-machine check: the golden cases solved by BASE's solver and by the working
 # tree's, here, compared to the last bit (tests/contact/golden/same_bits.py).

@@ -1,9 +1,6 @@
-"""`snakemake accuracy` on the small data (config/test.yaml), after the small run: the table
+"""`snakemake accuracy` on the small data (config/test.yaml), with the small run: the table
 holds every problem at every setting, and the errors fall as the pixel is refined."""
 
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import pandas as pd
@@ -17,17 +14,8 @@ REPO = Path(__file__).resolve().parents[2]
 
 @pytest.fixture(scope="module")
 def accuracy_run(small_run):
-    start = time.perf_counter()
-    result = subprocess.run(
-        [sys.executable, "-m", "snakemake", "-s", str(REPO / "Snakefile"), "-d", str(small_run)]
-        + ["accuracy", "--cores", "2", "--configfile", "config/test.yaml"],
-        cwd=small_run,
-        capture_output=True,
-        text=True,
-        timeout=900,
-    )
-    assert result.returncode == 0, result.stderr[-3000:]
-    print(f"small accuracy study: {time.perf_counter() - start:.1f} s")
+    """The small run's accuracy study: the session's small-data run makes `accuracy` in the
+    same Snakemake call as the rest (tests/workflow/conftest.py)."""
     return small_run / "results" / "small" / "accuracy"
 
 

@@ -64,7 +64,7 @@ def _repack(folder: Path, loads: list[float]) -> None:
 
 
 @pytest.fixture(scope="module")
-def project(small_run, tmp_path_factory):
+def project(small_data, tmp_path_factory):
     """A project after both copies' contact-area jobs, the copies made from the small run's
     virtual PS sphere (the session's small-data run, tests/workflow/conftest.py)."""
     project = tmp_path_factory.mktemp("load_series")
@@ -78,7 +78,7 @@ def project(small_run, tmp_path_factory):
     rows = []
     for name in (PER_LOAD, SERIES):
         folder = project / "lab" / name
-        shutil.copytree(small_run / paths.synthetic_sphere("PS"), folder)
+        shutil.copytree(small_data / paths.synthetic_sphere("PS"), folder)
         (folder / "truth.json").unlink()
         rows.append(ps.assign(sphere=name, data_source=str(folder)))
     _repack(project / "lab" / SERIES, loads)

@@ -20,12 +20,12 @@ SMALL = "small"
 
 
 @pytest.fixture(scope="module")
-def no_prior_run(small_run, tmp_path_factory):
+def no_prior_run(small_data, tmp_path_factory):
     """The virtual PS sphere as measured data, its sheet row without hardness_mpa and
     hardening_k_mpa_per_nm, run with the small config's scenes and scans."""
     tmp_path = tmp_path_factory.mktemp("no_prior")
     folder = tmp_path / "lab" / "PS-noprior"
-    shutil.copytree(small_run / "resources" / "synthetic" / SMALL / "PS", folder)
+    shutil.copytree(small_data / "resources" / "synthetic" / SMALL / "PS", folder)
     (folder / "truth.json").unlink()
     project = tmp_path / "project"
     shutil.copytree(REPO / "config", project / "config")

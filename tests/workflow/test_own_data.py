@@ -78,11 +78,11 @@ def _cut_scans(folder: Path, side_um: float) -> None:
         write_image(folder / name, scan.data[row : row + side, col : col + side], scan.pixel_m)
 
 
-def _lab_sphere(small_run, lab: Path, name: str, remove: list[str]) -> Path:
+def _lab_sphere(small_data, lab: Path, name: str, remove: list[str]) -> Path:
     """A copy of the virtual PS sphere as measured data, less ``remove``, and with its AFM scan
     cut where CUT_SCANS names it."""
     folder = lab / name
-    shutil.copytree(small_run / "resources" / "synthetic" / SMALL / "PS", folder)
+    shutil.copytree(small_data / "resources" / "synthetic" / SMALL / "PS", folder)
     (folder / "truth.json").unlink()
     for entry in remove:
         path = folder / entry
@@ -92,7 +92,7 @@ def _lab_sphere(small_run, lab: Path, name: str, remove: list[str]) -> Path:
     return folder
 
 
-def _project(tmp_path, small_run, spheres: dict[str, list[str]]) -> Path:
+def _project(tmp_path, small_data, spheres: dict[str, list[str]]) -> Path:
     """A project folder whose sheet lists ``spheres`` (name -> files removed), the PS row's
     values each, with two scenes (one rendered, one not) and no scans to keep the run short."""
     project = tmp_path / "project"
@@ -100,7 +100,7 @@ def _project(tmp_path, small_run, spheres: dict[str, list[str]]) -> Path:
     sheet = pd.read_csv(project / "config" / "materials.tsv", sep="\t", dtype=str)
     ps = sheet[sheet["sphere"] == "PS"]
     rows = [
-        ps.assign(sphere=name, data_source=str(_lab_sphere(small_run, tmp_path / "lab", name, rm)))
+        ps.assign(sphere=name, data_source=str(_lab_sphere(small_data, tmp_path / "lab", name, rm)))
         for name, rm in spheres.items()
     ]
     pd.concat(rows).to_csv(project / "config" / "own.tsv", sep="\t", index=False)
@@ -146,12 +146,12 @@ def _made(project, sphere) -> set[str]:
 
 
 @pytest.fixture(scope="module")
-def lab_run(small_run, tmp_path_factory):
+def lab_run(small_data, tmp_path_factory):
     """The run of the complete copy and of one copy per case, with its dry run and the check
     command's plan made before it."""
     tmp_path = tmp_path_factory.mktemp("own_data")
     spheres = {COMPLETE: []} | {n: c[0] for n, c in CASES.items()} | dict.fromkeys(CUT_SCANS, [])
-    project = _project(tmp_path, small_run, spheres)
+    project = _project(tmp_path, small_data, spheres)
     dry = _snakemake(project, "-n")
     check = _check(project)
     run = _snakemake(project, "--cores", "2")
@@ -259,12 +259,12 @@ def _spheres_in(project, table: str) -> set[str]:
     return set(pd.read_csv(project / "results" / SMALL / "PS" / table)["sphere"])
 
 
-def test_one_corrupt_file_stops_only_its_sphere_until_it_is_fixed(small_run, tmp_path):
+def test_one_corrupt_file_stops_only_its_sphere_until_it_is_fixed(small_data, tmp_path):
     """Two spheres, one with a truncated fluorescence image: every output of the other is
     made, and the run exits non-zero naming the file. A rerun makes PS's tables and the
     summary without the failed sphere, marked failed, and still exits non-zero; once the file
     is fixed, the next run puts the sphere back and exits 0 (amontons.workflow.ledger)."""
-    project = _project(tmp_path, small_run, {COMPLETE: [], "PS-corrupt": []})
+    project = _project(tmp_path, small_data, {COMPLETE: [], "PS-corrupt": []})
     image = tmp_path / "lab" / "PS-corrupt" / "fluorescence" / "100.tif"
     intact = image.read_bytes()
     image.write_bytes(intact[:2000])
@@ -386,11 +386,11 @@ def test_the_check_and_the_dry_run_predict_the_loads_outside_the_scan(lab_run):
         assert [float(load) for load in named] == left_out, sphere
 
 
-def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_run, tmp_path):
+def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
     """The p_Y scan (three values, to keep it short) of the sphere whose AFM scan holds three
     loads: every value is solved and compared on those three, the best value's fit is over
     them, and best.json and the model table list 200 and 300 mN as outside_scan."""
-    project = _project(tmp_path, small_run, {"PS-cutscan": []})
+    project = _project(tmp_path, small_data, {"PS-cutscan": []})
     path = project / "config" / "test.yaml"
     config = yaml.safe_load(path.read_text())
     config.update(run_scenes=["penetration_hardness"], run_scans=["p_y"])

@@ -24,6 +24,8 @@ REPO = Path(__file__).resolve().parents[2]
 BIN = Path(sys.executable).parent
 # The run names of config/config.yaml and of its overlay config/test.yaml.
 FULL, SMALL = "full", "small"
+# The small run's overlay as the rerun test edits it (a copy of config/test.yaml).
+RERUN = "rerun.yaml"
 
 
 def measured(project, material, sphere, name, run=SMALL):
@@ -51,8 +53,8 @@ def project(tmp_path):
     return tmp_path
 
 
-def _edit_config(project, edit):
-    path = project / "config" / "test.yaml"
+def _edit_config(project, edit, name="test.yaml"):
+    path = project / "config" / name
     config = yaml.safe_load(path.read_text())
     edit(config)
     path.write_text(yaml.safe_dump(config))
@@ -293,21 +295,25 @@ def _job_stats(stdout: str) -> dict[str, str]:
 
 
 def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
+    """Dry runs on the session's small run. Its overlay is edited as a copy, rerun.yaml,
+    which is the same config under another name (the name only enters error messages):
+    other tests read the same folder's test.yaml at the same time."""
     project = small_run
-    again = snakemake(project, "-n", "--configfile", "config/test.yaml")
+    path = project / "config" / RERUN
+    shutil.copyfile(project / "config" / "test.yaml", path)
+    again = snakemake(project, "-n", "--configfile", f"config/{RERUN}")
     assert "Nothing to be done" in again.stdout + again.stderr
     # The same overlay with its keys in another order is the same config: nothing re-runs.
-    path = project / "config" / "test.yaml"
     overlay = yaml.safe_load(path.read_text())
     reordered = {key: overlay[key] for key in reversed(overlay)}
     reordered["virtual_experiment"] = dict(reversed(overlay["virtual_experiment"].items()))
     path.write_text(yaml.safe_dump(reordered, sort_keys=False))
-    same = snakemake(project, "-n", "--configfile", "config/test.yaml")
+    same = snakemake(project, "-n", "--configfile", f"config/{RERUN}")
     assert "Nothing to be done" in same.stdout + same.stderr
     # A changed setting re-runs exactly the jobs that use it: params hold only their slice.
     # (Key order is kept: Snakemake compares params dicts in order.)
-    _edit_config(project, lambda c: c.update(optics={"psf": {"profile_radius_nm": 1800.0}}))
-    changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
+    _edit_config(project, lambda c: c.update(optics={"psf": {"profile_radius_nm": 1800.0}}), RERUN)
+    changed = snakemake(project, "-n", "--configfile", f"config/{RERUN}")
     # The PSF also renders the three optics scenes of each sphere and every scan value
     # (2 spheres x 2 scans x 7 values): they follow it, and so do the study built on them and
     # the run's answer built on the study (verdict, summary, the report's first page).
@@ -341,8 +347,8 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
 
     # The k scan presses its base scene (hardening) at every value: its 2 x 7 jobs follow,
     # the p_Y scan's do not.
-    _edit_config(project, retune_hardening)
-    changed = snakemake(project, "-n", "--configfile", "config/test.yaml")
+    _edit_config(project, retune_hardening, RERUN)
+    changed = snakemake(project, "-n", "--configfile", f"config/{RERUN}")
     assert _job_stats(changed.stdout) == {
         "simulate_scene": "2",
         "render_scene": "2",
@@ -356,7 +362,7 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
     }
 
 
-def test_own_data_is_measured_and_a_replaced_image_reruns_its_jobs(small_run, tmp_path):
+def test_own_data_is_measured_and_a_replaced_image_reruns_its_jobs(small_data, tmp_path):
     """A sphere whose data_source is a folder of measured files (here a copy of the virtual
     PS sphere, names as a user writes them: 25mN.tif): its measurements run on it, and
     overwriting one image in place re-runs exactly the jobs that read the images - a folder
@@ -364,7 +370,7 @@ def test_own_data_is_measured_and_a_replaced_image_reruns_its_jobs(small_run, tm
     overwritten. The overwritten image shows no contact: it is flagged and left out of the
     fit, and the run goes on."""
     own = tmp_path / "my_data" / "PS-own"
-    shutil.copytree(small_run / "resources" / "synthetic" / SMALL / "PS", own)
+    shutil.copytree(small_data / "resources" / "synthetic" / SMALL / "PS", own)
     (own / "truth.json").unlink()
     for image in (own / "fluorescence").glob("*.tif"):
         image.rename(image.with_name(f"{image.stem}mN.tif"))
@@ -510,7 +516,7 @@ def check_measurements_against_truth(project, material, sphere):
     )
 
 
-def test_own_afm_maps_in_vendor_formats_are_measured(small_run, tmp_path):
+def test_own_afm_maps_in_vendor_formats_are_measured(small_data, small_run, tmp_path):
     """A measured sphere whose AFM scans come as an ISO 25178 x3p file (before) and a
     Gwyddion file (after), written from the virtual PS sphere's float TIFF scans: the topography
     rule reads them through SurfaceTopography and gives the TIFF scans' numbers (to 1e-9
@@ -518,7 +524,7 @@ def test_own_afm_maps_in_vendor_formats_are_measured(small_run, tmp_path):
     from SurfaceTopography import Topography
 
     own = tmp_path / "my_data" / "PS-afm"
-    shutil.copytree(small_run / "resources" / "synthetic" / SMALL / "PS", own)
+    shutil.copytree(small_data / "resources" / "synthetic" / SMALL / "PS", own)
     for stem, writer in (("afm_before", "to_x3p"), ("afm_after", "to_gwy")):
         scan = read_image(own / f"{stem}.tif", allow_nan=True)
         ny, nx = scan.data.shape
