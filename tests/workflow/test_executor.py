@@ -105,7 +105,7 @@ def assert_same_output(ours: Path, reference: Path) -> None:
     assert ours.read_bytes() == reference.read_bytes(), ours
 
 
-def test_cluster_executor_gives_the_local_run_byte_for_byte(tmp_path, request):
+def test_cluster_executor_gives_the_local_run_byte_for_byte(small_run, tmp_path):
     project = tmp_path / "project"
     shutil.copytree(REPO / "config", project / "config")
     logs = tmp_path / "job_logs"
@@ -123,7 +123,5 @@ def test_cluster_executor_gives_the_local_run_byte_for_byte(tmp_path, request):
         p for top in ("results", "resources") for p in (project / top).rglob("*") if p.is_file()
     )
     assert len(produced) >= 30
-    # the session's small run, asked for once this run is done, so that the two run at once
-    small_run = request.getfixturevalue("small_run")
     for path in produced:
         assert_same_output(path, small_run / path.relative_to(project))

@@ -58,7 +58,7 @@ def _best(project, sphere, scan) -> dict:
 
 @pytest.mark.parametrize("scan", ["p_y", "k"])
 def test_a_scan_without_prior_finds_what_the_scan_about_the_prior_finds(
-    no_prior_run, scan, request
+    small_run, no_prior_run, scan
 ):
     """Within one step of the prior-free scan (a factor of its grid's ratio, 1.47 for p_Y and
     1.78 for k by default): the two scans judge the same images on different grids."""
@@ -70,9 +70,6 @@ def test_a_scan_without_prior_finds_what_the_scan_about_the_prior_finds(
     step = math.log(values[1] / values[0])
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["scans"][scan]
     assert len(values) == config["prior_free_steps"]
-    # the session's small run, asked for only now: a session fixture in the signature is made
-    # before the module's run, which then waited for it (tests/workflow/conftest.py)
-    small_run = request.getfixturevalue("small_run")
     with_prior = _best(small_run, "PS", scan)["best"]
     without = _best(project, "PS-noprior", scan)["best"]
     assert abs(math.log(without / with_prior)) <= step * (1 + 1e-9)
