@@ -8,7 +8,7 @@ each bound and why): the same contact set, fields within a stated fraction of th
 iterations within a stated count, a converged residual. It is held to two records: the one
 made on the machine named in golden.machine.json, and one made on another kind of machine
 (earlier-machine.npz, the developers' machine until 2026-11-26), whose round-off differs from
-the first in 16 of the 17 cases, so that the tolerances are tried against a real other CPU
+the first in every one of the 16 cases, so that the tolerances are tried against a real other CPU
 on every run. On a machine of the record's kind (same CPU features and library versions),
 the record must also hold to the last bit.
 

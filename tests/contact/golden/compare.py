@@ -3,10 +3,11 @@ same_bits.py): to the last bit on the machine that made it, to stated tolerances
 
 Other CPUs round differently. FFTW's codelets and numba's compiled kernels follow the CPU's
 vector width and FMA, so the same solve on another kind of machine differs in its last
-bits. Measured on 2026-11-27 against the record (made on 26f01d4's code on the developers'
-machine of then): a 2-core Intel Xeon with AVX-512 and a 2-core AMD EPYC with AVX-512 each
-differ in 16 of the 17 cases, and so does this machine's solve with numpy's pocketfft in
-place of FFTW (``backend="numpy"``). The largest differences, over all three, set the
+bits. Measured on 2026-11-27 against the record made on the developers' machine until
+2026-11-26 (earlier-machine.npz): this 2-core Intel Xeon with AVX-512 (golden.npz's machine)
+and a 2-core AMD EPYC with AVX-512 (issue 48's report) each differ from it in every one of
+the 16 cases, and so does a solve with numpy's pocketfft in place of FFTW
+(``backend="numpy"``). The largest differences, over all three, set the
 bounds below (:data:`ROUTES`).
 
 What a rebuild must show is exact identity on one machine: same_bits.py re-makes the record
