@@ -14,7 +14,7 @@ these fixtures; the first to ask makes them under a file lock in the session's s
 temporary folder, and the others wait for it and read the same folder, so the small data set
 runs once per session however many workers there are. A failed run is recorded beside the
 folder, and every worker that asks then fails with its error instead of running it again.
-Tests only read these folders; the one test that edits the run's config restores it.
+Tests only read these folders (the rerun test edits a copy of the overlay, rerun.yaml).
 """
 
 import contextlib
