@@ -18,10 +18,11 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
-# Re-install whenever the declared dependencies change. --no-compile: Python compiles each
-# module when it is first imported, not every module of every package now (20 s of 46).
+# Re-install whenever the declared dependencies change. (Not --no-compile: where
+# PYTHONDONTWRITEBYTECODE is set, as on the developers' machines, nothing would ever compile
+# the packages' modules, and every process of the tests would parse them anew: 10 s an import.)
 $(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet --no-compile -e ".[test]"
+	$(BIN)/python -m pip install --quiet -e ".[test]"
 	touch $(STAMP)
 
 install: $(STAMP)

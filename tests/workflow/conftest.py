@@ -119,7 +119,7 @@ def small_data(tmp_path_factory) -> Path:
 def small_run(small_data, tmp_path_factory) -> Path:
     """The deployed folder after the whole small-data run, 2 cores, and the accuracy study
     (`snakemake accuracy`), with the report at results/small/report.html. Tests only read it
-    (one edits its config for dry runs, and restores it)."""
+    (the rerun test's dry runs read an edited copy of its overlay)."""
     root = _shared_root(tmp_path_factory)
 
     def make():
