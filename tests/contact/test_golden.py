@@ -17,6 +17,7 @@ FFTW_ESTIMATE plans, so that neither this process's plans nor a wisdom file on t
 enter the bytes. The same-machine check of a rebuild is same_bits.py (``make golden-bits``).
 """
 
+import functools
 import importlib.util
 import json
 import subprocess
@@ -44,15 +45,20 @@ def _load_compare():
 compare = _load_compare()
 
 
+@functools.cache
+def _record(path: Path) -> dict[str, np.ndarray]:
+    """Every array of a record, read once per process (the tests ask for it per case)."""
+    with np.load(path) as data:
+        return {k: data[k] for k in data.files}
+
+
 def _arrays(path: Path, name: str | None = None) -> dict[str, np.ndarray]:
     """The arrays of a record (of one case, if ``name`` is given)."""
-    with np.load(path) as data:
-        return {k: data[k] for k in data.files if name is None or k.split("/")[0] == name}
+    return {k: v for k, v in _record(path).items() if name is None or k.split("/")[0] == name}
 
 
 def _case_names() -> list[str]:
-    with np.load(STORED) as data:
-        return sorted({key.split("/")[0] for key in data.files})
+    return sorted({key.split("/")[0] for key in _record(STORED)})
 
 
 @pytest.fixture(scope="module")
