@@ -38,11 +38,13 @@ reproduce: $(STAMP)
 # a time, so that a module's fixtures run once, and the modules that start long Snakemake runs
 # first (tests/conftest.py).
 test: $(STAMP)
-	# the solver's kernels into numba's cache (if cold) once, before the test processes and
-	# their Snakemake jobs need them: a process that finds the cache cold compiles its own
-	$(BIN)/python -c "from amontons.contact.kernel_cache import main; main()"
+	# the solver's kernels into numba's cache (if cold) once, beside the tests: a test process
+	# or Snakemake job that needs them meanwhile waits on the warm-up's lock, then loads them
+	# (amontons.contact.jit); pytest's start and the first data sets need no kernel
+	$(BIN)/python -c "from amontons.contact.kernel_cache import main; main()" & warm=$$!; \
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadscope \
-		--no-loadscope-reorder
+		--no-loadscope-reorder; tests=$$?; \
+	wait $$warm || { echo "make test: the kernel warm-up failed" >&2; exit 1; }; exit $$tests
 
 # A rebuild's same-machine check: the golden cases solved by BASE's solver and by the working
 # tree's, here, compared to the last bit (tests/contact/golden/same_bits.py).

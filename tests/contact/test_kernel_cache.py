@@ -107,3 +107,51 @@ def test_the_warm_up_solves_reach_their_routes():
         assert 20 < area < 600, (case, area)
         if isinstance(law, PenetrationHardness):
             assert res.pressure.max() > 0.9 * law.p_y, case
+
+
+LOCK_PROBE = """
+import fcntl, sys
+with open(sys.argv[1], "a") as handle:
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        print("held")
+    else:
+        print("free")
+"""
+
+
+def _lock_state(path) -> str:
+    """Whether another process finds the lock file ``path`` held or free."""
+    out = subprocess.run(
+        [sys.executable, "-c", LOCK_PROBE, str(path)],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=60,
+    )
+    return out.stdout.strip()
+
+
+def test_one_process_at_a_time_warms_the_cache(tmp_path):
+    """The warm-up lock lives beside the cache and is held against other processes for
+    the block only (the test workers and a Snakemake run's first jobs start together)."""
+    f = _tiny_cached_function(tmp_path)
+    lock = tmp_path / "__pycache__" / ".amontons-warm-up.lock"
+    with jit.warm_up_lock([f]):
+        assert lock.exists()
+        assert _lock_state(lock) == "held"
+    assert _lock_state(lock) == "free"
+
+
+def test_a_process_that_waited_for_a_warm_cache_compiles_nothing(tmp_path, monkeypatch):
+    """Cold when first asked, warm once the lock is had (another process compiled while
+    this one waited): no child is started."""
+    f = _tiny_cached_function(tmp_path)
+    answers = iter([True, False])
+    started = []
+    monkeypatch.setattr(jit, "is_cold", lambda dispatchers: next(answers))
+    monkeypatch.setattr(jit, "compile_in_child", lambda: started.append(1))
+    monkeypatch.delenv(jit.CHILD_ENV, raising=False)
+    jit.ensure_cached((f,))
+    assert started == []

@@ -8,16 +8,21 @@ kernels would differ from the same solve in every later process in the last bits
 2e-13 of the peak pressure at 256²–512²). So the first process to need the kernels on a
 cold cache compiles them in a child process (:func:`ensure_cached`, which runs
 ``amontons.contact.kernel_cache.main``: tiny solves through every route, from the top of the
-package) and then loads them from the cache like every later process does. The kernels
-(:mod:`.spectrum`, :mod:`.kernels`) enter through :func:`kernel_threads`.
+package) and then loads them from the cache like every later process does. Processes that
+start together (the test workers, a Snakemake run's first jobs, a warm-up beside them) take
+turns on a lock file in the cache folder (:func:`warm_up_lock`): one compiles, the others
+wait and then load. The kernels (:mod:`.spectrum`, :mod:`.kernels`) enter through
+:func:`kernel_threads`.
 """
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import subprocess
 import sys
+import tempfile
 import warnings
 
 import numba
@@ -66,7 +71,35 @@ def ensure_cached(dispatchers) -> None:
     _checked.add(id(dispatchers))
     if os.environ.get(CHILD_ENV) or not is_cold(dispatchers):
         return
-    compile_in_child()
+    with warm_up_lock(dispatchers):
+        # another process may have filled the cache while this one waited
+        if is_cold(dispatchers):
+            compile_in_child()
+
+
+@contextlib.contextmanager
+def warm_up_lock(dispatchers):
+    """Hold an exclusive lock (``flock``) on a file in the cache folder of ``dispatchers``
+    for the block, so that one process at a time warms the cache; the others wait. The
+    file stays (an empty lock file, reused); the lock ends with the block or the process."""
+    path = os.path.join(_cache_folder(dispatchers), ".amontons-warm-up.lock")
+    with open(path, "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _cache_folder(dispatchers) -> str:
+    """The folder numba caches the first of ``dispatchers`` in; the temporary folder where
+    numba does not say (another numba version, ``NUMBA_DISABLE_JIT``)."""
+    try:
+        folder = dispatchers[0]._cache._cache_path
+    except (AttributeError, IndexError):
+        return tempfile.gettempdir()
+    os.makedirs(folder, exist_ok=True)
+    return folder
 
 
 def mark_checked(dispatchers) -> None:

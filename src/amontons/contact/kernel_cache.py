@@ -58,10 +58,18 @@ def warm_up_cases():
 
 
 def main() -> None:
-    """Compile the kernels into the cache if it is cold (``make reproduce``, and the child
-    of :func:`.jit.ensure_cached`)."""
-    if os.environ.get(jit.CHILD_ENV) or is_cold(kernels.ENTRY_POINTS):
-        # this process compiles: its warm-up must not start another child
-        jit.mark_checked(kernels.ENTRY_POINTS)
-        jit.mark_checked(kernels.SPECTRUM_ENTRY_POINTS)
-        warm_up()
+    """Compile the kernels into the cache if it is cold (``make reproduce``, ``make test``,
+    and the child of :func:`.jit.ensure_cached`, whose parent holds the lock)."""
+    if os.environ.get(jit.CHILD_ENV):
+        _compile_here()
+        return
+    with jit.warm_up_lock(kernels.ENTRY_POINTS):
+        if is_cold(kernels.ENTRY_POINTS):
+            _compile_here()
+
+
+def _compile_here() -> None:
+    """The warm-up in this process, which must not start another child."""
+    jit.mark_checked(kernels.ENTRY_POINTS)
+    jit.mark_checked(kernels.SPECTRUM_ENTRY_POINTS)
+    warm_up()
