@@ -9,6 +9,7 @@ from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_json, write_table
 from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_fluorescence_loads
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area, otsu_contact_area
 from amontons.plots import plot_scene_comparison
 from amontons.runlog import run_logged
@@ -43,9 +44,7 @@ def main(
     settings = OtsuSettings.from_config(otsu)
     fields, _, attrs = read_load_series(rendered_path)
     pixel_m = attrs["image_pixel_nm"] * 1e-9
-    images = read_fluorescence_loads(
-        fluorescence, loads_mn, None if pixel_nm is None else pixel_nm * 1e-9, images
-    )
+    images = read_fluorescence_loads(fluorescence, loads_mn, optional_nm_to_m(pixel_nm), images)
     if abs(images[0].pixel_m - pixel_m) > 1e-6 * pixel_m:
         raise RawDataError(
             f"{images[0].path}: pixel {images[0].pixel_m * 1e9:.4g} nm, but the scene was "

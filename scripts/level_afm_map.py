@@ -3,6 +3,7 @@
 import logging
 
 from amontons.io.fields import write_levelled_map
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.scan_lines import line_levelling_mode
 from amontons.runlog import run_logged
 from amontons.simulate.surface import read_and_level_afm_map
@@ -13,7 +14,7 @@ log = logging.getLogger(__name__)
 def main(afm_before: str, levelled_path: str, afm: dict) -> None:
     levelled = read_and_level_afm_map(
         afm_before,
-        fallback_pixel_m=None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
+        fallback_pixel_m=optional_nm_to_m(afm["pixel_nm"]),
         nan_policy=afm["nan_policy"],
         channel=afm["channel"],
         line_levelling=line_levelling_mode(afm["line_levelling"]),

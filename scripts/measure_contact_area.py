@@ -4,6 +4,7 @@ import logging
 
 from amontons.io.files import write_table
 from amontons.io.rawdata import read_fluorescence_loads
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, contact_area_table, image_contact_area
 from amontons.plots import plot_contact_separation
 from amontons.runlog import run_logged
@@ -23,9 +24,7 @@ def main(
     sphere: str,
 ) -> None:
     settings = OtsuSettings.from_config(otsu)
-    images = read_fluorescence_loads(
-        fluorescence, loads_mn, None if pixel_nm is None else pixel_nm * 1e-9, images
-    )
+    images = read_fluorescence_loads(fluorescence, loads_mn, optional_nm_to_m(pixel_nm), images)
     areas = [image_contact_area(image, settings) for image in images]
     table = contact_area_table(loads_mn, images, areas)
     for row in table.itertuples():

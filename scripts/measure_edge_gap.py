@@ -5,6 +5,7 @@ import logging
 from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json
 from amontons.io.rawdata import fluorescence_planes
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings
 from amontons.measure.edge_gap import measure_edge_gap, unmeasured_edge_gap_record
 from amontons.measure.errors import NotMeasurable
@@ -37,7 +38,7 @@ def main(
         result = measure_edge_gap(
             reflection_path,
             image,
-            None if pixel_nm is None else pixel_nm * 1e-9,
+            optional_nm_to_m(pixel_nm),
             choice=choice,
             reflection_choice=ImageChoice(**reflection_images),
             load_mn=reflection_load_mn,

@@ -4,6 +4,7 @@ import logging
 
 from amontons.io.files import write_json, write_table
 from amontons.io.rawdata import fluorescence_planes
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings
 from amontons.measure.intensity import (
     intensity_pressure_record,
@@ -35,7 +36,7 @@ def main(
     result, backgrounds, excluded = measure_intensity_pressure(
         paths,
         loads_mn,
-        None if pixel_nm is None else pixel_nm * 1e-9,
+        optional_nm_to_m(pixel_nm),
         choice=choices,
         otsu=OtsuSettings.from_config(otsu),
         background_margin_px=background_margin_px,

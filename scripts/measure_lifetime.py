@@ -3,6 +3,7 @@
 import logging
 
 from amontons.io.files import write_json
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings
 from amontons.measure.lifetime import measure_lifetime
 from amontons.runlog import run_logged
@@ -13,7 +14,7 @@ log = logging.getLogger(__name__)
 def main(
     flim_path: str,
     lifetime_path: str,
-    pixel_nm: float,
+    pixel_nm: float | None,
     otsu: dict,
     exclude_edge_px: int,
     channel: int | None,
@@ -22,7 +23,7 @@ def main(
     """``channel`` and ``irf_peak_ns`` apply to a PTU file only (config optics.lifetime)."""
     stats = measure_lifetime(
         flim_path,
-        pixel_nm * 1e-9,
+        optional_nm_to_m(pixel_nm),
         otsu=OtsuSettings.from_config(otsu),
         exclude_edge_px=exclude_edge_px,
         channel=channel,

@@ -4,6 +4,7 @@ import logging
 
 from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.psf import measure_bead
 from amontons.plots import plot_psf_profile
 from amontons.runlog import run_logged
@@ -24,7 +25,7 @@ def main(
 ) -> None:
     psf = measure_bead(
         bead_path,
-        None if pixel_nm is None else pixel_nm * 1e-9,
+        optional_nm_to_m(pixel_nm),
         choice=ImageChoice(**images),
         profile_radius_m=profile_radius_nm * 1e-9,
         centroid_radius_m=centroid_radius_nm * 1e-9,

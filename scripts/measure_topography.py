@@ -3,6 +3,7 @@
 import logging
 
 from amontons.io.files import write_json
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.scan_lines import line_levelling_mode
 from amontons.measure.topography import measure_topography
 from amontons.plots import plot_topography
@@ -26,7 +27,7 @@ def main(
     topo = measure_topography(
         before_path,
         after_path,
-        None if afm_pixel_nm is None else afm_pixel_nm * 1e-9,
+        optional_nm_to_m(afm_pixel_nm),
         nan_policy=nan_policy,
         channel=channel,
         line_levelling=line_levelling_mode(line_levelling),

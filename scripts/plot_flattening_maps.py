@@ -15,6 +15,7 @@ import pandas as pd
 from amontons.contact.surfaces import sphere as sphere_cap
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_table
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.flattening import SMOOTHING_PX
 from amontons.measure.scan_lines import line_levelling_mode
 from amontons.measure.topography import measure_topography
@@ -58,7 +59,7 @@ def main(
     topo = measure_topography(
         before_path,
         after_path,
-        None if afm["pixel_nm"] is None else afm["pixel_nm"] * 1e-9,
+        optional_nm_to_m(afm["pixel_nm"]),
         nan_policy=afm["nan_policy"],
         channel=afm["channel"],
         line_levelling=line_levelling_mode(afm["line_levelling"]),

@@ -13,6 +13,7 @@ import pandas as pd
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_table
 from amontons.io.rawdata import read_fluorescence_loads
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
 from amontons.simulate.compare import intersection_over_union
@@ -47,9 +48,7 @@ def main(
     otsu: dict,
     label: str,
 ) -> None:
-    images = read_fluorescence_loads(
-        fluorescence, loads_mn, None if pixel_nm is None else pixel_nm * 1e-9, images
-    )
+    images = read_fluorescence_loads(fluorescence, loads_mn, optional_nm_to_m(pixel_nm), images)
     pixel_m = images[0].pixel_m
     settings = OtsuSettings.from_config(otsu)
     measured = [image_contact_area(image, settings) for image in images]

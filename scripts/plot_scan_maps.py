@@ -10,6 +10,7 @@ import pandas as pd
 from amontons.io.fields import read_load_series
 from amontons.io.files import read_json, write_table
 from amontons.io.rawdata import read_fluorescence_loads
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
 from amontons.simulate.register import Registration, warp_to_measured
@@ -30,9 +31,7 @@ def main(
     otsu: dict,
     label: str,
 ) -> None:
-    images = read_fluorescence_loads(
-        fluorescence, loads_mn, None if pixel_nm is None else pixel_nm * 1e-9, images
-    )
+    images = read_fluorescence_loads(fluorescence, loads_mn, optional_nm_to_m(pixel_nm), images)
     measured = images[-1]
     contact = image_contact_area(measured, OtsuSettings.from_config(otsu))
     box = crop_box(contact.mask)

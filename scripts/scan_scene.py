@@ -14,6 +14,7 @@ from amontons.contact import FreeBoundaryError
 from amontons.io.fields import write_load_series
 from amontons.io.files import read_json, write_json
 from amontons.io.rawdata import fluorescence_planes, read_fluorescence_series
+from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area, image_pixel_m
 from amontons.runlog import run_logged
 from amontons.simulate.compare import compare_loads, sheet_load_index
@@ -91,7 +92,7 @@ def main(
     files, choices = fluorescence_planes(fluorescence, sheet_mn, images)
     images = read_fluorescence_series(
         [files[i] for i in simulated],
-        None if pixel_nm is None else pixel_nm * 1e-9,
+        optional_nm_to_m(pixel_nm),
         [choices[i] for i in simulated],
     )
     measured = [image_contact_area(image, settings) for image in images]

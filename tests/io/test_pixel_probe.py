@@ -4,6 +4,7 @@ says yes, the reader finds a pixel with no sheet value; where it says no, the re
 one."""
 
 import numpy as np
+import ptufile
 import pylibCZIrw.czi as pyczi
 import pytest
 import tifffile
@@ -12,6 +13,7 @@ from amontons.io.confocal import ImageChoice, read_confocal
 from amontons.io.confocal_writers import write_confocal
 from amontons.io.layout import RawDataError
 from amontons.io.pixel_probe import states_pixel_size, tiff_scan_side_m
+from amontons.io.ptu import PtuError, read_ptu_header, read_ptu_image
 from amontons.io.tiff import ImageError, read_tiff, write_image
 
 DATA = np.arange(1, 65, dtype=np.uint16).reshape(8, 8)
@@ -114,3 +116,28 @@ def test_a_tiff_scan_without_a_pixel_or_a_readable_header_has_no_size(tmp_path):
     assert tiff_scan_side_m(preview, 40e-9) is None
     assert tiff_scan_side_m(truncated, 40e-9) is None
     assert tiff_scan_side_m(tmp_path / "absent.tif", 40e-9) is None
+
+
+@pytest.mark.parametrize("pixel_um, states", [(0.2, True), (0.0, False)])
+def test_the_probe_reads_a_ptu_header_as_the_photon_reader_does(tmp_path, pixel_um, states):
+    """The FLIM photons' pixel (ImgHdr_PixResol, µm; 0: none given), read from the tag header
+    with the standard library, agrees with ptufile's reading (amontons.io.ptu)."""
+    path = tmp_path / "flim.ptu"
+    histograms = np.ones((6, 4, 8), np.uint16)
+    ptufile.imwrite(path, histograms, 25e-9, 16e-12, tags={"ImgHdr_PixResol": pixel_um})
+    assert states_pixel_size(path) is states
+    header = read_ptu_header(path)
+    assert header.shape == (6, 4)
+    # µm to m: one rounding
+    assert header.pixel_m == (pytest.approx(0.2e-6, rel=1e-15) if states else None)
+    if not states:
+        with pytest.raises(PtuError, match="no pixel size"):
+            read_ptu_image(path)
+
+
+def test_a_ptu_cut_in_its_header_is_named(tmp_path):
+    path = tmp_path / "flim.ptu"
+    ptufile.imwrite(path, np.ones((4, 4, 8), np.uint16), 25e-9, 16e-12, pixel_resolution=0.2)
+    path.write_bytes(path.read_bytes()[:200])
+    with pytest.raises(RawDataError, match=r"flim\.ptu: the PTU header ends before Header_End"):
+        states_pixel_size(path)

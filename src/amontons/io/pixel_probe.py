@@ -1,16 +1,18 @@
-"""Whether a confocal image's file states its pixel size, and how large a TIFF AFM scan is,
-read from the header alone with the standard library: the workflow asks these when it builds
-the DAG (amontons.workflow.spheres, amontons.workflow.scenes), so that a measured sphere whose
-images carry no pixel size, and whose sheet row gives none, stops the run before any job,
-naming the sphere and the file, and so that the dry run says which loads a scene will leave
-outside a small scan.
+"""Whether an image's file (confocal, FLIM map or photons) states its pixel size, and how
+large a TIFF AFM scan is, read from the header alone with the standard library: the workflow
+asks these when it builds the DAG (amontons.workflow.spheres, amontons.workflow.scenes), so
+that a measured sphere whose images carry no pixel size, and whose sheet row gives none, stops
+the run before any job, naming the sphere and the file, and so that the dry run says which
+loads a scene will leave outside a small scan.
 
 The readers (amontons.io.confocal, amontons.io.tiff) take the pixel from the same places:
 
 - TIFF: the resolution tags with a centimetre or inch unit, an inch resolution above the
   display defaults (amontons.io.tiff); an ImageJ hyperstack: the tags with the ImageJ ``unit``;
   an OME-TIFF: PhysicalSizeX in the OME-XML;
-- CZI: the Scaling of the XML metadata segment (X distance > 0).
+- CZI: the Scaling of the XML metadata segment (X distance > 0);
+- PicoQuant PTU (the FLIM photons, amontons.io.ptu): the header tag ``ImgHdr_PixResol``
+  (µm, > 0).
 
 The same headers say how many series and frames a file holding a sphere's whole load series
 has (:func:`load_plane_count`), so that one with a plane too many or too few stops the run
@@ -167,6 +169,33 @@ def _czi_states_pixel(path: Path) -> bool:
     return False
 
 
+_PTU_MAGIC = b"PQTTTR\x00\x00"
+_PTU_TAG = struct.Struct("<32siIq")  # ident, index, type, value (or the length of what follows)
+_PTU_FLOAT8 = 0x20000008
+_PTU_FOLLOWED = {0x2001FFFF, 0x4001FFFF, 0x4002FFFF, 0xFFFFFFFF}  # arrays, strings, blobs
+_PTU_END = "Header_End"
+
+
+def _ptu_states_pixel(path: Path) -> bool:
+    """Whether the PTU header's ImgHdr_PixResol holds a pixel > 0 (the tags are walked
+    to Header_End; no record is read)."""
+    with open(path, "rb") as stream:
+        if stream.read(16)[:8] != _PTU_MAGIC:
+            raise RawDataError(f"{path}: not a PicoQuant PTU file (no PQTTTR header)")
+        while True:
+            raw = stream.read(_PTU_TAG.size)
+            if len(raw) < _PTU_TAG.size:
+                raise RawDataError(f"{path}: the PTU header ends before Header_End")
+            ident, _, kind, value = _PTU_TAG.unpack(raw)
+            name = ident.rstrip(b"\0").decode("ascii", "replace")
+            if name == _PTU_END:
+                return False
+            if name == "ImgHdr_PixResol" and kind == _PTU_FLOAT8:
+                return struct.unpack("<d", raw[-8:])[0] > 0
+            if kind in _PTU_FOLLOWED:
+                stream.seek(value, 1)
+
+
 def _size(element: ElementTree.Element | None, name: str, get) -> int:
     """A size of ``element`` (1 where it gives none)."""
     value = None if element is None else get(element, name)
@@ -217,11 +246,15 @@ def _header(path: Path, read, *args):
 
 
 def states_pixel_size(path: str | Path) -> bool:
-    """Whether the confocal image ``path`` (a suffix of amontons.io.layout.CONFOCAL_SUFFIXES)
+    """Whether the image ``path`` (a confocal image, a suffix of
+    amontons.io.layout.CONFOCAL_SUFFIXES; a FLIM map ``.tif``; or FLIM photons ``.ptu``)
     states its pixel size in its metadata. Raises RawDataError naming the file when its header
     cannot be read."""
     path = Path(path)
-    read = _czi_states_pixel if confocal_suffix(path) == ".czi" else _tiff_states_pixel
+    if path.suffix.lower() == ".ptu":
+        read = _ptu_states_pixel
+    else:
+        read = _czi_states_pixel if confocal_suffix(path) == ".czi" else _tiff_states_pixel
     return _header(path, read)
 
 

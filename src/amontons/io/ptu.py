@@ -104,9 +104,14 @@ def _check_complete(path: Path, ptu: ptufile.PtuFile) -> None:
         )
 
 
-def _pixel_m(path: Path, ptu: ptufile.PtuFile, fallback_pixel_m: float | None) -> float:
+def _header_pixel_m(ptu: ptufile.PtuFile) -> float | None:
+    """The pixel (m) the header's ImgHdr_PixResol (µm) states; None where it states none."""
     file_um = ptu.tags.get("ImgHdr_PixResol")
-    file_m = float(file_um) / 1e6 if file_um and float(file_um) > 0 else None
+    return float(file_um) / 1e6 if file_um and float(file_um) > 0 else None
+
+
+def _pixel_m(path: Path, ptu: ptufile.PtuFile, fallback_pixel_m: float | None) -> float:
+    file_m = _header_pixel_m(ptu)
     if file_m is None and fallback_pixel_m is None:
         raise PtuError(f"{path}: no pixel size in the PTU header (ImgHdr_PixResol) nor the sheet")
     if file_m is None:
@@ -166,6 +171,27 @@ def _decode(
         moment[start : start + step] = histogram @ centres
         decay += histogram.sum(axis=(0, 1), dtype=np.int64)
     return photons, moment, decay
+
+
+@dataclass(frozen=True)
+class PtuHeader:
+    """What a T3 image-mode PTU's header says of its image: ``shape`` (rows, columns) and
+    ``pixel_m`` (m; None where ``ImgHdr_PixResol`` gives none)."""
+
+    shape: tuple[int, int]
+    pixel_m: float | None
+
+
+def read_ptu_header(path: str | Path) -> PtuHeader:
+    """The image size and pixel of the T3 image-mode PTU ``path``, from its header alone (no
+    photon is decoded: the data check reads this). Raises PtuError naming the file for a
+    file that is missing, not a PTU, cut short or not a T3 image."""
+    path = Path(path)
+    with _open(path) as ptu:
+        _check_image_mode(path, ptu)
+        _check_complete(path, ptu)
+        shape = tuple(int(n) for n in ptu.shape[1:3])
+        return PtuHeader(shape=shape, pixel_m=_header_pixel_m(ptu))
 
 
 def read_ptu_image(

@@ -65,3 +65,9 @@ def si_factor(unit: str, quantity: str) -> float:
             "(also spelled with brackets, µ as μ or u, N·m as N.m, Nm or N m, ° as deg)"
         )
     return table[canonical]
+
+
+def optional_nm_to_m(value_nm: float | None) -> float | None:
+    """A length in nm (a sheet or config value) in m; None, a value left blank, stays None
+    (the reader then takes the file's own value, or names what is missing)."""
+    return None if value_nm is None else value_nm * 1e-9
