@@ -2,9 +2,10 @@
 
 import logging
 
+from amontons.io.export_map import export_maps
 from amontons.io.files import write_table
 from amontons.io.layout import per_load_files, rheometer_name
-from amontons.io.rheometer_export import EXPORT_SHAPES, ExportMap
+from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
 from amontons.measure.friction import measure_friction
 from amontons.runlog import run_logged
 
@@ -22,15 +23,16 @@ def main(
 ) -> None:
     """``rheometer``: the per-load files, or the virtual experiment's folder of them, written
     in ``virtual_format`` (config virtual_experiment.formats.rheometer; None for measured
-    data); ``export``: the column map of the rheometer program's export (config
-    rheometer_export), None for our own CSV."""
+    data); ``export``: the export map(s) of the rheometer programs (config rheometer_export,
+    or the one the sheet names for the sphere; None: none), which read the files that are
+    not our own CSV (amontons.io.rheometer_files)."""
     suffix = ".csv" if virtual_format in (None, "csv") else EXPORT_SHAPES[virtual_format].suffix
     table = measure_friction(
         per_load_files(rheometer, loads_mn, lambda load: rheometer_name(load, suffix)),
         loads_mn,
         median_window_s=median_window_s,
         plateau_fraction=plateau_fraction,
-        export=None if export is None else ExportMap.from_config(export),
+        maps=export_maps(export),
     )
     for row in table.itertuples():
         log.info("%s: %g mN → static %.4g mN", row.file, row.load_mn, row.static_friction_mn)

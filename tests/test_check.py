@@ -6,6 +6,7 @@ import shutil
 
 import numpy as np
 import pandas as pd
+import ptufile
 import pylibCZIrw.czi as pyczi
 import pytest
 import tifffile
@@ -122,4 +123,21 @@ def test_a_load_series_file_with_a_series_too_few_stops_before_any_job(project, 
         r"optics\.images\.load_series puts the sheet's 5 loads .* expected exactly 5 series"
     )
     with pytest.raises(ValueError, match=message):
+        check(["config/own.yaml"], repo / "workflow")
+
+
+def test_a_ptu_with_a_blank_sheet_pixel_is_listed_with_its_headers_pixel(project, repo):
+    """The FLIM photons state their pixel in the PTU header (ImgHdr_PixResol): the check
+    lists it from the file, and a PTU that states none, with the sheet blank, stops before
+    any job naming it."""
+    flim = project / "lab" / "flim.ptu"
+    histograms = np.ones((12, 10, 16), np.uint16)
+    ptufile.imwrite(flim, histograms, 25e-9, 16e-12, pixel_resolution=0.2)
+    (plan,) = check(["config/own.yaml"], repo / "workflow")
+    (record,) = [f for f in plan["files"] if f["path"] == str(flim)]
+    assert record["shape"] == [12, 10] and record["pixel_from"] == "file"
+    assert record["pixel_nm"] == pytest.approx(200.0, rel=1e-12)
+    assert f"{flim} [ptu]: 12×10 px, pixel 200 nm (file)" in report([plan])
+    ptufile.imwrite(flim, histograms, 25e-9, 16e-12, tags={"ImgHdr_PixResol": 0.0})
+    with pytest.raises(ValueError, match=rf"sphere PS: {flim}; expected the sheet's"):
         check(["config/own.yaml"], repo / "workflow")

@@ -17,7 +17,8 @@ from amontons.config import (
     read_sample_sheet,
     validate,
 )
-from amontons.io.rheometer_export import EXPORT_SHAPES, ExportMap
+from amontons.io.export_map import ExportMap
+from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
 from amontons.workflow.run import WorkflowRun, load_workflow_config
 
 

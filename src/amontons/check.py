@@ -16,16 +16,18 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from pathlib import Path
 
 from amontons.config import ConfigError, read_config
 from amontons.io.absorbance import read_absorbance_csv
 from amontons.io.confocal import ImageChoice, LoadPlane, read_confocal
+from amontons.io.export_map import ExportMap, export_maps
 from amontons.io.heightmap import read_heights
-from amontons.io.layout import FLIM_NAME, PLANE_NOUN, RawDataError
-from amontons.io.rheometer import read_rheometer_csv
+from amontons.io.layout import PLANE_NOUN, RawDataError
+from amontons.io.ptu import read_ptu_header
+from amontons.io.rheometer_files import read_rheometer_file, reader_label
 from amontons.io.tiff import read_tiff
 from amontons.workflow.params import image_choice
 from amontons.workflow.run import WorkflowRun
@@ -73,9 +75,27 @@ def _height_map(path: str) -> dict:
     }
 
 
-def _rheometer(path: str) -> dict:
-    trace = read_rheometer_csv(path)
-    return {"rows": len(trace.time_s)}
+def _ptu(path: str) -> dict:
+    header = read_ptu_header(path)
+    pixel_nm = None if header.pixel_m is None else header.pixel_m * 1e9
+    return {"shape": list(header.shape), "pixel_nm": pixel_nm}
+
+
+def flim_reader(path: str) -> Callable[[str], dict]:
+    """A reader for :func:`describe_file` of the FLIM file: its photons' header (``.ptu``),
+    else its map's TIFF tags."""
+    return _ptu if Path(path).suffix.lower() == ".ptu" else _tiff
+
+
+def rheometer_reader(maps: Mapping[str, ExportMap]) -> Callable[[str], dict]:
+    """A reader for :func:`describe_file` of a rheometer file: which reader takes it (our
+    CSV or an export map of ``maps``, amontons.io.rheometer_files) and its rows."""
+
+    def read(path: str) -> dict:
+        reader, trace = read_rheometer_file(path, maps)
+        return {"reader": reader_label(reader), "rows": len(trace.time_s)}
+
+    return read
 
 
 def _absorbance(path: str) -> dict:
@@ -124,11 +144,15 @@ def fluorescence_files(
 
 
 def sphere_files(
-    spheres: Spheres, sphere: str, choices: tuple[ImageChoice, ImageChoice]
+    spheres: Spheres,
+    sphere: str,
+    choices: tuple[ImageChoice, ImageChoice],
+    rheometer_maps: Mapping[str, ExportMap],
 ) -> tuple[list[dict], list[str]]:
     """Every raw file of a measured sphere that is there, described (confocal images through
-    ``choices``: the fluorescence and bead one, the reflection one), and the errors that
-    would stop the run before any job."""
+    ``choices``: the fluorescence and bead one, the reflection one; rheometer files with the
+    reader that takes each, among our CSV and ``rheometer_maps``), and the errors that would
+    stop the run before any job."""
     files, errors = [], []
     fluorescence_pixel = spheres.value(sphere, "fluorescence_pixel_nm")
     image = confocal_reader(choices[0], fluorescence_pixel)
@@ -140,7 +164,7 @@ def sphere_files(
     if spheres.has(sphere, RHEOMETER):
         try:
             files += [
-                describe_file(path, _rheometer, None)
+                describe_file(path, rheometer_reader(rheometer_maps), None)
                 for path in spheres.per_load_inputs(sphere, "rheometer")
             ]
         except RawDataError as error:
@@ -153,8 +177,14 @@ def sphere_files(
         ),
         (spheres.bead_image(sphere), image, fluorescence_pixel),
         (spheres.absorbance_spectrum(sphere), _absorbance, None),
-        (spheres.raw_file(sphere, FLIM_NAME), _tiff, fluorescence_pixel),
     ]
+    try:
+        flim = spheres.flim_path(sphere)
+    except RawDataError as error:  # a flim.tif and a flim.ptu
+        flim = None
+        errors.append(str(error))
+    if flim is not None:
+        singles.append((flim, flim_reader(flim), fluorescence_pixel))
     files += [describe_file(p, read, pixel) for p, read, pixel in singles if Path(p).is_file()]
     for stem in (AFM_BEFORE, AFM_AFTER):
         if spheres.has(sphere, stem):
@@ -191,7 +221,8 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
         choices = tuple(
             ImageChoice(**image_choice(run.config, reflection)) for reflection in (False, True)
         )
-        record["files"], record["errors"] = sphere_files(run.spheres, sphere, choices)
+        maps = export_maps(run.spheres.rheometer_export(sphere, run.config.get("rheometer_export")))
+        record["files"], record["errors"] = sphere_files(run.spheres, sphere, choices, maps)
     side_um = None
     if run.spheres.has(sphere, AFM_BEFORE):
         side_um = scan_side_um(record["files"], run.spheres.afm_path(sphere, AFM_BEFORE))
@@ -222,6 +253,8 @@ def _file_line(record: dict) -> str:
         details.append(f"pixel {record['pixel_nm']:.4g} nm ({record['pixel_from']})")
     elif "pixel_nm" in record:
         details.append("NO PIXEL SIZE (neither the file nor the sheet gives one)")
+    if "reader" in record:
+        details.append(f"read as {record['reader']}")
     if "rows" in record:
         details.append(f"{record['rows']} rows")
     return f"    {path} [{record['format']}]: {', '.join(details)}"

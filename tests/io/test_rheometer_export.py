@@ -10,16 +10,12 @@ import dataclasses
 import numpy as np
 import pytest
 
+from amontons.io.export_map import ExportMap, ExportMapError
 from amontons.io.layout import RawDataError, rheometer_files, rheometer_name
 from amontons.io.rawdata import read_rheometer_traces
 from amontons.io.rheometer import RheometerError, read_rheometer_csv, write_rheometer_csv
-from amontons.io.rheometer_export import (
-    EXPORT_SHAPES,
-    ExportMap,
-    ExportMapError,
-    read_rheometer_export,
-    write_rheometer_export,
-)
+from amontons.io.rheometer_export import read_rheometer_export
+from amontons.io.rheometer_export_shapes import EXPORT_SHAPES, write_rheometer_export
 from amontons.measure.friction import static_friction
 from amontons.virtual.rheometer import rheometer_trace
 
@@ -145,10 +141,10 @@ def test_windows_encodings_read_the_same(tmp_path, encoding):
 
 def test_read_through_the_raw_data_reader_with_the_load_check(tmp_path):
     path = _export(tmp_path, "semicolons")
-    (trace,) = read_rheometer_traces([path], [25.0], _map("semicolons"))
+    (trace,) = read_rheometer_traces([path], [25.0], {"semicolons": _map("semicolons")})
     assert trace.normal_force_n.mean() == pytest.approx(LOAD_N, rel=0.01)
     with pytest.raises(RawDataError, match="mean normal force .* the sheet say 50 mN"):
-        read_rheometer_traces([path], [50.0], _map("semicolons"))
+        read_rheometer_traces([path], [50.0], {"semicolons": _map("semicolons")})
 
 
 def test_the_layout_finds_exports_by_load(tmp_path):

@@ -13,9 +13,10 @@ import pytest
 
 from amontons.config import read_config
 from amontons.io.confocal import read_confocal
+from amontons.io.export_map import ExportMap
 from amontons.io.layout import fluorescence_names, per_load_files, rheometer_files, rheometer_name
 from amontons.io.rawdata import read_bead, read_fluorescence_series, read_rheometer_traces
-from amontons.io.rheometer_export import EXPORT_SHAPES, ExportMap
+from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
 from amontons.io.tiff import read_image
 from amontons.measure.area import OtsuSettings, contact_area_table, image_contact_area
 from amontons.measure.friction import static_friction
@@ -136,7 +137,7 @@ def test_friction_from_the_export_is_the_csvs(routes):
     )
     export = ExportMap.from_config(EXPORT_SHAPES["semicolons"].column_map())
     exported = read_rheometer_traces(
-        rheometer_files(root / "instrument" / "rheometer", loads_mn), loads_mn, export
+        rheometer_files(root / "instrument" / "rheometer", loads_mn), loads_mn, {"export": export}
     )
     for ours, theirs in zip(csv, exported, strict=True):
         a, b = static_friction(ours), static_friction(theirs)

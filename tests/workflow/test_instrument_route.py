@@ -20,10 +20,11 @@ import pandas as pd
 import pytest
 import yaml
 
+from amontons.io.export_map import ExportMap
 from amontons.io.layout import FLIM_NAME, FLIM_PTU_NAME, IMAGE_FORMATS
 from amontons.io.rawdata import read_rheometer_traces
 from amontons.io.rheometer import RheometerError, read_rheometer_csv
-from amontons.io.rheometer_export import EXPORT_SHAPES, ExportMap
+from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
 from amontons.physics.gaussian import FWHM_PER_SIGMA
 from amontons.workflow.paths import CONTACT_AREA, FRICTION, LIFETIME, PSF, TRUTH, RunPaths
 
@@ -183,7 +184,9 @@ def test_friction_is_the_same_within_the_rounding_of_the_units(routes):
     names = [f"rheometer/{load}.csv" for load in loads]
     plain = read_rheometer_traces([routes[PLAIN]["sphere"] / n for n in names], loads)
     instrument = read_rheometer_traces(
-        [routes[INSTRUMENT]["sphere"] / n for n in names], loads, ExportMap.from_config(EXPORT)
+        [routes[INSTRUMENT]["sphere"] / n for n in names],
+        loads,
+        {"export": ExportMap.from_config(EXPORT)},
     )
     for a, b in zip(plain, instrument, strict=True):
         assert a.rotation_radius_m == b.rotation_radius_m

@@ -1,14 +1,17 @@
 """The selected spheres as the DAG reads them: where their raw files lie and which they are."""
 
 import numpy as np
+import ptufile
 import pytest
 import tifffile
 
 from amontons.config import ConfigError
 from amontons.io.confocal_writers import write_confocal
 from amontons.io.layout import RawDataError
+from amontons.io.tiff import write_image
 from amontons.workflow.params import image_choice
 from amontons.workflow.paths import RunPaths
+from amontons.workflow.run import check_rheometer_exports
 from amontons.workflow.spheres import (
     ABSORBANCE,
     AFM_AFTER,
@@ -196,6 +199,34 @@ def test_images_without_a_pixel_and_no_sheet_pixel_stop_the_run_naming_sphere_an
     assert spheres.image_pixel_inputs("syn") == []
 
 
+@pytest.mark.parametrize("name", ["flim.ptu", "flim.tif"])
+def test_a_flim_file_without_a_pixel_stops_the_run_like_any_image(tmp_path, name):
+    """The FLIM file is read at the fluorescence pixel too: a PTU takes its pixel from its
+    header (ImgHdr_PixResol), a map from its TIFF tags; neither there nor in the sheet stops
+    the run before any job, naming the file (not a TypeError in the lifetime job)."""
+    files = {f"fluorescence/{load}.tif": "" for load in (10, 20, 40)}
+    spheres, folder = _spheres(tmp_path, **files)
+    image = np.ones((8, 8), np.uint16)
+    for load in (10, 20, 40):
+        write_confocal(folder / f"fluorescence/{load}.tif", image, 200e-9, "ome_tiff")
+    del spheres.records["lab"]["fluorescence_pixel_nm"]
+    flim = folder / name
+    if name == "flim.ptu":
+        histograms = np.ones((8, 8, 16), np.uint16)
+        ptufile.imwrite(flim, histograms, 25e-9, 16e-12, pixel_resolution=0.2)
+    else:
+        write_image(flim, np.full((8, 8), 1.5), 200e-9)
+    assert spheres.images_without_pixel("lab") == []
+    spheres.check_pixel_sizes()  # the file states its pixel: the sheet may stay blank
+    if name == "flim.ptu":
+        ptufile.imwrite(flim, histograms, 25e-9, 16e-12, tags={"ImgHdr_PixResol": 0.0})
+    else:
+        tifffile.imwrite(flim, np.full((8, 8), 1.5))
+    assert spheres.images_without_pixel("lab") == [str(flim)]
+    with pytest.raises(RawDataError, match=rf"sphere lab: {flim};"):
+        spheres.check_pixel_sizes()
+
+
 # A measured sphere whose one file holds every load (config optics.images.load_series), as
 # the DAG reads it: that file is the input of every job that reads fluorescence, the jobs'
 # images param says which plane is which load, and what cannot be mapped without a guess
@@ -338,3 +369,48 @@ def test_a_load_series_file_with_a_plane_too_many_stops_the_run_naming_sphere_an
     spheres.load_series["axis"] = "series"  # one series: as many as one load needs, not two
     with pytest.raises(RawDataError, match=r"it holds 1 series \(its header says\)"):
         spheres.check_load_series_files()
+
+
+# Two programs' export maps (config rheometer_export), as a lab with two rheometers has them.
+TWO_MAPS = {
+    program: {
+        "columns": {
+            "time": {"column": "Time", "unit": "s"},
+            "angle": {"column": "Angle", "unit": "mrad"},
+            "normal_force": {"column": "Normal force", "unit": "N"},
+            "torque": {"column": torque, "unit": "mN·m"},
+        },
+        "rotation_radius": {"key": "Radius", "unit": "mm"},
+    }
+    for program, torque in (("rheocompass", "Torque"), ("trios", "Torque (motor)"))
+}
+
+
+def test_a_sheet_row_may_name_the_export_map_of_its_spheres_files(tmp_path):
+    """The friction job of a sphere whose row names a map gets that map alone (the DAG's
+    param); a sphere whose row names none gets every map, matched to each file by its
+    header; a single map passes as it is, whatever the row says."""
+    spheres, _ = _spheres(tmp_path)
+    spheres.records["lab"]["rheometer_export"] = "trios"
+    assert spheres.rheometer_export("lab", TWO_MAPS) == {"trios": TWO_MAPS["trios"]}
+    assert spheres.rheometer_export("syn", TWO_MAPS) == TWO_MAPS
+    assert spheres.rheometer_export("syn", None) is None
+    single = TWO_MAPS["trios"]
+    spheres.records["lab"]["rheometer_export"] = "export"
+    assert spheres.rheometer_export("lab", single) == single
+    check_rheometer_exports(TWO_MAPS, {"lab": {"rheometer_export": "trios"}}, "mine.yaml")
+    check_rheometer_exports(single, {"lab": {"rheometer_export": "export"}}, "mine.yaml")
+
+
+def test_a_map_the_config_lacks_or_cannot_read_stops_the_run_before_any_job():
+    message = (
+        r"sphere lab: rheometer_export = 'rspace' in the sheet; expected one of the export "
+        r"maps of mine\.yaml's rheometer_export: \['rheocompass', 'trios'\]"
+    )
+    with pytest.raises(ConfigError, match=message):
+        check_rheometer_exports(TWO_MAPS, {"lab": {"rheometer_export": "rspace"}}, "mine.yaml")
+    with pytest.raises(ConfigError, match=r"rheometer_export: none"):
+        check_rheometer_exports(None, {"lab": {"rheometer_export": "trios"}}, "mine.yaml")
+    bad = {"trios": {**TWO_MAPS["trios"], "decimal": ";"}}
+    with pytest.raises(ConfigError, match=r"mine\.yaml: rheometer_export\.trios\.decimal = ';'"):
+        check_rheometer_exports(bad, {}, "mine.yaml")

@@ -5,17 +5,18 @@ RawDataError naming the file and what was expected.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from amontons.io.absorbance import AbsorbanceError, read_absorbance_csv
 from amontons.io.confocal import NO_CHOICE, ImageChoice, LoadPlane, read_confocal
+from amontons.io.export_map import ExportMap
 from amontons.io.layout import RawDataError, fluorescence_names, per_load_files, same_load
 from amontons.io.ptu import PhotonImage, PtuError, read_ptu_image
-from amontons.io.rheometer import RheometerError, RheometerTrace, read_rheometer_csv
-from amontons.io.rheometer_export import ExportMap, read_rheometer_export
+from amontons.io.rheometer import RheometerError, RheometerTrace
+from amontons.io.rheometer_files import read_rheometer_file
 from amontons.io.tiff import Image, ImageError, read_image
 
 # A rheometer's set-point and its measured normal force differ by its force noise and drift;
@@ -24,10 +25,13 @@ NORMAL_FORCE_TOLERANCE = 0.1
 
 
 def read_rheometer_traces(
-    paths: Sequence[str | Path], loads_mn: Sequence[float], export: ExportMap | None = None
+    paths: Sequence[str | Path],
+    loads_mn: Sequence[float],
+    maps: Mapping[str, ExportMap] | None = None,
 ) -> list[RheometerTrace]:
-    """Every load's rheometer record (``paths``, one per load, in the order of ``loads_mn``):
-    our own CSV, or with ``export`` the program's export read through that column map.
+    """Every load's rheometer record (``paths``, one per load, in the order of ``loads_mn``),
+    each read by what it is: our own CSV, or a program's export through the first of ``maps``
+    (name → column map) whose columns it names (amontons.io.rheometer_files).
 
     Besides the file checks of amontons.io.rheometer.read_rheometer_csv (columns, rotation radius,
     numbers) or amontons.io.rheometer_export.read_rheometer_export (mapped columns, units), the
@@ -37,10 +41,7 @@ def read_rheometer_traces(
     traces = []
     for load, path in zip(loads_mn, paths, strict=True):
         try:
-            if export is None:
-                trace = read_rheometer_csv(path)
-            else:
-                trace = read_rheometer_export(path, export)
+            _, trace = read_rheometer_file(path, maps or {})
         except RheometerError as error:
             raise RawDataError(str(error)) from error
         measured_mn = float(np.mean(trace.normal_force_n)) * 1e3

@@ -46,6 +46,21 @@ def _metadata(lines: list[str]) -> dict[str, str]:
     return metadata
 
 
+def has_own_columns(path: str | Path) -> bool:
+    """Whether ``path`` is laid out as our own CSV: its first line after the ``#`` header
+    names one of :data:`COLUMNS` or more (the reader then says which are missing). False for
+    a file that is not UTF-8 text or cannot be opened."""
+    try:
+        with Path(path).open(encoding="utf-8") as handle:
+            for line in handle:
+                if line.startswith("#") or not line.strip():
+                    continue
+                return bool({cell.strip() for cell in line.split(",")} & set(COLUMNS))
+    except (OSError, UnicodeDecodeError):
+        return False
+    return False
+
+
 def read_rheometer_csv(path: str | Path) -> RheometerTrace:
     """Read one load's rheometer CSV with its '# key: value' header.
 

@@ -4,19 +4,15 @@ An export is a text table: an optional preamble of metadata lines (``key<sep>val
 of column names, optionally a second row of units, then one row per sample. The programs
 differ in the separator (comma, semicolon, tab), the decimal mark (a German locale writes
 decimal commas), where the unit stands (in brackets after the name, ``Torque(N m)`` or
-``Torque [mN·m]``, or on the row below the names) and their column names. The
-:class:`ExportMap` (from config) names, for time, plate angle (or deflection angle), normal
-force and torque, the export's column and, optionally, its unit; optionally where the
-rotation radius stands (a preamble key, a column, or a value in the config). The separator,
-the decimal mark, the header and unit rows are detected, or set by the map.
+``Torque [mN·m]``, or on the row below the names) and their column names. The column map
+(:class:`amontons.io.export_map.ExportMap`, from config) names each channel's column and unit
+and where the rotation radius stands; the separator, the decimal mark, the header and unit
+rows are detected, or set by the map.
 
 Units go through the one table of :mod:`amontons.io.units`. The reader returns the same
 :class:`RheometerTrace` (SI units) as our own CSV (:mod:`amontons.io.rheometer`), so the
-friction measurement does not know which file it came from.
-
-:data:`EXPORT_SHAPES` are three export shapes written the way the programs write them
-(modelled on Malvern rSpace, TA TRIOS and Anton Paar RheoCompass in a German locale), each
-with its writer and its column map: the virtual experiment writes them and the tests read them.
+friction measurement does not know which file it came from. The programs' export shapes that
+the virtual experiment writes are :mod:`amontons.io.rheometer_export_shapes`.
 """
 
 from __future__ import annotations
@@ -24,191 +20,21 @@ from __future__ import annotations
 import codecs
 import csv
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from amontons.io.files import atomic_path
+from amontons.io.export_map import CHANNELS, ExportMap, RadiusSource
 from amontons.io.rheometer import RheometerError, RheometerTrace
 from amontons.io.units import UnitError, canonical_unit, si_factor
 
-# The four channels of a friction test and the quantity (amontons.io.units) of each.
-CHANNELS = {"time": "time", "angle": "angle", "normal_force": "force", "torque": "torque"}
-SEPARATORS = {"tab": "\t", "\t": "\t", ";": ";", ",": ","}
-DECIMALS = (".", ",")
 MIN_ROWS = 10  # as our own CSV (amontons.io.rheometer): a friction trace needs a record
 _NUMBER = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$")
 _COMMA_NUMBER = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
 _VALUE_WITH_UNIT = re.compile(r"^([+-]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][+-]?\d+)?)\s*(.*)$")
 _NAME_WITH_UNIT = re.compile(r"^(.*?)\s*[\[(]([^\[\]()]*)[\])]$")
-
-
-class ExportMapError(ValueError):
-    """A column map (config) that cannot describe an export."""
-
-
-@dataclass(frozen=True)
-class MappedColumn:
-    """One channel's column in the export: its name as the header writes it (without a
-    bracketed unit) and its unit (canonical; None: the unit the file gives)."""
-
-    column: str
-    unit: str | None
-
-
-@dataclass(frozen=True)
-class RadiusSource:
-    """Where the rotation radius stands: a preamble ``key``, a ``column`` (one value), or a
-    ``value`` given in the config; ``unit`` a length unit (None: the file's own)."""
-
-    key: str | None = None
-    column: str | None = None
-    value: float | None = None
-    unit: str | None = None
-
-
-@dataclass(frozen=True)
-class ExportMap:
-    """How to read one program's export (config ``rheometer_export``; config/README.md).
-
-    ``columns``: time, angle, normal_force, torque; ``separator`` one of ``,``, ``;``, tab
-    (None: detected); ``decimal`` ``.`` or ``,`` (None: detected); ``table`` the 1-based
-    table to read where several tables (intervals, steps) hold the columns; ``encoding`` of
-    the text (None: a byte-order mark, else UTF-8, else Windows-1252).
-    """
-
-    columns: Mapping[str, MappedColumn]
-    rotation_radius: RadiusSource | None = None
-    separator: str | None = None
-    decimal: str | None = None
-    table: int | None = None
-    encoding: str | None = None
-
-    @classmethod
-    def from_config(cls, config: Mapping, where: str = "rheometer_export") -> ExportMap:
-        """The map from its config slice (plain data); raises ExportMapError naming the key
-        (``where`` and below), the value and what was expected, an unknown unit included."""
-        if not isinstance(config, Mapping):
-            raise ExportMapError(f"{where} = {config!r}; expected a mapping with 'columns'")
-        known = {"columns", "rotation_radius", "separator", "decimal", "table", "encoding"}
-        _no_other_keys(config, known, where)
-        columns_config = config.get("columns")
-        if not isinstance(columns_config, Mapping):
-            raise ExportMapError(
-                f"{where}.columns = {columns_config!r}; expected a mapping of "
-                f"{', '.join(CHANNELS)} to {{column, unit}}"
-            )
-        _no_other_keys(columns_config, set(CHANNELS), f"{where}.columns")
-        columns = {}
-        for channel, quantity in CHANNELS.items():
-            if channel not in columns_config:
-                raise ExportMapError(
-                    f"{where}.columns has no '{channel}'; expected {{column, unit}} for each of "
-                    f"{', '.join(CHANNELS)}"
-                )
-            columns[channel] = _mapped_column(
-                columns_config[channel], quantity, f"{where}.columns.{channel}"
-            )
-        separator = _choice(config, "separator", SEPARATORS, where)
-        decimal = _choice(config, "decimal", {d: d for d in DECIMALS}, where)
-        table = config.get("table")
-        whole = isinstance(table, int) and not isinstance(table, bool)
-        if table is not None and (not whole or table < 1):
-            raise ExportMapError(f"{where}.table = {table!r}; expected a table number ≥ 1")
-        encoding = config.get("encoding")
-        if encoding is not None:
-            try:
-                codecs.lookup(encoding)
-            except (LookupError, TypeError) as error:
-                raise ExportMapError(
-                    f"{where}.encoding = {encoding!r}; expected a text encoding such as utf-8, "
-                    "utf-16 or cp1252"
-                ) from error
-        radius = config.get("rotation_radius")
-        return cls(
-            columns=columns,
-            rotation_radius=None
-            if radius is None
-            else _radius_source(radius, f"{where}.rotation_radius"),
-            separator=separator,
-            decimal=decimal,
-            table=table,
-            encoding=encoding,
-        )
-
-
-def _no_other_keys(config: Mapping, known: set[str], where: str) -> None:
-    unknown = sorted(set(config) - known)
-    if unknown:
-        raise ExportMapError(f"{where}: unknown keys {unknown}; expected some of {sorted(known)}")
-
-
-def _choice(config: Mapping, key: str, allowed: Mapping[str, str], where: str) -> str | None:
-    value = config.get(key, "auto")
-    if value == "auto":
-        return None
-    if value not in allowed:
-        raise ExportMapError(
-            f"{where}.{key} = {value!r}; expected 'auto' or one of {sorted(set(allowed))}"
-        )
-    return allowed[value]
-
-
-def _checked_unit(unit, quantity: str, where: str) -> str | None:
-    if unit is None:
-        return None
-    if not isinstance(unit, str):
-        raise ExportMapError(f"{where}.unit = {unit!r}; expected a {quantity} unit as text")
-    try:
-        si_factor(unit, quantity)
-    except UnitError as error:
-        raise ExportMapError(f"{where}.unit: {error}") from error
-    return canonical_unit(unit)
-
-
-def _mapped_column(config, quantity: str, where: str) -> MappedColumn:
-    if isinstance(config, str):
-        config = {"column": config}
-    if not isinstance(config, Mapping) or not isinstance(config.get("column"), str):
-        raise ExportMapError(
-            f"{where} = {config!r}; expected {{column: <the export's column name>, unit: <its "
-            f"{quantity} unit, optional>}}"
-        )
-    _no_other_keys(config, {"column", "unit"}, where)
-    return MappedColumn(config["column"], _checked_unit(config.get("unit"), quantity, where))
-
-
-def _radius_source(config, where: str) -> RadiusSource:
-    if not isinstance(config, Mapping):
-        raise ExportMapError(
-            f"{where} = {config!r}; expected one of {{key: <preamble key>}}, {{column: <name>}} "
-            "or {value: <number>}, with a length unit"
-        )
-    _no_other_keys(config, {"key", "column", "value", "unit"}, where)
-    given = [name for name in ("key", "column", "value") if config.get(name) is not None]
-    if len(given) != 1:
-        raise ExportMapError(
-            f"{where} gives {given or 'none'} of key, column, value; expected exactly one"
-        )
-    value = config.get("value")
-    if value is not None and (
-        isinstance(value, bool) or not isinstance(value, int | float) or not value > 0
-    ):
-        raise ExportMapError(f"{where}.value = {value!r}; expected a positive length")
-    unit = _checked_unit(config.get("unit"), "length", where)
-    if value is not None and unit is None:
-        raise ExportMapError(f"{where}: a value needs its unit (e.g. unit: mm)")
-    return RadiusSource(
-        key=config.get("key"),
-        column=config.get("column"),
-        value=None if value is None else float(value),
-        unit=unit,
-    )
-
-
-# --- reading -----------------------------------------------------------------------------------
 
 
 def _decode(path: Path, encoding: str | None) -> str:
@@ -291,6 +117,50 @@ def _headers(lines: list[str], names: dict[str, str], separators) -> list[_Heade
         if best is not None:
             found.append(best)
     return found
+
+
+def _separators(export: ExportMap) -> list[str]:
+    return [export.separator] if export.separator else ["\t", ";", ","]
+
+
+def _names(export: ExportMap) -> dict[str, str]:
+    """Channel (and rotation_radius where it is a column) → the export's column name."""
+    names = {channel: mapped.column for channel, mapped in export.columns.items()}
+    radius_source = export.rotation_radius
+    if radius_source is not None and radius_source.column is not None:
+        names["rotation_radius"] = radius_source.column
+    return names
+
+
+def holds_mapped_columns(path: str | Path, export: ExportMap) -> bool:
+    """Whether a line of the text file ``path`` names every column of ``export``: the map
+    reads it. False for a file that is not text in the map's encoding."""
+    try:
+        lines = _decode(Path(path), export.encoding).splitlines()
+    except RheometerError:
+        return False
+    return bool(_headers(lines, _names(export), _separators(export)))
+
+
+def table_columns(path: str | Path) -> list[str]:
+    """The column names a text table ``path`` seems to have: of its first 500 lines, the one
+    with the most cells that are not all numbers (under a tab, a semicolon or a comma), for
+    an error that says what the file holds. Raises RheometerError naming the file where it
+    is not text."""
+    lines = _decode(Path(path), None).splitlines()
+    best: list[str] = []
+    for line in lines[:500]:
+        if line.startswith("#"):
+            continue
+        for separator in ("\t", ";", ","):
+            if separator not in line:
+                continue
+            cells = _cells(line, separator)
+            if all(_NUMBER.match(c) or not c for c in cells):
+                continue
+            if len(cells) > len(best):
+                best = cells
+    return [cell for cell in best if cell]
 
 
 def _missing_column(path: Path, lines: list[str], export: ExportMap, separators) -> RheometerError:
@@ -470,12 +340,9 @@ def read_rheometer_export(path: str | Path, export: ExportMap) -> RheometerTrace
     """
     path = Path(path)
     lines = _decode(path, export.encoding).splitlines()
-    separators = [export.separator] if export.separator else ["\t", ";", ","]
-    names = {channel: mapped.column for channel, mapped in export.columns.items()}
+    separators = _separators(export)
     radius_source = export.rotation_radius
-    if radius_source is not None and radius_source.column is not None:
-        names["rotation_radius"] = radius_source.column
-    headers = _headers(lines, names, separators)
+    headers = _headers(lines, _names(export), separators)
     if not headers:
         raise _missing_column(path, lines, export, separators)
     if export.table is None and len(headers) > 1:
@@ -520,168 +387,3 @@ def read_rheometer_export(path: str | Path, export: ExportMap) -> RheometerTrace
         metadata=metadata,
         source=str(path),
     )
-
-
-# --- writing: three export shapes --------------------------------------------------------------
-
-
-def _number(value: float, decimal: str) -> str:
-    # 9 significant digits, as our own CSV (amontons.io.rheometer): decimal rounding commutes
-    # with the powers of ten between units, so both files hold the same digits
-    text = f"{value:.9g}"
-    return text.replace(".", ",") if decimal == "," else text
-
-
-def _columns_in_units(trace: RheometerTrace, units: Mapping[str, str]) -> dict[str, np.ndarray]:
-    si = {
-        "time": trace.time_s,
-        "angle": trace.angle_rad,
-        "normal_force": trace.normal_force_n,
-        "torque": trace.torque_n_m,
-    }
-    return {c: np.asarray(si[c]) / si_factor(units[c], CHANNELS[c]) for c in CHANNELS}
-
-
-def _radius_mm(trace: RheometerTrace, path: Path) -> float:
-    if trace.rotation_radius_m is None:
-        raise RheometerError(f"{path}: trace has no rotation radius to write")
-    return trace.rotation_radius_m * 1e3
-
-
-@dataclass(frozen=True)
-class ExportShape:
-    """One program's export: its column names and units, how it lays them out, and where it
-    keeps the rotation radius (``radius_key`` in the preamble, or None: not in the file)."""
-
-    description: str
-    names: Mapping[str, str]
-    units: Mapping[str, str]
-    radius_key: str | None
-    suffix: str
-    write_lines: Callable[[ExportShape, RheometerTrace, Path], list[str]]
-
-    def column_map(self, rotation_radius_mm: float | None = None) -> dict:
-        """The column map (config data, :meth:`ExportMap.from_config`) that reads this shape;
-        a shape without the radius in its file takes ``rotation_radius_mm`` as a value."""
-        config: dict = {
-            "columns": {c: {"column": self.names[c], "unit": self.units[c]} for c in CHANNELS}
-        }
-        if self.radius_key is not None:
-            config["rotation_radius"] = {"key": self.radius_key, "unit": "mm"}
-        elif rotation_radius_mm is not None:
-            config["rotation_radius"] = {"value": rotation_radius_mm, "unit": "mm"}
-        return config
-
-
-def _brackets_lines(shape: ExportShape, trace: RheometerTrace, path: Path) -> list[str]:
-    """Units in brackets after each name, comma-separated, decimal points, no preamble; a
-    first column of text (the program's action name)."""
-    values = _columns_in_units(trace, shape.units)
-    header = ["Action Name"] + [f"{shape.names[c]}({shape.units[c]})" for c in CHANNELS]
-    rows = [
-        ",".join(["Friction test"] + [_number(values[c][i], ".") for c in CHANNELS])
-        for i in range(trace.time_s.size)
-    ]
-    return [",".join(header), *rows]
-
-
-def _unit_row_lines(shape: ExportShape, trace: RheometerTrace, path: Path) -> list[str]:
-    """Tab-separated: a preamble of ``key<tab>value`` lines with the geometry, a ``[step]``
-    section with the step's name, the names row, then the units row below it."""
-    values = _columns_in_units(trace, shape.units)
-    preamble = [
-        "Filename\t" + path.stem,
-        "Instrument name\tvirtual rheometer",
-        *[f"{key}\t{value}" for key, value in trace.metadata.items()],
-        "[Geometry Parameters]",
-        f"{shape.radius_key}\t{_radius_mm(trace, path):.6g} mm",
-        "[step]",
-        "Friction - 1",
-    ]
-    rows = [
-        "\t".join(_number(values[c][i], ".") for c in CHANNELS) for i in range(trace.time_s.size)
-    ]
-    return [
-        *preamble,
-        "\t".join(shape.names[c] for c in CHANNELS),
-        "\t".join(shape.units[c] for c in CHANNELS),
-        *rows,
-    ]
-
-
-def _semicolon_lines(shape: ExportShape, trace: RheometerTrace, path: Path) -> list[str]:
-    """Semicolons and decimal commas (a German locale): a preamble of ``key:;value`` lines,
-    the names row after an ``Interval data:`` cell with a point number and a status column,
-    the units in brackets on the row below, then one row per point."""
-    values = _columns_in_units(trace, shape.units)
-    radius = _number(_radius_mm(trace, path), ",")
-    n = trace.time_s.size
-    preamble = [
-        "Project:;Friction",
-        f"Test:;{path.stem}",
-        *[f"{key}:;{value}" for key, value in trace.metadata.items()],
-        f"{shape.radius_key}:;{radius} mm",
-        f"Interval and data points:;1;{n}",
-    ]
-    names = ["Interval data:", "Point No."] + [shape.names[c] for c in CHANNELS] + ["Status"]
-    units = ["", "[]"] + [f"[{shape.units[c]}]" for c in CHANNELS] + ["[]"]
-    rows = [
-        ";".join(["", str(i + 1)] + [_number(values[c][i], ",") for c in CHANNELS] + ["Dy_auto"])
-        for i in range(n)
-    ]
-    return [*preamble, ";".join(names), ";".join(units), *rows]
-
-
-EXPORT_SHAPES: dict[str, ExportShape] = {
-    "brackets": ExportShape(
-        description="units in brackets after the names (modelled on Malvern rSpace)",
-        names={
-            "time": "Time (action)",
-            "angle": "Angular displacement",
-            "normal_force": "Normal force",
-            "torque": "Torque",
-        },
-        units={"time": "s", "angle": "rad", "normal_force": "N", "torque": "N m"},
-        radius_key=None,
-        suffix=".csv",
-        write_lines=_brackets_lines,
-    ),
-    "units_row": ExportShape(
-        description="units on a second header row, tab-separated (modelled on TA TRIOS)",
-        names={
-            "time": "Step time",
-            "angle": "Displacement",
-            "normal_force": "Axial force",
-            "torque": "Torque",
-        },
-        units={"time": "s", "angle": "mrad", "normal_force": "N", "torque": "µN.m"},
-        radius_key="Rotation radius",
-        suffix=".txt",
-        write_lines=_unit_row_lines,
-    ),
-    "semicolons": ExportShape(
-        description="semicolons and decimal commas with a metadata preamble and units in "
-        "brackets on a second row (modelled on Anton Paar RheoCompass, German locale)",
-        names={
-            "time": "Time",
-            "angle": "Deflection Angle",
-            "normal_force": "Normal Force",
-            "torque": "Torque",
-        },
-        units={"time": "s", "angle": "mrad", "normal_force": "N", "torque": "mN·m"},
-        radius_key="Rotation radius",
-        suffix=".csv",
-        write_lines=_semicolon_lines,
-    ),
-}
-
-
-def write_rheometer_export(path: str | Path, trace: RheometerTrace, shape: str) -> None:
-    """Write ``trace`` as the program of ``shape`` (a key of EXPORT_SHAPES) exports it,
-    atomically (UTF-8, the programs' CRLF line ends)."""
-    if shape not in EXPORT_SHAPES:
-        raise ValueError(f"unknown export shape '{shape}'; expected one of {list(EXPORT_SHAPES)}")
-    path = Path(path)
-    lines = EXPORT_SHAPES[shape].write_lines(EXPORT_SHAPES[shape], trace, path)
-    with atomic_path(path) as tmp:
-        tmp.write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"))

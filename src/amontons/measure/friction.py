@@ -10,7 +10,7 @@ The records are read by amontons.io.rheometer (one CSV per normal load).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,10 +18,10 @@ import numpy as np
 import pandas as pd
 from scipy.ndimage import median_filter
 
+from amontons.io.export_map import ExportMap
 from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_rheometer_traces
 from amontons.io.rheometer import RheometerError, RheometerTrace
-from amontons.io.rheometer_export import ExportMap
 
 
 @dataclass(frozen=True)
@@ -228,13 +228,13 @@ def measure_friction(
     *,
     median_window_s: float,
     plateau_fraction: float,
-    export: ExportMap | None = None,
+    maps: Mapping[str, ExportMap] | None = None,
 ) -> pd.DataFrame:
     """Friction per load from the rheometer records ``rheometer_paths`` (one per load of
-    ``loads_mn``; our CSV, or with ``export`` the program's export read through that column
-    map); units in the column names."""
+    ``loads_mn``; each our CSV, or a program's export read through the first of ``maps``,
+    name → column map, that names its columns); units in the column names."""
     rows = []
-    traces = read_rheometer_traces(rheometer_paths, loads_mn, export)
+    traces = read_rheometer_traces(rheometer_paths, loads_mn, maps)
     for load, trace in zip(loads_mn, traces, strict=True):
         try:
             result = static_friction(

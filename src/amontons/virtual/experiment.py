@@ -32,7 +32,7 @@ from amontons.io.layout import (
     fluorescence_name,
     rheometer_name,
 )
-from amontons.io.rheometer_export import EXPORT_SHAPES
+from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
 from amontons.physics import hertz
 from amontons.physics.newton_rings import ring_gap
 from amontons.virtual.instruments import (

@@ -21,7 +21,7 @@ from amontons.io.confocal_writers import write_confocal
 from amontons.io.heightmap import write_height_map
 from amontons.io.layout import AFM_AFTER_NAME, AFM_BEFORE_NAME
 from amontons.io.ptu import write_ptu_image
-from amontons.io.rheometer_export import write_rheometer_export
+from amontons.io.rheometer_export_shapes import write_rheometer_export
 from amontons.io.tiff import write_image
 from amontons.physics.beer_lambert import EPSILON_M2_PER_MOL, surface_density_per_m2
 from amontons.physics.roughness import flattening_depth, roughness_statistics
@@ -161,7 +161,7 @@ def write_rheometer(
     shape: str = "csv",
 ) -> float:
     """One load's friction test (torque, angle, normal force), as our CSV (``shape`` 'csv') or
-    as a program's export (a key of amontons.io.rheometer_export.EXPORT_SHAPES); returns the
+    as a program's export (a key of amontons.io.rheometer_export_shapes.EXPORT_SHAPES); returns the
     true dynamic friction (N). The trace, and so its noise, is the same in every shape."""
     dynamic = settings.dynamic_fraction * static_friction_n
     trace = rheometer_trace(

@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from amontons.io.layout import IMAGE_FORMATS
-from amontons.io.rheometer_export import EXPORT_SHAPES
+from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
 from amontons.virtual.afm import AfmSettings
 from amontons.virtual.flim import TcspcSettings
 from amontons.virtual.rough_contact import SolverSettings
@@ -114,9 +114,9 @@ class OutputFormats:
 
     ``flim``: 'tif' (the mean arrival time map) or 'ptu' (the time-tagged photons, which need
     ``tcspc``); ``rheometer``: 'csv' (our own) or one of the export shapes of
-    amontons.io.rheometer_export.EXPORT_SHAPES; ``images``: the confocal images' format, a key
-    of amontons.io.layout.IMAGE_FORMATS ('tif', 'ome_tiff', 'czi'). The default is the TIFF and
-    CSV route.
+    amontons.io.rheometer_export_shapes.EXPORT_SHAPES; ``images``: the confocal images'
+    format, a key of amontons.io.layout.IMAGE_FORMATS ('tif', 'ome_tiff', 'czi'). The
+    default is the TIFF and CSV route.
     """
 
     flim: str = "tif"

@@ -25,13 +25,14 @@ from amontons.config.sheet import (
     check_shared_files,
     read_sample_sheet,
 )
+from amontons.io.export_map import ExportMapError, export_maps
 from amontons.io.layout import IMAGE_FORMATS, load_axis_conflict
 from amontons.workflow.accuracy import AccuracyStudy
 from amontons.workflow.ledger import read_held_out
 from amontons.workflow.paths import RunPaths
 from amontons.workflow.resources import SolveResources
 from amontons.workflow.scenes import Scenes
-from amontons.workflow.spheres import Spheres
+from amontons.workflow.spheres import SHEET_EXPORT_COLUMN, Spheres
 from amontons.workflow.study import Study
 from amontons.workflow.summary import Summary
 from amontons.workflow.targets import Targets
@@ -69,7 +70,25 @@ def load_workflow_config(
     check_curvature_pairs(config, source)
     check_accuracy_study(config, sheet, source)
     check_load_series(config["optics"]["images"], source)
+    check_rheometer_exports(config.get("rheometer_export"), selected, source)
     return selected
+
+
+def check_rheometer_exports(value, records: Mapping[str, Mapping], source: str) -> None:
+    """The config's rheometer_export (none, one column map, or named maps;
+    amontons.io.export_map.export_maps) must describe exports, and a sheet row that names a
+    map for its sphere (column rheometer_export) must name one of them."""
+    try:
+        maps = export_maps(value)
+    except ExportMapError as error:
+        raise ConfigError(f"{source}: {error}") from error
+    for sphere, record in records.items():
+        named = record.get(SHEET_EXPORT_COLUMN)
+        if named is not None and named not in maps:
+            raise ConfigError(
+                f"sphere {sphere}: {SHEET_EXPORT_COLUMN} = {named!r} in the sheet; expected one "
+                f"of the export maps of {source}'s rheometer_export: {list(maps) or 'none'}"
+            )
 
 
 def check_load_series(images: Mapping, source: str) -> None:

@@ -68,6 +68,9 @@ NO_PSF = (
     "figure and no model-table row"
 )
 STAND_IN_PSF = "the PSF is optics.psf.stand_in's (psf.json says so); no bead profile figure"
+# The sheet column that names the export map (config rheometer_export) of a sphere's
+# rheometer files.
+SHEET_EXPORT_COLUMN = "rheometer_export"
 # Sheet columns that name a file shared by many spheres, in place of the sphere's own.
 SHARED_FILE_COLUMNS = {BEAD: "bead_file", ABSORBANCE: "absorbance_file"}
 
@@ -151,6 +154,16 @@ class Spheres:
         value = self.records[sphere].get(column)
         return None if value is None else float(value)
 
+    def rheometer_export(self, sphere: str, maps):
+        """The export maps a sphere's rheometer files are read with: the config's
+        rheometer_export ``maps`` as they are, or only the map its sheet row names (column
+        rheometer_export; a single map is named 'export'). Our own CSV reads as such either
+        way (amontons.io.rheometer_files)."""
+        named = self.records[sphere].get(SHEET_EXPORT_COLUMN)
+        if named is None or maps is None or "columns" in maps:
+            return maps
+        return {named: maps[named]}
+
     def pixel_nm(self, sphere: str) -> float | None:
         """The fluorescence images' pixel from the sheet, nm; None where the sheet leaves it
         to the files' metadata."""
@@ -166,18 +179,19 @@ class Spheres:
         return [self.paths.measured(CONTACT_AREA, self.material_of(sphere), sphere)]
 
     def images_without_pixel(self, sphere: str) -> list[str]:
-        """The confocal images of a measured sphere whose sheet row gives no
-        fluorescence_pixel_nm that state no pixel size in their metadata either
-        (amontons.io.pixel_probe); none where the sheet gives one. Images that do not match
-        the loads, or whose header cannot be read, are left to the errors that name them."""
+        """The images of a measured sphere whose sheet row gives no fluorescence_pixel_nm
+        that state no pixel size in their metadata either (amontons.io.pixel_probe): the
+        confocal images (fluorescence, reflection, bead) and the FLIM file (map or photons);
+        none where the sheet gives one. Images that do not match the loads, or whose header
+        cannot be read, are left to the errors that name them."""
         if self.is_synthetic(sphere) or self.pixel_nm(sphere) is not None:
             return []
         try:
             images = self.per_load_inputs(sphere, "fluorescence")
         except RawDataError:
             images = []
-        singles = (self.reflection_image(sphere), self.bead_image(sphere))
-        images += [path for path in singles if os.path.isfile(path)]
+        singles = (self.reflection_image(sphere), self.bead_image(sphere), self.flim_path(sphere))
+        images += [path for path in singles if path is not None and os.path.isfile(path)]
         return [path for path in images if not _states_pixel(path)]
 
     def check_pixel_sizes(self) -> None:
@@ -190,7 +204,7 @@ class Spheres:
                 "images without a pixel size in their metadata, and no fluorescence_pixel_nm "
                 f"in the sheet: {'; '.join(lines)}; expected the sheet's fluorescence_pixel_nm "
                 "for these spheres, or images that state their pixel (OME-TIFF PhysicalSizeX, "
-                "CZI Scaling, TIFF resolution tags)"
+                "CZI Scaling, TIFF resolution tags, PTU ImgHdr_PixResol)"
             )
 
     def load_series_file(self, sphere: str) -> str | None:
