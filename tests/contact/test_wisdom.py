@@ -73,6 +73,17 @@ def test_processes_started_together_share_their_slab_plans(tmp_path):
     assert json.loads(wisdom.read_text())[0].startswith("(fftw-3")
 
 
+def test_a_temporary_a_killed_writer_left_is_removed_by_the_next_write(tmp_path, monkeypatch):
+    """The wisdom is written under its lock: a temporary found then is a killed writer's."""
+    wisdom = tmp_path / "wisdom.json"
+    stale = tmp_path / "wisdom.jsonx8k2_q.tmp"
+    stale.write_text('["(fftw-3.3.10 fftw_wisdom')  # cut short
+    monkeypatch.setenv(WISDOM_ENV, str(wisdom))
+    _plan_new_shape((10, 26))
+    assert json.loads(wisdom.read_text())[0].startswith("(fftw-3")
+    assert not stale.exists()
+
+
 def test_a_corrupt_wisdom_file_is_an_error_naming_it(tmp_path, monkeypatch):
     bad = tmp_path / "wisdom.json"
     bad.write_text("this is not wisdom")

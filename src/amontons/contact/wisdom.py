@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import glob
 import hashlib
 import json
 import os
@@ -123,7 +124,12 @@ def _entries(wisdom):
 
 
 def _write_atomically(path: Path, wisdom) -> None:
-    """Replace ``path`` by the wisdom in one rename: a reader never sees half a file."""
+    """Replace ``path`` by the wisdom in one rename: a reader never sees half a file. Called
+    under the file's lock, so a temporary of an earlier writer is one it left when it was
+    killed: removed first."""
+    for stale in path.parent.glob(f"{glob.escape(path.name)}*.tmp"):
+        with contextlib.suppress(OSError):
+            stale.unlink()
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
     try:
         with os.fdopen(fd, "w") as fh:

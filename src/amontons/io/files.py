@@ -1,12 +1,16 @@
-"""Atomic writes of records (JSON) and tables (CSV): a file is either complete or absent.
+"""Atomic writes of records (JSON) and tables (CSV): a file is either complete or absent,
+and a writer killed mid-write leaves no temporary behind for good (:func:`atomic_path`).
 
 Standard library only: the workflow's helpers import it without the numerical stack.
 """
 
 from __future__ import annotations
 
+import contextlib
+import glob
 import json
 import os
+import socket
 import tempfile
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
@@ -16,10 +20,18 @@ from typing import Any
 
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; move it into place only if the block succeeds."""
+    """Yield a temporary path beside ``path``; move it into place only if the block succeeds.
+
+    The temporary is named ``.<name>.<host>-<pid>.<random><suffix>``: a writer killed before
+    it could clean up (SIGKILL, a node lost) leaves it behind, and the next write of ``path``
+    on the same host removes it once that process is gone (:func:`remove_stale_temporaries`).
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    handle, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    remove_stale_temporaries(path)
+    handle, tmp = tempfile.mkstemp(
+        dir=path.parent, prefix=f"{_temporary_prefix(path)}{os.getpid()}.", suffix=path.suffix
+    )
     os.close(handle)
     try:
         yield Path(tmp)
@@ -27,6 +39,38 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
+
+
+def _temporary_prefix(path: Path) -> str:
+    """The start of the name of every temporary of ``path`` written on this host."""
+    return f".{path.name}.{socket.gethostname()}-"
+
+
+def remove_stale_temporaries(path: str | Path) -> list[Path]:
+    """Remove the temporaries of ``path`` (:func:`atomic_path`) whose writer on this host is
+    no longer running, and return them. A temporary of a live process, or of another host
+    (whose processes this one cannot see), is left alone."""
+    path = Path(path)
+    prefix = _temporary_prefix(path)
+    removed = []
+    for candidate in path.parent.glob(f"{glob.escape(prefix)}*{glob.escape(path.suffix)}"):
+        pid_text = candidate.name[len(prefix) :].split(".", 1)[0]
+        if pid_text.isdigit() and not _running(int(pid_text)):
+            with contextlib.suppress(FileNotFoundError):
+                candidate.unlink()
+            removed.append(candidate)
+    return removed
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` exists on this host (one of another user's counts)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
 
 
 def write_json(path: str | Path, record: Mapping[str, Any]) -> None:
