@@ -106,3 +106,15 @@ def test_the_configs_maps_one_or_named(tmp_path):
         export_maps({"separator": ";", "trios": MAPS_CONFIG["trios"]})
     with pytest.raises(ExportMapError, match=r"rheometer_export = 'trios'; expected null"):
         export_maps("trios")
+
+
+def test_named_maps_added_over_the_templates_single_map_keep_it_as_export():
+    """A lab's config file adds its maps over config/config.yaml's single one, and Snakemake
+    merges the two key by key: the single map's keys stay one map, named 'export', beside
+    the lab's."""
+    merged = {**MAPS_CONFIG["rheocompass"], "trios": MAPS_CONFIG["trios"]}
+    maps = export_maps(merged)
+    assert list(maps) == ["export", "trios"]
+    assert maps["export"] == export_maps(MAPS_CONFIG["rheocompass"])["export"]
+    with pytest.raises(ExportMapError, match=r"rheometer_export\.export: the name of the single"):
+        export_maps({**merged, "export": MAPS_CONFIG["trios"]})

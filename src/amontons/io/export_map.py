@@ -21,9 +21,10 @@ from amontons.io.units import UnitError, canonical_unit, si_factor
 CHANNELS = {"time": "time", "angle": "angle", "normal_force": "force", "torque": "torque"}
 SEPARATORS = {"tab": "\t", "\t": "\t", ";": ";", ",": ","}
 DECIMALS = (".", ",")
-# The name a single map (config rheometer_export with its own 'columns') goes by.
+# The name a single map (config rheometer_export with its own 'columns') goes by, and the
+# keys of a map.
 SINGLE_MAP_NAME = "export"
-_MAP_KEYS = frozenset({"columns", "rotation_radius", "separator", "decimal", "table", "encoding"})
+MAP_KEYS = frozenset({"columns", "rotation_radius", "separator", "decimal", "table", "encoding"})
 
 
 class ExportMapError(ValueError):
@@ -73,7 +74,7 @@ class ExportMap:
         (``where`` and below), the value and what was expected, an unknown unit included."""
         if not isinstance(config, Mapping):
             raise ExportMapError(f"{where} = {config!r}; expected a mapping with 'columns'")
-        _no_other_keys(config, set(_MAP_KEYS), where)
+        _no_other_keys(config, set(MAP_KEYS), where)
         columns_config = config.get("columns")
         if not isinstance(columns_config, Mapping):
             raise ExportMapError(
@@ -190,24 +191,34 @@ def _radius_source(config, where: str) -> RadiusSource:
 
 def export_maps(config, where: str = "rheometer_export") -> dict[str, ExportMap]:
     """The export maps of the config's ``rheometer_export`` (plain data), by name, in the
-    config's order: none for null; one map (a mapping with ``columns``) named
-    :data:`SINGLE_MAP_NAME`; else a mapping of names to maps. Raises ExportMapError naming
-    the key, the value and what was expected."""
+    config's order: none for null; a map's own keys (``columns``, ``rotation_radius``, ...)
+    make one map named :data:`SINGLE_MAP_NAME`, and every other key names a map of its own.
+    Both may stand side by side: a config file that adds named maps over config/config.yaml's
+    single one (Snakemake merges the files key by key) keeps that one as ``export``. Raises
+    ExportMapError naming the key, the value and what was expected."""
     if config is None:
         return {}
-    if not isinstance(config, Mapping):
+    if not isinstance(config, Mapping) or not config:
         raise ExportMapError(
             f"{where} = {config!r}; expected null, one column map (with 'columns'), or named "
             "maps {<name>: {columns: ...}, ...}"
         )
-    if "columns" in config:
-        return {SINGLE_MAP_NAME: ExportMap.from_config(config, where)}
-    clashes = sorted(set(config) & _MAP_KEYS)
-    if clashes or not config:
-        raise ExportMapError(
-            f"{where} has {clashes or 'no entries'} but no 'columns'; expected one column map "
-            "(with 'columns') or named maps {<name>: {columns: ...}, ...}"
-        )
-    return {
-        str(name): ExportMap.from_config(map_, f"{where}.{name}") for name, map_ in config.items()
-    }
+    own = {key: value for key, value in config.items() if key in MAP_KEYS}
+    maps = {}
+    if own:
+        if "columns" not in own:
+            raise ExportMapError(
+                f"{where} has {sorted(own)} but no 'columns'; expected one column map (with "
+                "'columns') or named maps {<name>: {columns: ...}, ...}"
+            )
+        maps[SINGLE_MAP_NAME] = ExportMap.from_config(own, where)
+    for name, value in config.items():
+        if name in MAP_KEYS:
+            continue
+        if name == SINGLE_MAP_NAME and own:
+            raise ExportMapError(
+                f"{where}.{name}: the name of the single map given by {where}'s own keys; "
+                "expected another name"
+            )
+        maps[str(name)] = ExportMap.from_config(value, f"{where}.{name}")
+    return maps

@@ -17,6 +17,7 @@ import os
 import re
 from collections.abc import Mapping
 
+from amontons.io.export_map import MAP_KEYS, SINGLE_MAP_NAME
 from amontons.io.layout import (
     ABSORBANCE_NAME,
     AFM_SUFFIXES,
@@ -160,8 +161,10 @@ class Spheres:
         rheometer_export; a single map is named 'export'). Our own CSV reads as such either
         way (amontons.io.rheometer_files)."""
         named = self.records[sphere].get(SHEET_EXPORT_COLUMN)
-        if named is None or maps is None or "columns" in maps:
+        if named is None or maps is None:
             return maps
+        if named == SINGLE_MAP_NAME:  # the map given by rheometer_export's own keys
+            return {key: value for key, value in maps.items() if key in MAP_KEYS}
         return {named: maps[named]}
 
     def pixel_nm(self, sphere: str) -> float | None:
