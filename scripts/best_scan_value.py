@@ -9,19 +9,45 @@ import pandas as pd
 from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_json, write_table
 from amontons.runlog import run_logged
-from amontons.simulate.scan import ScanError, ScanPoint, best_scan_value, log_area_scatter
+from amontons.simulate.scan import (
+    ScanError,
+    ScanPoint,
+    best_scan_value,
+    log_area_scatter,
+    not_decided_record,
+)
 
 log = logging.getLogger(__name__)
+
+
+def write_not_decided(records: list[dict], table_path: str, best_path: str, scan_name: str):
+    """A scan with nothing to judge: every value's row, none solved, and best.json saying
+    why (amontons.simulate.scan.not_decided_record). An answer, not a failure."""
+    best = {"scan": scan_name, **not_decided_record(records)}
+    log.warning("%s: not decided: %s", scan_name, best["not_decided"])
+    rows = [
+        {
+            "value": record["value"],
+            "log_area_distance": None,
+            "iou_largest": None,
+            "area_ratio_largest": None,
+            "simulated_area_largest_um2": None,
+            "measured_area_largest_um2": None,
+            "best": False,
+            "contact_leaves_window": False,
+            "wall_time_s": record.get("wall_time_s"),
+        }
+        for record in records
+    ]
+    write_table(table_path, pd.DataFrame(rows))
+    write_json(best_path, best)
 
 
 def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str, confidence):
     records = sorted((read_json(p) for p in point_paths), key=lambda r: r["value"])
     if all(r.get("loads") == [] for r in records):  # the scan held no load (scan_scene)
-        raise ScanError(
-            f"scan {scan_name}: sphere {records[0]['sphere']}'s AFM scan holds none of the "
-            f"loads' windows ({len(records[0]['outside_scan'])} loads outside_scan); expected "
-            "a scan covering at least the loads a scan is judged on (three)"
-        )
+        write_not_decided(records, table_path, best_path, scan_name)
+        return
     solved = [r for r in records if r["outside_window"] is None]
     if not solved:
         raise ScanError(

@@ -10,6 +10,7 @@ import pandas as pd
 
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
+from amontons.simulate.scan import is_decided
 from amontons.study_figures import plot_normalised_study
 
 log = logging.getLogger(__name__)
@@ -39,6 +40,11 @@ def main(amontons_paths, best_paths: dict, table_path, figure_paths, reference_l
             ]
     for sphere, path in best_paths.items():
         best = read_json(path)
+        if not is_decided(best):
+            log.warning(
+                "%s: the k scan was not decided (%s); not drawn", sphere, best["not_decided"]
+            )
+            continue
         loads = np.array([r["load_mn"] for r in best["best_loads"]])
         areas = np.array([r["simulated_area_um2"] for r in best["best_loads"]])
         if not np.any(np.isclose(loads, reference_load_mn)):

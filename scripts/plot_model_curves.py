@@ -13,7 +13,8 @@ import pandas as pd
 from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
-from amontons.simulate.scan import estimate_text, grid_best_label
+from amontons.simulate.fits import MIN_FIT_LOADS
+from amontons.simulate.scan import estimate_text, grid_best_label, is_decided
 from amontons.study_figures import Curve, plot_area_curves
 
 log = logging.getLogger(__name__)
@@ -69,7 +70,7 @@ def main(
         }
         for f, a in zip(points.loads_mn, points.areas_um2, strict=True)
     ]
-    curves = []
+    curves, estimates = [], []
     for name, files in scenes.items():
         if "render" in files:
             table = pd.read_csv(files["render"])
@@ -79,15 +80,20 @@ def main(
             loads = [r["load_mn"] for r in rows]
             areas = [r["area_um2"] for r in rows]
             kind = "solver real area"
+        if len(loads) < MIN_FIT_LOADS:  # the AFM scan held fewer loads' windows
+            estimates.append(f"scene {name} not fitted ({len(loads)} loads in the AFM scan)")
+            continue
         curve, summary = fitted_curve(f"scene {name}", loads, areas, confidence, "-")
         curves.append(curve)
         records += [
             {"series": f"scene {name}", "area": kind, "load_mn": f, "area_um2": a, **summary}
             for f, a in zip(curve.loads_mn, curve.areas_um2, strict=True)
         ]
-    estimates = []
-    for path in scans.values():
+    for name, path in scans.items():
         best = read_json(path)
+        if not is_decided(best):  # its AFM scan held no load: no curve to draw
+            estimates.append(f"{name} not decided (no load in the AFM scan)")
+            continue
         estimates.append(estimate_text(best))
         rows = best["best_loads"]
         # the CSV's series keeps its name; the legend names the grid's best as such

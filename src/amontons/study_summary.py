@@ -21,7 +21,8 @@ from pathlib import Path
 import pandas as pd
 
 from amontons.config.scenes import SCAN_MODELS
-from amontons.simulate.scan import PARAMETER_SYMBOLS, interval_text, significant
+from amontons.simulate.fits import NOT_DECIDED, NOT_DECIDED_SOURCE
+from amontons.simulate.scan import PARAMETER_SYMBOLS, interval_text, is_decided, significant
 
 # The models of the verdict, in the order the study discusses them (docs/study.md §4), and
 # how a reader names them.
@@ -155,12 +156,19 @@ def _exponent_text(value, difference) -> str:
     return f"{value:.3f} ({_signed(difference)})"
 
 
+def _not_decided(row: Mapping, model: str) -> bool:
+    """Whether a verdict row's ``model`` comes from a scan that was not decided (its AFM
+    scan held no load: amontons.simulate.scan.not_decided_record)."""
+    source = row.get(f"{model}_source")
+    return isinstance(source, str) and source.endswith(NOT_DECIDED_SOURCE)
+
+
 def model_text(row: Mapping, model: str) -> str:
     """A verdict row's cell for ``model``: exponent, its difference from the measured one,
     and the area ratio at the largest load where the model is rendered."""
     value = row.get(f"{model}_exponent")
     if not _present(value):
-        return "not run"
+        return NOT_DECIDED_SOURCE if _not_decided(row, model) else "not run"
     text = _exponent_text(value, row[f"{model}_exponent_difference"])
     ratio = row.get(f"{model}_area_ratio")
     return text if not _present(ratio) else f"{text}, area ×{ratio:.2f}"
@@ -171,7 +179,7 @@ def parameter_text(row: Mapping, parameter: str) -> str:
     stem = PARAMETER_STEMS[parameter]
     estimate = row.get(f"{stem}_estimate")
     if not _present(estimate):
-        return "not scanned"
+        return NOT_DECIDED_SOURCE if _not_decided(row, SCAN_MODELS[parameter]) else "not scanned"
     low, high = (_cell(row[f"{stem}_{end}"]) for end in ("low", "high"))
     return (
         f"{significant(estimate)} ({interval_text(low, high)}); grid's best "
@@ -342,7 +350,15 @@ def measured_headline(sphere: str, fit: Mapping, path: str) -> Headline:
 
 
 def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
-    """A scan's estimate with its interval and the grid's best (best.json)."""
+    """A scan's estimate with its interval and the grid's best (best.json); for a scan not
+    decided, why."""
+    if not is_decided(best):
+        symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+        return Headline(
+            f"{sphere}: {symbol} of {MODELS[_model_of(best['parameter'])]} ({unit})",
+            f"{NOT_DECIDED_SOURCE}: {best[NOT_DECIDED]}",
+            f"`{path}`: {NOT_DECIDED}",
+        )
     if "estimate" not in best or "grid_best" not in best:
         raise SummaryError(
             f"{path}: no 'estimate' or 'grid_best'; expected a best.json of rule "

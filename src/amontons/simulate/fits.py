@@ -11,6 +11,10 @@ from amontons.fits import fit_power_law
 
 # fit_power_law's standard errors need three points: a scene with fewer loads is not fitted.
 MIN_FIT_LOADS = 3
+# best.json's key that holds why a scan was not decided (amontons.simulate.scan), and how
+# the model table's source names such a scan.
+NOT_DECIDED = "not_decided"
+NOT_DECIDED_SOURCE = "not decided"
 # The exponent columns of a scene that was not fitted: empty, with left_out saying why.
 _NO_EXPONENT = {"estimate": None, "ci_low": None, "ci_high": None}
 
@@ -163,6 +167,9 @@ def model_table_rows(
             }
         )
     for name, best in scan_bests.items():
+        if NOT_DECIDED in best:
+            rows.append(_not_decided_row(sphere, name, best, models, measured))
+            continue
         low, high = best["scatter_interval"]
         rows.append(
             {
@@ -181,3 +188,24 @@ def model_table_rows(
             }
         )
     return rows
+
+
+def _not_decided_row(
+    sphere: str, name: str, best: Mapping, models: Mapping[str, str], measured: Mapping
+) -> dict:
+    """A scan's row where it was not decided (best.json says why): no value, no exponent,
+    and ``left_out`` saying why."""
+    return {
+        "sphere": sphere,
+        "model": models[best["scene"]],
+        "source": f"scan {name}, {NOT_DECIDED_SOURCE}",
+        "area": "rendered Otsu",
+        "parameter": best["parameter"],
+        "value": None,
+        "value_low": None,
+        "value_high": None,
+        **_exponent_columns(_NO_EXPONENT, measured),
+        "area_ratio_largest": None,
+        "iou_largest": None,
+        "left_out": f"{NOT_DECIDED_SOURCE}: {best[NOT_DECIDED]}",
+    }

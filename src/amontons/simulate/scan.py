@@ -47,6 +47,7 @@ import numpy as np
 from scipy import stats
 
 from amontons.config.scenes import SCAN_MODELS
+from amontons.simulate.fits import NOT_DECIDED
 from amontons.simulate.scan_grid import ScanError, scan_values, value_label
 
 __all__ = [
@@ -57,7 +58,9 @@ __all__ = [
     "estimate_text",
     "grid_best_label",
     "grid_best_text",
+    "not_decided_record",
     "interval_text",
+    "is_decided",
     "log_area_distance",
     "log_area_scatter",
     "scan_values",
@@ -261,11 +264,45 @@ def best_scan_value(
     )
 
 
+def is_decided(best: Mapping) -> bool:
+    """Whether a best.json record holds a judgement (else :data:`NOT_DECIDED` says why)."""
+    return NOT_DECIDED not in best
+
+
+def not_decided_record(points: Sequence[Mapping]) -> dict:
+    """best.json of a scan with nothing to judge: its AFM scan holds none of the loads'
+    windows, so no value was solved (``points``: every value's scan_point.json, which then
+    carries the scan's size and the largest window about the apex it holds). Says why, with
+    the loads left out and each one's window, the scan's size and the largest window in it
+    (µm); no estimate, interval or grid's best."""
+    first = points[0]
+    outside = first["outside_scan"]
+    windows = [row["window_um"] for row in outside]
+    scan = " × ".join(f"{side:.1f}" for side in first["scan_um"])
+    loads = ", ".join(f"{row['load_mn']:g}" for row in outside)
+    why = (
+        f"the AFM scan ({scan} µm) holds no load's window about the apex: the largest window "
+        f"it holds is {first['largest_window_in_scan_um']:.1f} µm, and the windows of the "
+        f"loads ({loads} mN) need {min(windows):.1f} to {max(windows):.1f} µm; a scan is "
+        "judged on the loads whose window the scan holds"
+    )
+    return {
+        "sphere": first["sphere"],
+        "scene": first["scene"],
+        "parameter": first["parameter"],
+        "values": [point["value"] for point in points],
+        NOT_DECIDED: why,
+        "outside_scan": outside,
+        "scan_um": first["scan_um"],
+        "largest_window_in_scan_um": first["largest_window_in_scan_um"],
+    }
+
+
 def estimate_columns(best: Mapping | None) -> dict:
     """A scan's estimate and the interval that belongs to it, as model-table columns, from its
-    best.json record (``None``, for a scene's row: empty columns). The interval's ends are
-    ``None`` where it is open at the scan's end."""
-    if best is None:
+    best.json record (``None``, for a scene's row, or a scan not decided: empty columns). The
+    interval's ends are ``None`` where it is open at the scan's end."""
+    if best is None or not is_decided(best):
         return {"estimate": None, "estimate_low": None, "estimate_high": None}
     low, high = best["scatter_interval"]
     return {"estimate": best["estimate"], "estimate_low": low, "estimate_high": high}
