@@ -56,13 +56,16 @@ def main(
         "value": value,
         "outside_scan": coverage.to_record()["outside_scan"],
     }
+    if coverage.clipped_from_m is not None:  # the scan clipped the window: say by how much
+        record["window_clipped"] = coverage.to_record()["window_clipped"]
     if scene is None:
         # The window does not depend on the scanned parameter: no value has a load to solve,
         # and best_scan_value says so.
         log.warning("%s = %g: the AFM scan holds no load's window", scan["parameter"], value)
         write_load_series(fields_path, [], [], record)
-        write_json(point_path, {**record, "log_area_distance": None, "outside_window": None,
-                                "loads": []})  # fmt: skip
+        # the scan's size and the largest window in it: what best_scan_value says why with
+        write_json(point_path, {**record, **coverage.to_record(), "log_area_distance": None,
+                                "outside_window": None, "loads": []})  # fmt: skip
         return
     indenter = afm_indenter(levelled, scene, levelled_path)
     try:

@@ -169,9 +169,18 @@ def test_the_dag_reads_a_tiff_scans_size_and_names_the_loads_it_leaves_out(measu
     for scene, entry in coverage.items():
         assert all(row["window_um"] > 50.0 for row in entry["outside_scan"]), scene
     lines = run.outside_scan()
-    assert len(lines) == sum(map(len, left_out.values()))
-    for line in lines:
+    outside = [line for line in lines if "mN outside_scan" in line]
+    clipped = [line for line in lines if "window clipped from" in line]
+    assert len(outside) == sum(map(len, left_out.values()))
+    assert len(outside) + len(clipped) == len(lines)
+    for line in outside:
         assert line.startswith("sphere PS (PS): scene ") and "µm exceeds the 50.0 µm scan" in line
+    # a scene whose kept loads' own window exceeds the scan says it will be clipped
+    # hardening's window is 1.5 × the Hertz diameter: 100 mN's 55 µm is clipped to the scan
+    assert coverage["hardening"]["clipped_from_um"] > 50.0
+    assert len(clipped) == sum(c["clipped_from_um"] is not None for c in coverage.values())
+    for line in clipped:
+        assert line.startswith("sphere PS (PS): scene ") and "to the 50.0 µm scan for" in line
     assert any(
         line.startswith("sphere PS (PS): scene elastic: 300 mN outside_scan") for line in lines
     )

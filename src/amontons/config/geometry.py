@@ -1,6 +1,6 @@
 """A scene's solver window and grid, in SI units: the one geometry that the simulation
 (amontons.simulate.scene) solves on and that the workflow sizes jobs and checks windows with
-(docs/simulate.md, "Window and grid").
+(docs/simulate.md §2).
 
 A window is ``side_px`` × ``pixel_nm`` where a scene gives ``side_px``, else ``window_factor``
 × the Hertz contact diameter at the largest load; its pixel is ``pixel_nm``, coarsened where
@@ -12,6 +12,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import NamedTuple
+
+# The least window over a load's Hertz contact diameter that a window clipped to a small AFM
+# scan may keep (docs/simulate.md §2, "A scan smaller than the contact"): the virtual PS
+# sphere's contacts fit from 1.15-1.25 at 50-300 mN under both models, at the draft and the
+# standard pixel (benchmarks/window_margin.py, 2026-11-27); at 25 mN, rougher relative to its
+# contact, from 1.4-1.5. A contact that still reaches the clipped window's edge is refused
+# by the solver and its load left out (amontons.simulate.solve.solve_on_clipped_window); one
+# that does not has the area of an unclipped window, to the pixel.
+CONTACT_MARGIN = 1.25
 
 
 class GeometryError(ValueError):
@@ -93,24 +102,33 @@ def grid_window_m(name: str, scene: Mapping, frame: Frame) -> float:
 
 
 class LeftOutLoad(NamedTuple):
-    """A load whose window (m) does not fit in the AFM scan about the sphere's apex."""
+    """A load whose window (m) does not fit in the AFM scan about the sphere's apex, or
+    (``reason``) whose contact reached the edge of the window the scan clipped."""
 
     load_n: float
     window_m: float
+    reason: str | None = None
 
     def to_record(self) -> dict:
-        """JSON-ready: the load (mN) and the window it needs (µm)."""
-        return {"load_mn": self.load_n * 1e3, "window_um": self.window_m * 1e6}
+        """JSON-ready: the load (mN), the window it needs (µm) and, where it was solved on a
+        clipped window and its contact reached the edge, that reason."""
+        record = {"load_mn": self.load_n * 1e3, "window_um": self.window_m * 1e6}
+        if self.reason is not None:
+            record["reason"] = self.reason
+        return record
 
 
 class InScan(NamedTuple):
-    """A scene's frame cut to the loads an AFM scan holds, the loads left out, and the window
-    (m) and solver pixel (m) the kept loads are solved on (None, None where none is kept)."""
+    """A scene's frame cut to the loads an AFM scan holds, the loads left out, the window
+    (m) and solver pixel (m) the kept loads are solved on (None, None where none is kept),
+    and the window (m) the kept loads would have had where the scan clipped it (None where
+    they are solved on their own window)."""
 
     frame: Frame
     left_out: tuple[LeftOutLoad, ...]
     window_m: float | None
     pixel_m: float | None
+    clipped_from_m: float | None = None
 
 
 def _grid_within(scene: Mapping, limit_m: float) -> tuple[float, float]:
@@ -121,29 +139,42 @@ def _grid_within(scene: Mapping, limit_m: float) -> tuple[float, float]:
     return (n - n % 2) * pixel, pixel
 
 
+def contact_room_m(frame: Frame, load_n: float) -> float:
+    """The least window (m) a load's contact is solved on: :data:`CONTACT_MARGIN` × its
+    Hertz contact diameter (docs/simulate.md, "A scan smaller than the contact")."""
+    return CONTACT_MARGIN * hertz_diameter_m(load_n, frame.radius_m, frame.e_star_pa)
+
+
 def frame_in_scan(name: str, scene: Mapping, frame: Frame, scan_window_m: float) -> InScan:
     """The frame cut to the loads a scan holds, and the loads left out (``outside_scan``).
 
     ``scan_window_m`` is the side (m) of the largest square about the sphere's apex that lies
     inside the AFM scan. A load is kept where the grid window sized on it as the largest load
-    fits in that square; the loads increase, so the ones left out are the largest. A scene with
-    a fixed ``side_px`` keeps all its loads or none. The kept loads are solved on the frame's
-    own window where the scan holds it, else on the largest grid window the scan holds, which
-    is never smaller than the one sized on the largest load kept: as much room about the
-    contact as the scan allows.
+    fits in that square, or, failing that, where its contact does with the room the solver
+    needs (:func:`contact_room_m`); the loads increase, so the ones left out are the largest.
+    A scene with a fixed ``side_px`` keeps all its loads or none. The kept loads are solved
+    on the frame's own window where the scan holds it, else on the largest grid window the
+    scan holds: as much room about the contact as the scan allows; where that is smaller than
+    their own window, ``clipped_from_m`` is their own window.
     """
+    fixed = scene.get("side_px") is not None
     kept: list[float] = []
     left_out: list[LeftOutLoad] = []
     for load in frame.loads_n:
         window = grid_window_m(name, scene, frame._replace(loads_n=(*kept, load)))
-        if left_out or window > scan_window_m:
+        fits = window <= scan_window_m or (
+            not fixed and contact_room_m(frame, load) <= scan_window_m
+        )
+        if left_out or not fits:
             left_out.append(LeftOutLoad(load, window))
         else:
             kept.append(load)
     cut = frame._replace(loads_n=tuple(kept))
     if not kept:
         return InScan(cut, tuple(left_out), None, None)
-    if not left_out:
+    own = grid_window_m(name, scene, cut)
+    if not left_out and own <= scan_window_m:
         window = window_m(name, scene, frame)
         return InScan(cut, (), window, solver_pixel_m(scene, window))
-    return InScan(cut, tuple(left_out), *_grid_within(scene, scan_window_m))
+    held, pixel = _grid_within(scene, scan_window_m)
+    return InScan(cut, tuple(left_out), held, pixel, own if own > scan_window_m else None)

@@ -196,11 +196,13 @@ def scene_for_sphere(name: str, config: Mapping, sphere: str, record: Mapping) -
 
 def scene_in_scan(
     name: str, config: Mapping, sphere: str, record: Mapping, scan_window_m: float
-) -> tuple[Scene | None, tuple[geometry.LeftOutLoad, ...]]:
-    """The scene ``name`` on the AFM map of ``sphere`` cut to the loads whose window fits in
-    the largest square about the apex that the scan holds (``scan_window_m``, m), and the loads
-    left out, on the window amontons.config.geometry.frame_in_scan gives them (the scene's own
-    where the scan holds every load); where no load fits, the scene is None."""
+) -> tuple[Scene | None, geometry.InScan]:
+    """The scene ``name`` on the AFM map of ``sphere`` cut to the loads whose window, or
+    whose contact with the room the solver needs, fits in the largest square about the apex
+    that the scan holds (``scan_window_m``, m), on the window
+    amontons.config.geometry.frame_in_scan gives them (the scene's own where the scan holds
+    it), and that cut (the loads left out, the window clipped); where no load fits, the
+    scene is None."""
     if config["surface"] != "afm_before":
         raise SceneError(f"scene {name}: surface = {config['surface']!r} is not a sphere's map")
     frame = geometry.sphere_frame(config, record)
@@ -209,9 +211,9 @@ def scene_in_scan(
     except geometry.GeometryError as exc:
         raise SceneError(str(exc)) from exc
     if not cut.frame.loads_n:
-        return None, cut.left_out
+        return None, cut
     scene = _scene(name, config, cut.frame, record={**record, "sphere": sphere})
-    return replace(scene, window_m=cut.window_m, pixel_m=cut.pixel_m), cut.left_out
+    return replace(scene, window_m=cut.window_m, pixel_m=cut.pixel_m), cut
 
 
 def synthetic_scene(name: str, config: Mapping) -> Scene:

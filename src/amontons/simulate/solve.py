@@ -16,11 +16,11 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from amontons.contact import ContactResult, solve_load_series
+from amontons.contact import ContactResult, FreeBoundaryError, solve_load_series
 from amontons.contact.greenwood_tripp import AsperityModel, greenwood_tripp
 from amontons.simulate.scene import Scene
 from amontons.simulate.surface import Indenter
@@ -100,6 +100,36 @@ def solve_scene(
         per_load=[_diagnostics(r) for r in results],
         wall_time_s=time.perf_counter() - start,
     )
+
+
+def solve_on_clipped_window(
+    scene: Scene, indenter: Indenter, *, threads: int = 1, backend: str = "cpu"
+) -> tuple[SceneSolution | None, tuple[float, ...]]:
+    """A scene on a window the AFM scan clipped (amontons.config.geometry.frame_in_scan): its
+    load series, and where the largest load's contact reaches the window's edge (the solver's
+    FreeBoundaryError), the series without it, and so on down. Returns the solution of the
+    loads kept (None where none is) and the loads dropped (N, increasing).
+
+    On a window that holds the contact, the contact is that of an unclipped window to the
+    pixel (docs/simulate.md §2, "A scan smaller than the contact", measured by
+    benchmarks/window_margin.py): the edge is the test of room."""
+    loads = scene.loads_n
+    while loads:
+        try:
+            solution = solve_scene(
+                replace(scene, loads_n=loads), indenter, threads=threads, backend=backend
+            )
+        except FreeBoundaryError as error:
+            log.info(
+                "%s: %g mN left out: its contact reaches the clipped window's edge (%s)",
+                scene.name,
+                loads[-1] * 1e3,
+                error,
+            )
+            loads = loads[:-1]
+            continue
+        return solution, scene.loads_n[len(loads) :]
+    return None, scene.loads_n
 
 
 def greenwood_tripp_scene(

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -173,20 +173,44 @@ def scan_window_m(levelled: LevelledMap) -> float:
 @dataclass(frozen=True)
 class ScanCoverage:
     """What of a scene's loads a sphere's AFM scan holds: the scan's width and height (m), the
-    largest window about the fitted apex inside it (m) and the loads left out, each with the
-    window it needs (amontons.config.geometry.LeftOutLoad)."""
+    largest window about the fitted apex inside it (m), the loads left out, each with the
+    window it needs (amontons.config.geometry.LeftOutLoad), and where the scan clipped the
+    window of the loads kept, the window they would have had and the one they are solved on
+    (m; None where not clipped)."""
 
     scan_m: tuple[float, float]
     largest_window_m: float
     left_out: tuple[LeftOutLoad, ...]
+    clipped_from_m: float | None = None
+    solved_window_m: float | None = None
+
+    def without(self, dropped: tuple[float, ...], windows_m: tuple[float, ...]) -> ScanCoverage:
+        """This coverage with the loads ``dropped`` (N) left out too, each with its own
+        window (``windows_m``, m): their contacts reached the clipped window's edge
+        (amontons.simulate.solve.solve_on_clipped_window)."""
+        reason = "its contact reaches the edge of the window the scan clipped"
+        extra = tuple(
+            LeftOutLoad(load, window, reason)
+            for load, window in zip(dropped, windows_m, strict=True)
+        )
+        return replace(self, left_out=extra + self.left_out)
 
     def to_record(self) -> dict:
-        """JSON-ready, units in the key names; ``outside_scan`` lists the loads left out."""
-        return {
+        """JSON-ready, units in the key names; ``outside_scan`` lists the loads left out;
+        ``window_clipped`` (only where the scan clipped the window) the window the loads
+        would have had, the one they were solved on, and its fraction of it."""
+        record = {
             "scan_um": [s * 1e6 for s in self.scan_m],
             "largest_window_in_scan_um": self.largest_window_m * 1e6,
             "outside_scan": [load.to_record() for load in self.left_out],
         }
+        if self.clipped_from_m is not None:
+            record["window_clipped"] = {
+                "own_window_um": self.clipped_from_m * 1e6,
+                "clipped_to_um": self.solved_window_m * 1e6,
+                "fraction": self.solved_window_m / self.clipped_from_m,
+            }
+        return record
 
 
 def afm_scene(
@@ -195,10 +219,21 @@ def afm_scene(
     """The scene ``name`` on ``sphere``'s levelled map at the loads whose window the scan
     holds (None where it holds none), and what the scan covers."""
     window = scan_window_m(levelled)
-    scene, left_out = scene_in_scan(name, config, sphere, record, window)
+    scene, cut = scene_in_scan(name, config, sphere, record, window)
     n0, n1 = levelled.heights_m.shape
     scan = (n1 * levelled.pixel_m, n0 * levelled.pixel_m)
-    for load in left_out:
+    if cut.clipped_from_m is not None:
+        log.info(
+            "scene %s, sphere %s: window clipped from %.1f to %.1f µm, the %.1f µm the scan "
+            "holds about the apex (the contacts of %s mN fit with the room the solver needs)",
+            name,
+            sphere,
+            cut.clipped_from_m * 1e6,
+            cut.window_m * 1e6,
+            window * 1e6,
+            ", ".join(f"{f * 1e3:g}" for f in cut.frame.loads_n),
+        )
+    for load in cut.left_out:
         log.info(
             "scene %s, sphere %s: %g mN left out (outside_scan): its window of %.1f µm does not "
             "fit in the %.1f µm the scan holds about the apex (scan %.1f × %.1f µm)",
@@ -210,7 +245,7 @@ def afm_scene(
             scan[0] * 1e6,
             scan[1] * 1e6,
         )
-    return scene, ScanCoverage(scan, window, left_out)
+    return scene, ScanCoverage(scan, window, cut.left_out, cut.clipped_from_m, cut.window_m)
 
 
 def afm_indenter(levelled: LevelledMap, scene: Scene, source: str) -> Indenter:

@@ -34,6 +34,13 @@ def outside_scan_lines(scene: str, coverage: dict, side_um: float) -> list[str]:
     ]
     if not coverage["simulated_mn"]:
         lines.append(f"scene {scene}: the AFM scan holds no load's window; nothing simulated")
+    elif coverage.get("clipped_from_um") is not None:
+        lines.append(
+            f"scene {scene}: window clipped from {coverage['clipped_from_um']:.1f} µm to the "
+            f"{side_um:.1f} µm scan for {', '.join(f'{f:g}' for f in coverage['simulated_mn'])}"
+            " mN (their contacts fit with the solver's margin; one that reaches the edge is "
+            "left out)"
+        )
     return lines
 
 
@@ -134,6 +141,7 @@ class Scenes:
             coverage[scene] = {
                 "simulated_mn": [f * 1e3 for f in cut.frame.loads_n],
                 "outside_scan": [load.to_record() for load in cut.left_out],
+                "clipped_from_um": None if cut.clipped_from_m is None else cut.clipped_from_m * 1e6,
             }
         return coverage
 
