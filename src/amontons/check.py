@@ -228,7 +228,22 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
         side_um = scan_side_um(record["files"], run.spheres.afm_path(sphere, AFM_BEFORE))
     record["scan_side_um"] = side_um
     record["scenes"] = {} if side_um is None else run.scenes.scan_coverage(sphere, side_um)
+    record["undecided_scans"] = undecided_scans(run, sphere, record["scenes"])
     return record
+
+
+def undecided_scans(run: WorkflowRun, sphere: str, coverage: dict) -> dict[str, str]:
+    """The sphere's parameter scans that will have nothing to judge, each with why: their
+    scene keeps no load inside the AFM scan (``coverage``: :meth:`Scenes.scan_coverage`), so
+    their best.json will say 'not decided' (docs/study.md §6)."""
+    return {
+        scan: f"scan {scan}: not decided (its scene {spec['scene']} keeps no load inside the "
+        "AFM scan, so no value is solved)"
+        for scan, spec in run.scenes.scans.items()
+        if scan in run.scenes.runnable_scans(sphere)
+        and spec["scene"] in coverage
+        and not coverage[spec["scene"]]["simulated_mn"]
+    }
 
 
 def check(configfiles: list[str], workflow_dir: Path = WORKFLOW_DIR) -> list[dict]:
@@ -278,6 +293,7 @@ def report(plans: list[dict]) -> str:
             lines += [
                 f"  {line}" for line in outside_scan_lines(scene, coverage, plan["scan_side_um"])
             ]
+        lines += [f"  {line}" for line in plan["undecided_scans"].values()]
     return "\n".join(lines)
 
 

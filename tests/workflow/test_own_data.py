@@ -551,6 +551,7 @@ def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
     config.update(run_scenes=["penetration_hardness"], run_scans=["p_y"])
     config["scans"] = {"p_y": {"steps": 3}}
     path.write_text(yaml.safe_dump(config))
+    check = _check(project)
     run = _snakemake(project, "--cores", "2")
     assert run.returncode == 0, run.stderr[-3000:]
     scan = project / "results" / SMALL / "PS" / "PS-cutscan" / "scans" / "p_y"
@@ -568,6 +569,10 @@ def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
     cut = models[models["sphere"] == "PS-cutscan"]
     assert set(cut["left_out"]) == {"outside_scan: 200, 300 mN"}
     _a_scan_with_nothing_to_judge_says_why(project, models)
+    # the data check said so before the run, and of that sphere only
+    plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
+    assert list(plans["PS-noload"]["undecided_scans"]) == ["p_y"]
+    assert plans["PS-cutscan"]["undecided_scans"] == {}
 
 
 def _a_scan_with_nothing_to_judge_says_why(project, models):
