@@ -19,7 +19,6 @@ from amontons.io.units import optional_nm_to_m
 from amontons.measure.flattening import SMOOTHING_PX
 from amontons.measure.scan_lines import line_levelling_mode
 from amontons.measure.topography import measure_topography
-from amontons.plots import plot_unmeasured
 from amontons.runlog import run_logged
 from amontons.simulate.flattening import (
     flattened_region,
@@ -27,7 +26,7 @@ from amontons.simulate.flattening import (
     window_slices,
 )
 from amontons.simulate.scan import grid_best_label, grid_best_text, is_decided
-from amontons.study_figures import MapPanel, plot_height_maps
+from amontons.study_figures import MapPanel, plot_height_maps, write_undecided_k_scan
 
 log = logging.getLogger(__name__)
 
@@ -46,13 +45,6 @@ def describe(name: str, depth, centre, pixel_m: float, shape, area_px: int) -> d
 
 def _title(name: str, depth) -> str:
     return f"{name}\nflattening {'none' if depth is None else f'{depth * 1e9:.1f} nm deep'}"
-
-
-def write_not_decided(best: dict, table_path: str, figure_paths: list[str], label: str) -> None:
-    """The table and the figure of a sphere whose k scan was not decided: why, in both."""
-    table = pd.DataFrame([{"best_k_mpa_per_nm": None, "not_decided": best["not_decided"]}])
-    write_table(table_path, table)
-    plot_unmeasured(best["not_decided"], f"{label}: the k scan was not decided", figure_paths)
 
 
 def main(
@@ -74,7 +66,7 @@ def main(
     )
     best = read_json(k_scan["best"])
     if not is_decided(best):  # the k scan solved nothing: no model to show
-        write_not_decided(best, table_path, figure_paths, label)
+        write_undecided_k_scan(best, table_path, figure_paths, label)
         return
     path = next(
         p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["grid_best"]

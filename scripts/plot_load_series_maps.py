@@ -15,13 +15,12 @@ from amontons.io.files import read_json, write_table
 from amontons.io.rawdata import read_fluorescence_loads
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area
-from amontons.plots import plot_unmeasured
 from amontons.runlog import run_logged
 from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.register import Registration, warp_to_measured
 from amontons.simulate.render import area_fraction_map
 from amontons.simulate.scan import grid_best_text, is_decided, significant
-from amontons.study_figures import MapPanel, crop_box, plot_map_grid
+from amontons.study_figures import MapPanel, crop_box, plot_map_grid, write_undecided_k_scan
 
 log = logging.getLogger(__name__)
 
@@ -34,13 +33,6 @@ def warped_series(path: str, registration: Registration, shape):
         image = warp_to_measured(field["image"], registration, shape, order=1)
         out.append((image, image > info["otsu_threshold"]))
     return out, attrs
-
-
-def write_not_decided(best: dict, table_path: str, figure_paths: list[str], label: str) -> None:
-    """The table and the figure of a sphere whose k scan was not decided: why, in both."""
-    table = pd.DataFrame([{"best_k_mpa_per_nm": None, "not_decided": best["not_decided"]}])
-    write_table(table_path, table)
-    plot_unmeasured(best["not_decided"], f"{label}: the k scan was not decided", figure_paths)
 
 
 def main(
@@ -64,7 +56,7 @@ def main(
     box = crop_box(measured[-1].mask)
     best = read_json(k_scan["best"])
     if not is_decided(best):  # the k scan solved nothing: no model to show
-        write_not_decided(best, table_path, figure_paths, label)
+        write_undecided_k_scan(best, table_path, figure_paths, label)
         return
     best_path = next(
         p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["grid_best"]

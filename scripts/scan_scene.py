@@ -49,22 +49,23 @@ def main(
     config = scene_config_at(base_config, scan["parameter"], value)
     levelled = load_levelled_map(levelled_path)
     scene, coverage = afm_scene(scan["scene"], config, sphere, sphere_record, levelled)
+    covered = coverage.to_record()
     record = {
         "sphere": sphere,
         "scene": scan["scene"],
         "parameter": scan["parameter"],
         "value": value,
-        "outside_scan": coverage.to_record()["outside_scan"],
+        "outside_scan": covered["outside_scan"],
     }
-    if coverage.clipped_from_m is not None:  # the scan clipped the window: say by how much
-        record["window_clipped"] = coverage.to_record()["window_clipped"]
+    if "window_clipped" in covered:  # the scan clipped the window: say by how much
+        record["window_clipped"] = covered["window_clipped"]
     if scene is None:
         # The window does not depend on the scanned parameter: no value has a load to solve,
         # and best_scan_value says so.
         log.warning("%s = %g: the AFM scan holds no load's window", scan["parameter"], value)
         write_load_series(fields_path, [], [], record)
         # the scan's size and the largest window in it: what best_scan_value says why with
-        write_json(point_path, {**record, **coverage.to_record(), "log_area_distance": None,
+        write_json(point_path, {**record, **covered, "log_area_distance": None,
                                 "outside_window": None, "loads": []})  # fmt: skip
         return
     indenter = afm_indenter(levelled, scene, levelled_path)

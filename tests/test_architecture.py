@@ -202,7 +202,7 @@ def test_no_module_outside_the_solver_closes_an_import_circle():
 # only modules of its own floor or of floors below it, never above.
 CONTACT_FLOORS = (
     # 1. laws, options, results: what a caller passes and gets
-    ("errors", "laws", "options", "pools", "result", "surfaces", "array_backends"),
+    ("errors", "laws", "options", "pools", "result", "surfaces", "array_backends", "locks"),
     # 2. operators: FFT plans and wisdom, Green's functions, convolutions
     ("wisdom", "fft", "greens", "jit", "spectrum", "array_convolution", "convolution"),
     # 3. kernel sets: the element-wise work of one iteration

@@ -13,8 +13,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
 
-from amontons.plots import _save, amontons_axes  # noqa: E402
+from amontons.io.files import write_table  # noqa: E402
+from amontons.plots import _save, amontons_axes, plot_unmeasured  # noqa: E402
 
 
 @dataclass(frozen=True)
@@ -215,3 +217,13 @@ def plot_normalised_study(
         _plain_log_ticks(ax)
     fig.suptitle(title, fontsize=9)
     _save(fig, paths)
+
+
+def write_undecided_k_scan(
+    best: dict, table_path: str, figure_paths: list[str], label: str
+) -> None:
+    """The table and the figure (Fig. B.9 or B.11) of a sphere whose k scan was not decided
+    (best.json's ``not_decided``): why, in both, in place of a model that was not solved."""
+    table = pd.DataFrame([{"best_k_mpa_per_nm": None, "not_decided": best["not_decided"]}])
+    write_table(table_path, table)
+    plot_unmeasured(best["not_decided"], f"{label}: the k scan was not decided", figure_paths)

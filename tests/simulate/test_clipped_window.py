@@ -12,36 +12,20 @@ import numpy as np
 import pytest
 
 from amontons.config import geometry
-from amontons.measure.topography import sphere_cap
 from amontons.physics.hertz import contact_radius
 from amontons.simulate.scene import scene_for_sphere
 from amontons.simulate.solve import solve_on_clipped_window, solve_scene
 from amontons.simulate.surface import afm_indenter, afm_scene, level_afm_map
 
-SCENE = {
-    "surface": "afm_before",
-    "geometry": "sphere",
-    "model": "elastic",
-    "loads": "measured",
-    "pixel_nm": 250.0,
-    "window_factor": 1.5,
-    "side_px": None,
-    "max_side_px": 512,
-    "tol": 1e-8,
-    "optics": "none",
-    "rendering": "emission",
-    "confinement_floor_mpa": 0.0,
-    "p_y_mpa": None,
-    "k_mpa_per_nm": None,
-    "increment": "local",
-    "alpha": 1.0,
-}
+# test_surface's elastic scene on a smooth sphere's map (1.5 × the Hertz diameter, 250 nm)
+from .test_surface import SCENE, _sphere_map
+
 RECORD = {"diameter_mm": 2.0, "e_star_gpa": 20.0, "loads": [5.0, 20.0, 80.0]}
 PIXEL_M = 100e-9
 
 
 def _levelled(side_px):
-    return level_afm_map(sphere_cap((side_px, side_px), PIXEL_M, 1e-3, (0.0, 0.0), 0.0), PIXEL_M)
+    return level_afm_map(_sphere_map(side_px, PIXEL_M, 1e-3), PIXEL_M)
 
 
 def _hertz_diameter_m(load_mn):

@@ -18,7 +18,6 @@ wait and then load. The kernels (:mod:`.spectrum`, :mod:`.kernels`) enter throug
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import os
 import subprocess
 import sys
@@ -26,6 +25,8 @@ import tempfile
 import warnings
 
 import numba
+
+from .locks import exclusive_lock
 
 # fastmath "reassoc" only: it lets LLVM vectorise the reductions (several partial sums per
 # chunk instead of one serial chain; benchmarks/README.md, "Why the kernels are written as
@@ -77,18 +78,10 @@ def ensure_cached(dispatchers) -> None:
             compile_in_child()
 
 
-@contextlib.contextmanager
 def warm_up_lock(dispatchers):
-    """Hold an exclusive lock (``flock``) on a file in the cache folder of ``dispatchers``
-    for the block, so that one process at a time warms the cache; the others wait. The
-    file stays (an empty lock file, reused); the lock ends with the block or the process."""
-    path = os.path.join(_cache_folder(dispatchers), ".amontons-warm-up.lock")
-    with open(path, "a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+    """An exclusive lock on a file in the cache folder of ``dispatchers`` (a context
+    manager), so that one process at a time warms the cache; the others wait."""
+    return exclusive_lock(os.path.join(_cache_folder(dispatchers), ".amontons-warm-up.lock"))
 
 
 def _cache_folder(dispatchers) -> str:

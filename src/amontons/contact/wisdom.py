@@ -32,10 +32,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-try:  # POSIX: serialise planning between processes
-    import fcntl
-except ImportError:  # pragma: no cover - Windows: no lock, the file is still shared
-    fcntl = None
+from .locks import exclusive_lock
 
 WISDOM_ENV = "AMONTONS_FFTW_WISDOM"
 # How the plans in a file were timed; a change sets the files of before aside. Until
@@ -141,17 +138,9 @@ def _write_atomically(path: Path, wisdom) -> None:
         raise
 
 
-@contextlib.contextmanager
 def _locked(path: Path):
     """An exclusive lock on ``path``'s lock file for the duration (no-op without fcntl)."""
-    with open(path.with_name(path.name + ".lock"), "a") as lock:
-        if fcntl is not None:
-            fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            if fcntl is not None:
-                fcntl.flock(lock, fcntl.LOCK_UN)
+    return exclusive_lock(path.with_name(path.name + ".lock"))
 
 
 @contextlib.contextmanager
