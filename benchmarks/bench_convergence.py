@@ -25,7 +25,7 @@ import time
 
 from _common import E_STAR, TIMING_EFFORT, header, parser, rough_load, rough_surface, table
 
-import amontons.contact.cg as cg
+import amontons.contact.cg_iteration as cg_iteration
 from amontons.contact import solve
 
 
@@ -54,7 +54,7 @@ def main():
     repeats = args.repeats or 3
     header("Benchmark 3: iterations to convergence, periodic self-affine surface", args)
     rows = []
-    default_fraction = cg.RESET_FRACTION
+    default_fraction = cg_iteration.RESET_FRACTION
     for n in sizes:
         h, load = rough_surface(n), rough_load(n)
         # build plans for all levels once, outside the timings
@@ -75,12 +75,12 @@ def main():
             ("this solver + coarse-to-fine", default_fraction, True),
         ]
         for name, fraction, c2f in variants:
-            cg.RESET_FRACTION = fraction
+            cg_iteration.RESET_FRACTION = fraction
             try:
                 reps = 1 if (fraction == 0.0 and n >= 2048) else repeats
                 res, t = timed_solve(h, load, reps, args.threads, coarse_to_fine=c2f)
             finally:
-                cg.RESET_FRACTION = default_fraction
+                cg_iteration.RESET_FRACTION = default_fraction
             levels = res.info.coarse_levels
             rows.append(
                 {

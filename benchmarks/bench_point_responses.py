@@ -3,7 +3,7 @@
 When a step changes few points (clipped or added), the fused solver follows it by the
 inverse transform of ``K*t`` and the changed points' responses
 (``kernels.add_point_responses``) instead of a whole convolution ``u = K*p``
-(``cg.SPARSE_MAX_PERIODIC`` / ``SPARSE_MAX_PADDED`` points at most). Per grid and boundary
+(``cg_iteration.SPARSE_MAX_PERIODIC`` / ``SPARSE_MAX_PADDED`` points at most). Per grid and boundary
 condition this prints: ms per point for 1 and 8 points in one call (each call after a
 128 MB sweep, as inside an iteration), the inverse half of a convolution, a whole one, and
 the break-even: the number of points whose responses cost what the whole convolution saves

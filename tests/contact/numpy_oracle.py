@@ -14,7 +14,8 @@ import numpy as np
 from scipy.linalg.blas import daxpy as _axpy
 
 from amontons.contact import fft as _fft
-from amontons.contact.cg import HardWall, finish_outcome
+from amontons.contact.cg import finish_outcome
+from amontons.contact.constraints import HardWall
 from amontons.contact.result import STALLED, ConvergenceError
 from amontons.contact.stall import StallMonitor
 

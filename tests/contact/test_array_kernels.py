@@ -44,7 +44,8 @@ from amontons.contact import kernels as K
 from amontons.contact.array_backends import NUMPY, NUMPY_ARRAY, array_module
 from amontons.contact.array_convolution import ArrayConvolution
 from amontons.contact.array_kernels import ArrayKernels
-from amontons.contact.cg import BoundedWall, polonsky_keer
+from amontons.contact.cg import polonsky_keer
+from amontons.contact.constraints import BoundedWall
 from amontons.contact.convolution import fast_padded_shape, get_operator
 from amontons.contact.options import CGOptions
 

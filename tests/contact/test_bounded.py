@@ -6,7 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from amontons.contact.cg import BoundedWall, HardWall, polonsky_keer
+from amontons.contact.cg import polonsky_keer
+from amontons.contact.constraints import BoundedWall, HardWall
 from amontons.contact.convolution import get_operator
 from amontons.contact.options import CGOptions
 from amontons.contact.surfaces import self_affine

@@ -29,7 +29,8 @@ from amontons.contact import self_affine, sphere
 from amontons.contact.array_backends import NUMPY
 from amontons.contact.array_convolution import ArrayConvolution
 from amontons.contact.array_kernels import ArrayKernels, DeviceKernels
-from amontons.contact.cg import BoundedWall, HardWall, _loop
+from amontons.contact.cg import run_on_kernels
+from amontons.contact.constraints import BoundedWall, HardWall
 from amontons.contact.convolution import fast_padded_shape
 from amontons.contact.options import CGOptions
 
@@ -159,7 +160,7 @@ def test_whole_solve_agrees_with_the_array_code(device, name):
     constraint = HardWall() if p_y is None else BoundedWall(np.full(h.shape, p_y))
     options = CGOptions(tol=1e-8, max_iter=3000)
     outs = [
-        _loop(
+        run_on_kernels(
             ks,
             op,
             h,

@@ -20,7 +20,8 @@ from threadpoolctl import threadpool_limits
 
 from amontons.contact import kernels as K
 from amontons.contact import self_affine, sphere
-from amontons.contact.cg import BoundedWall, polonsky_keer
+from amontons.contact.cg import polonsky_keer
+from amontons.contact.constraints import BoundedWall
 from amontons.contact.convolution import get_operator
 from amontons.contact.options import CGOptions
 from amontons.contact.winkler import WinklerOperator

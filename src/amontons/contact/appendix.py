@@ -15,7 +15,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from .cg import BoundedWall, polonsky_keer
+from .cg import polonsky_keer
+from .constraints import BoundedWall
 from .errors import ITERATION_CAP
 from .laws import ContactHardening, PenetrationHardness
 from .plastic_increments import increment as plastic_increment

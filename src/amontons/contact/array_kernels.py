@@ -8,11 +8,11 @@ the :mod:`.kernels` function of its name (arguments, in-place writes, returns); 
 differences are the ones a GPU asks for:
 
 * **one chunk.** :meth:`ArrayKernels.n_chunks` is 1: the per-chunk records of ``update``
-  and ``rescale_free`` are one row of ``SLOTS`` (>= :data:`.cg.SPARSE_MAX_PADDED`, the most
-  changed points the loop applies as point responses), written only when the events fit
-  (else the records are reported incomplete and the loop convolves afresh, as it does on
-  the numba set past ``record_max``). ``direction`` counts the violators but records none:
-  ``update`` finds them itself in its dense pass.
+  and ``rescale_free`` are one row of ``SLOTS`` (>= the most changed points the loop
+  applies as point responses, :data:`.cg_iteration.SPARSE_MAX_PADDED`), written only when
+  the events fit (else the records are reported incomplete and the loop convolves afresh,
+  as it does on the numba set past ``record_max``). ``direction`` counts the violators but
+  records none: ``update`` finds them itself in its dense pass.
 * **dense passes, element-wise parts fused.** The element-wise parts are small functions
   of arrays and scalars (:func:`_gap`, :func:`_direction_value`, :func:`_should_join`,
   ...), compiled by ``ArrayModule.fuse`` (``cupy.fuse``: one CUDA kernel each; on numpy
@@ -50,7 +50,7 @@ from . import device_sources as src
 from .array_backends import ArrayModule, array_module
 
 # Records per chunk (the one chunk): at least the most changed points the loop applies as
-# point responses (.cg.SPARSE_MAX_PERIODIC, SPARSE_MAX_PADDED), as kernels.SLOTS.
+# point responses (.cg_iteration.SPARSE_MAX_PERIODIC, SPARSE_MAX_PADDED), as kernels.SLOTS.
 SLOTS = 64
 
 

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .cg import BoundedWall, polonsky_keer
+from .cg import polonsky_keer
+from .constraints import BoundedWall
 from .plastic_increments import local_increment, penetration_at_bound
 from .result import Outcome
 

@@ -29,7 +29,14 @@ a child process first (:mod:`.jit` says why; the time it takes: benchmarks/READM
 
 Units: pressures in Pa, lengths in m; ``sigma`` is the dimensionless scale of the stored
 pressure and displacement (true value = ``sigma`` × stored), which lets load control rescale
-the field without a pass (see :mod:`amontons.contact.cg`).
+the field without a pass (see :mod:`amontons.contact.cg_iteration`).
+
+Why one module: numba's disk cache checks only the source file of the function it caches,
+so a helper or a constant imported from another file and changed there would leave the
+cached machine code stale (numba issue #1833, and numba's notes on ``cache=True``). The
+sweeps share their inline helpers (the join test) and the chunk layout (``CHUNK``,
+``SLOTS``, ``SCAN``), so they stay in this file (tests/test_architecture.py checks that no
+compiled function reads a name imported from another module).
 """
 
 from __future__ import annotations
@@ -49,7 +56,7 @@ from .spectrum import ENTRY_POINTS as SPECTRUM_ENTRY_POINTS
 # per-chunk overhead vanishes.
 CHUNK = 16384
 # Changed points (clipped + added) recorded per chunk. The solver applies changes as point
-# responses only when there are at most this many in total (.cg.SPARSE_MAX_PERIODIC,
+# responses only when there are at most this many in total (.cg_iteration.SPARSE_MAX_PERIODIC,
 # SPARSE_MAX_PADDED), so a chunk never needs more slots than that.
 SLOTS = 64
 # Points per block of update's search for clipped points and direction's for violators in a
@@ -303,8 +310,8 @@ def update(
     free points step to ``p - tau·t`` and are projected onto ``[0, p_max]`` (a clipped
     point leaves the free set and its direction is zeroed); then a constrained point that
     should be free (unloaded and penetrating with room to rise, or at ``p_max`` and open)
-    moves by ``-tau·g`` and joins the free set, as in :class:`amontons.contact.cg.HardWall`
-    and :class:`~amontons.contact.cg.BoundedWall`. With ``with_u``, ``u`` gets
+    moves by ``-tau·g`` and joins the free set, as in :class:`amontons.contact.constraints.HardWall`
+    and :class:`~amontons.contact.constraints.BoundedWall`. With ``with_u``, ``u`` gets
     ``-tau/sigma·r`` in place; without, ``u`` is not written (the gaps of the points that
     may join are still read from it) and ``r`` is not read: the caller brings ``u`` to the
     new pressure itself (:mod:`.cg`).
