@@ -86,14 +86,12 @@ def solve(
         Conjugate-gradient iteration cap per solve on the finest grid (default
         ``1000 + 4(n0 + n1)``).
     threads : int or None
-        Threads of the solve: the transforms run as ``threads`` slabs at once
-        (:mod:`amontons.contact.fft`) and the numba kernels on ``threads`` (capped at the
-        grid's chunks); None means every core this process may use (its CPU affinity). The
-        numpy FFT backend is serial (a warning says so when threads > 1). For the duration of
-        the call the OpenMP pools run ``threads`` threads and the BLAS pools one, and the
-        caller's limits are restored after it, also on an exception:
-        the CG's BLAS calls are level 1, and their threads cost more than they bring. A
-        second thread pays from about 512² (benchmarks/README.md, "A second core").
+        Threads of the solve: the transforms as ``threads`` slabs at once
+        (:mod:`amontons.contact.fft`), the numba kernels on ``threads`` (capped at the grid's
+        chunks); None: every core this process may use (its CPU affinity). The numpy FFT
+        backend is serial (a warning says so). The native pools are bounded for the call and
+        given back after it (:mod:`amontons.contact.pools`). A second thread pays from about
+        512² (benchmarks/README.md, "A second core").
     warm_start : array_like, optional
         Initial pressure, Pa (e.g. the pressure of a previous, nearby solve).
     coarse_to_fine : bool
@@ -104,12 +102,10 @@ def solve(
     backend : {"pyfftw", "numpy", "cupy", None}
         ``"pyfftw"``, ``"numpy"``: the CPU solver (numba kernels) with that FFT backend;
         None picks pyfftw when importable. ``"cupy"``: the same Polonsky–Keer loop on the
-        GPU, with the array kernel set and cuFFT (:mod:`amontons.contact.array_kernels`;
-        the optional extra ``pip install amontons[gpu]``); results come back as numpy
-        arrays, and without CuPy or a CUDA device the call raises
-        :class:`BackendUnavailableError`. (``"numpy-array"`` runs the GPU route's code on
-        numpy, for tests; ``"cupy-array"`` its array code on the GPU without its CUDA
-        kernels, the baseline benchmarks time them against.)
+        GPU (:mod:`amontons.contact.array_kernels`; ``pip install amontons[gpu]``), results
+        as numpy arrays; without CuPy or a CUDA device it raises
+        :class:`BackendUnavailableError`. (``"numpy-array"``: the GPU route's code on numpy,
+        for tests; ``"cupy-array"``: without its CUDA kernels, a benchmarks' baseline.)
     plasticity : PenetrationHardness or ContactHardening, optional
         Plasticity law of appendix B.2.3 (None: purely elastic). The result's
         ``plastic_displacement`` is then the plastic displacement of the indenter (m, <= 0
@@ -117,16 +113,14 @@ def solve(
     plastic_displacement : array_like, optional
         Plastic displacement left by earlier loading, m (the history of a load series).
     method : {"winkler", "bounded", "appendix", None}
-        Route of a plastic solve. ``"winkler"``: contact hardening with local increments
-        solved exactly as an elastic half-space plus a Winkler layer (docs/models.md §2.4);
-        ``"bounded"``: penetration hardness with local increments in one bounded CG
-        (0 <= p <= p_Y) under the force or approach constraint, the plastic displacement
-        being the penetration where p = p_Y (docs/models.md §2.3); ``"appendix"``: the
-        appendix's iterative scheme (bounded solve, plastic increment, repeat, and under
-        load control a root find on the approach; needs ``alpha < 1`` for contact
-        hardening). None (default): ``"winkler"`` or ``"bounded"`` where they apply, else
-        ``"appendix"`` (volume-conserving increments). Ignored, with a warning, by an
-        elastic solve.
+        Route of a plastic solve. ``"winkler"``: contact hardening, local increments solved
+        exactly as an elastic half-space plus a Winkler layer (docs/models.md §2.4);
+        ``"bounded"``: penetration hardness, local increments in one bounded CG
+        (0 <= p <= p_Y), the plastic displacement the penetration where p = p_Y
+        (docs/models.md §2.3); ``"appendix"``: the appendix's iterative scheme (needs
+        ``alpha < 1`` for contact hardening). None: ``"winkler"`` or ``"bounded"`` where
+        they apply, else ``"appendix"`` (volume-conserving increments). Ignored, with a
+        warning, by an elastic solve.
     max_outer : int, optional
         Cap on the outer loop of a plastic solve: plastic updates per approach
         (``"appendix"``, default 200) or active-set rounds (``"winkler"``, default 50).
@@ -134,15 +128,12 @@ def solve(
         outer loop).
     planner_effort : str, optional
         FFTW planner effort, one of "FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT",
-        "FFTW_EXHAUSTIVE". None (default): ``"FFTW_MEASURE"``: each plan is timed once per
-        machine and kept on disk as FFTW wisdom (:mod:`amontons.contact.wisdom`, file
-        ``$AMONTONS_FFTW_WISDOM`` or ``~/.cache/amontons``), which every later process
-        imports, so the same plan and the same result bytes in every run on the machine.
-        Its plans use ``threads`` (ESTIMATE's do not) and are faster than
-        ``"FFTW_ESTIMATE"``'s (benchmarks/README.md); ESTIMATE plans by heuristics, without
-        timing or disk. A plan for another thread count differs in
-        round-off only (the answer agrees with the one-thread one to 1e-10). Operators are
-        cached per effort. An effort given with the numpy backend is ignored, with a warning.
+        "FFTW_EXHAUSTIVE". None (default): ``"FFTW_MEASURE"``, each plan timed once per
+        machine and kept on disk as FFTW wisdom that every later process imports, so the
+        same plan and the same result bytes in every run on the machine
+        (:mod:`amontons.contact.wisdom` says where); faster than ESTIMATE's heuristic plans
+        (benchmarks/README.md, "FFTW planner effort"). Another thread count's plan differs
+        in round-off only (1e-10). Ignored, with a warning, by the numpy backend.
     raise_on_failure : bool
         True (default): a solve that does not converge raises :class:`ConvergenceError`.
         False: it returns a :class:`ContactResult` with ``success=False``, its ``status``
@@ -169,12 +160,10 @@ def solve(
     IgnoredOptionWarning
         An option was given that has no effect on this solve (see the options above).
     """
-    h = check_heights(heights)
-    spacing = check_positive("spacing", spacing, "m")
-    e_star = check_positive("e_star", e_star, "Pa")
-    load, displacement = check_control(load, displacement)
-    opts = solve_options(
-        h.shape,
+    h, spacing, e_star, opts = _checked_problem(
+        heights,
+        spacing,
+        e_star,
         periodic=periodic,
         tol=tol,
         max_iter=max_iter,
@@ -186,16 +175,10 @@ def solve(
         max_outer=max_outer,
         raise_on_failure=raise_on_failure,
     )
+    load, displacement = check_control(load, displacement)
     if warm_start is not None:
         warm_start = check_warm_start(warm_start, h.shape)
-    if opts.law is None and plastic_displacement is not None:
-        raise ContactInputError(
-            "plastic_displacement was given without a plasticity law; pass plasticity="
-            "PenetrationHardness(...) or ContactHardening(...)"
-        )
-    plastic_prev = None
-    if opts.law is not None:
-        plastic_prev = check_plastic_history(plastic_displacement, h.shape)
+    plastic_prev = _plastic_history(opts, plastic_displacement, h.shape)
     _warn_ignored(
         opts,
         h.shape,
@@ -204,20 +187,10 @@ def solve(
         coarse_to_fine=coarse_to_fine,
         warm_start=warm_start is not None,
     )
-    # BLAS pools on one thread, OpenMP pools (the kernels') on ``threads``, the caller's
-    # limits back after the call (.pools says why)
+    step = LoadStep(load, displacement, warm_start, plastic_prev, bool(coarse_to_fine))
+    # BLAS pools on one thread, the kernels' OpenMP on ``threads`` (.pools says why)
     with solve_pools(opts.threads):
-        return _solve_step(
-            h,
-            spacing,
-            e_star,
-            opts,
-            load=load,
-            displacement=displacement,
-            warm_start=warm_start,
-            plastic_prev=plastic_prev,
-            coarse_to_fine=bool(coarse_to_fine),
-        )
+        return _solve_step(h, spacing, e_star, opts, step)
 
 
 def solve_with_options(
@@ -230,17 +203,11 @@ def solve_with_options(
     h = check_heights(heights)
     load, displacement = check_control(load, displacement)
     plastic_prev = None if opts.law is None else np.zeros(h.shape)
+    spacing = check_positive("spacing", spacing, "m")
+    e_star = check_positive("e_star", e_star, "Pa")
     with solve_pools(opts.threads):
         return _solve_step(
-            h,
-            check_positive("spacing", spacing, "m"),
-            check_positive("e_star", e_star, "Pa"),
-            opts,
-            load=load,
-            displacement=displacement,
-            warm_start=None,
-            plastic_prev=plastic_prev,
-            coarse_to_fine=False,
+            h, spacing, e_star, opts, LoadStep(load, displacement, None, plastic_prev)
         )
 
 
@@ -299,12 +266,10 @@ def solve_load_series(
         As in :func:`solve`; an error raised by a step carries a note (``__notes__``) naming
         the step and its load.
     """
-    h = check_heights(heights)
-    spacing = check_positive("spacing", spacing, "m")
-    e_star = check_positive("e_star", e_star, "Pa")
-    arr = check_loads(loads)
-    opts = solve_options(
-        h.shape,
+    h, spacing, e_star, opts = _checked_problem(
+        heights,
+        spacing,
+        e_star,
         periodic=periodic,
         tol=tol,
         max_iter=max_iter,
@@ -316,6 +281,7 @@ def solve_load_series(
         max_outer=max_outer,
         raise_on_failure=raise_on_failure,
     )
+    arr = check_loads(loads)
     starts = _checked_starts(warm_starts, arr.size, h.shape)
     _warn_ignored(
         opts,
@@ -330,17 +296,11 @@ def solve_load_series(
     prev = None
     with solve_pools(opts.threads):  # as in solve
         for i, w in enumerate(arr):
+            start = _scaled_start(prev, w) if starts is None else starts[i]
+            first_coarse = bool(coarse_to_fine) and i == 0 and starts is None
             try:
                 res = _solve_step(
-                    h,
-                    spacing,
-                    e_star,
-                    opts,
-                    load=float(w),
-                    displacement=None,
-                    warm_start=_scaled_start(prev, w) if starts is None else starts[i],
-                    plastic_prev=plastic,
-                    coarse_to_fine=bool(coarse_to_fine) and i == 0 and starts is None,
+                    h, spacing, e_star, opts, LoadStep(float(w), None, start, plastic, first_coarse)
                 )
             except ContactError as err:
                 # the error describes the solve; the caller also needs to know which step
@@ -387,6 +347,28 @@ def solve_scan(heights, spacing, e_star, loads: Sequence[float], laws: Sequence,
         scan.append(series)
         previous = series
     return scan
+
+
+def _checked_problem(heights, spacing, e_star, **options):
+    """``(heights, spacing, e_star, SolveOptions)`` validated (m, m, Pa): every option
+    of :func:`solve` but the load step's (:func:`.options.solve_options`)."""
+    h = check_heights(heights)
+    spacing = check_positive("spacing", spacing, "m")
+    e_star = check_positive("e_star", e_star, "Pa")
+    return h, spacing, e_star, solve_options(h.shape, **options)
+
+
+def _plastic_history(opts, plastic_displacement, shape) -> np.ndarray | None:
+    """The validated plastic displacement left by earlier loading (m; zeros when none is
+    given), or None for an elastic solve, which refuses one."""
+    if opts.law is None and plastic_displacement is not None:
+        raise ContactInputError(
+            "plastic_displacement was given without a plasticity law; pass plasticity="
+            "PenetrationHardness(...) or ContactHardening(...)"
+        )
+    if opts.law is None:
+        return None
+    return check_plastic_history(plastic_displacement, shape)
 
 
 def _checked_starts(warm_starts, count: int, shape) -> list[np.ndarray] | None:
@@ -468,13 +450,10 @@ def _coarse_to_fine_obstacle(opts, shape, warm_start):
     return None
 
 
-def _solve_step(
-    h, spacing, e_star, opts, *, load, displacement, warm_start, plastic_prev, coarse_to_fine
-):
-    """One validated solve by the route of ``opts``, elastic or plastic from the plastic
-    state ``plastic_prev`` (m), checked and made into a ContactResult."""
+def _solve_step(h, spacing, e_star, opts, step: LoadStep):
+    """One validated solve of ``step`` by the route of ``opts``, elastic or plastic from the
+    plastic state ``step.plastic_prev`` (m), checked and made into a ContactResult."""
     t0 = time.perf_counter()
-    step = LoadStep(load, displacement, warm_start, plastic_prev, coarse_to_fine)
     out = run_route(h, spacing, e_star, opts, step)
     what = "solver" if opts.law is None else "plastic solve"
     return _finished(h, spacing, opts, out, info=_solve_info(opts, out, t0), what=what)
