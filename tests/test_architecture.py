@@ -207,8 +207,8 @@ CONTACT_FLOORS = (
     ("wisdom", "fft", "greens", "jit", "spectrum", "array_convolution", "convolution"),
     # 3. kernel sets: the element-wise work of one iteration
     ("kernels", "device_sources", "array_kernels", "bounded_load"),
-    # 4. the iteration: the one Polonsky-Keer control flow
-    ("stall", "cg"),
+    # 4. the iteration: the one Polonsky-Keer control flow, its steps and its constraints
+    ("stall", "constraints", "cg_iteration", "cg"),
     # 5. routes, chosen from one table
     ("plastic_increments", "root_find", "elastic", "winkler", "bounded", "appendix", "routes"),
     # 6. public calls (and the warm-up, which solves through them)
@@ -415,4 +415,119 @@ def test_no_script_or_measurement_looks_into_a_raw_data_folder():
         PACKAGE / "contact" / "wisdom.py",
     }
     found = [call for path in sources if path not in allowed for call in _folder_lookups(path)]
+    assert found == []
+
+
+# The longest function the solver may hold, docstring included (issue: a newcomer reads the
+# solver in named steps), and the longest step of the conjugate-gradient iteration.
+MAX_SOLVER_FUNCTION_LINES = 150
+MAX_CG_STEP_LINES = 80
+
+
+def _function_lengths(path: Path) -> dict[str, int]:
+    """Every function and method of ``path`` (qualified by its class) with its length in
+    lines, from ``def`` to its last line, docstring and comments included."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    lengths = {}
+
+    def visit(node, prefix):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef):
+                name = f"{prefix}{child.name}"
+                lengths[f"{path.name}::{name}"] = child.end_lineno - child.lineno + 1
+                visit(child, f"{name}.")
+            elif isinstance(child, ast.ClassDef):
+                visit(child, f"{prefix}{child.name}.")
+
+    visit(tree, "")
+    return lengths
+
+
+def test_the_length_reader_counts_methods_and_docstrings(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text('class A:\n    def f(self):\n        """Doc."""\n\n        return 1\n')
+    assert _function_lengths(probe) == {"probe.py::A.f": 4}
+
+
+def test_no_solver_function_is_longer_than_150_lines():
+    lengths = {}
+    for path in sorted((PACKAGE / "contact").glob("*.py")):
+        lengths |= _function_lengths(path)
+    assert len(lengths) > 200  # the reader found the solver
+    long = {name: n for name, n in lengths.items() if n > MAX_SOLVER_FUNCTION_LINES}
+    assert long == {}, f"split these into named steps (at most {MAX_SOLVER_FUNCTION_LINES})"
+
+
+def test_every_step_of_the_cg_iteration_fits_80_lines():
+    lengths = _function_lengths(PACKAGE / "contact" / "cg_iteration.py")
+    assert "cg_iteration.py::CGIteration.run" in lengths
+    long = {name: n for name, n in lengths.items() if n > MAX_CG_STEP_LINES}
+    assert long == {}, f"the iteration's steps stay at most {MAX_CG_STEP_LINES} lines"
+
+
+def _compiled_functions(tree: ast.Module) -> list[ast.FunctionDef]:
+    """The functions of a module decorated by numba (``@numba.njit(...)``, ``@njit``...)."""
+
+    def is_numba(decorator) -> bool:
+        target = decorator.func if isinstance(decorator, ast.Call) else decorator
+        return "numba" in ast.unparse(target) or ast.unparse(target) in {"njit", "jit"}
+
+    return [
+        node
+        for node in tree.body
+        if isinstance(node, ast.FunctionDef) and any(map(is_numba, node.decorator_list))
+    ]
+
+
+def _names_imported_from_amontons(tree: ast.Module) -> set[str]:
+    """The names a module binds by importing from amontons (relative imports are amontons'):
+    the name or its alias, a module's alias included (``from . import fft as _fft``)."""
+    bound = set()
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom) and (
+            node.level or (node.module or "").startswith("amontons")
+        ):
+            bound |= {alias.asname or alias.name for alias in node.names}
+        elif isinstance(node, ast.Import):
+            bound |= {
+                alias.asname or alias.name.split(".")[0]
+                for alias in node.names
+                if alias.name.startswith("amontons")
+            }
+    return bound
+
+
+def _foreign_names_in_kernels(path: Path) -> list[str]:
+    """Names a numba-compiled function of ``path`` reads that its module imported from
+    another amontons module (a function, a constant or a module)."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    foreign = _names_imported_from_amontons(tree)
+    return [
+        f"{path.name}:{node.lineno} {func.name} reads {node.id}"
+        for func in _compiled_functions(tree)
+        for node in ast.walk(func)
+        if isinstance(node, ast.Name) and node.id in foreign
+    ]
+
+
+def test_the_kernel_scan_finds_an_imported_helper(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text(
+        "import numba\nfrom .other import helper\nfrom . import fft as _fft\n\n"
+        "@numba.njit(cache=True)\ndef kernel(x):\n    return helper(x) + _fft.n\n"
+    )
+    assert _foreign_names_in_kernels(probe) == [
+        "probe.py:7 kernel reads helper",
+        "probe.py:7 kernel reads _fft",
+    ]
+
+
+def test_no_compiled_kernel_reads_a_name_from_another_module():
+    """numba's disk cache checks only the source file of the function it caches: a helper
+    or constant imported from another file, changed there, would leave the cached machine
+    code stale (numba issue #1833; numba's documentation of ``cache=True``). So each kernel
+    module holds every helper and constant its compiled functions read."""
+    modules = [p for p in sorted((PACKAGE / "contact").glob("*.py")) if "numba" in p.read_text()]
+    assert PACKAGE / "contact" / "kernels.py" in modules
+    found = [hit for path in modules for hit in _foreign_names_in_kernels(path)]
     assert found == []
