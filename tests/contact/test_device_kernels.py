@@ -29,7 +29,8 @@ from amontons.contact import self_affine, sphere
 from amontons.contact.array_backends import NUMPY
 from amontons.contact.array_convolution import ArrayConvolution
 from amontons.contact.array_kernels import ArrayKernels, DeviceKernels
-from amontons.contact.cg import run_on_kernels
+from amontons.contact.cg import run_to_outcome
+from amontons.contact.cg_iteration import CGIteration
 from amontons.contact.constraints import BoundedWall, HardWall
 from amontons.contact.convolution import fast_padded_shape
 from amontons.contact.options import CGOptions
@@ -160,18 +161,20 @@ def test_whole_solve_agrees_with_the_array_code(device, name):
     constraint = HardWall() if p_y is None else BoundedWall(np.full(h.shape, p_y))
     options = CGOptions(tol=1e-8, max_iter=3000)
     outs = [
-        run_on_kernels(
-            ks,
-            op,
-            h,
-            options,
-            pixel_area=1.0,
-            h_scale=float(h.std()),
-            p_init=np.ones_like(h),
-            constraint=constraint,
-            load=control.get("load"),
-            displacement=control.get("displacement"),
-        )  # fmt: skip
+        run_to_outcome(
+            CGIteration(
+                ks,
+                op,
+                h,
+                options,
+                pixel_area=1.0,
+                h_scale=float(h.std()),
+                p_init=np.ones_like(h),
+                constraint=constraint,
+                load=control.get("load"),
+                displacement=control.get("displacement"),
+            )
+        )
         for ks in (device, A)
     ]
     dev, arr = outs

@@ -89,7 +89,7 @@ def polonsky_keer(
     with ks.kernel_threads(
         _kernel_threads(operator, options.threads, ks.n_chunks(np.size(heights)))
     ):
-        return run_on_kernels(
+        state = CGIteration(
             ks,
             operator,
             heights,
@@ -101,6 +101,7 @@ def polonsky_keer(
             displacement=displacement,
             constraint=constraint,
         )
+        return run_to_outcome(state)
 
 
 def kernel_set(options: CGOptions):
@@ -108,7 +109,7 @@ def kernel_set(options: CGOptions):
     unless ``options.array_module`` names an array namespace, then the array kernels of
     :mod:`.array_kernels` on it (``"cupy"``: on the GPU).
 
-    A kernel set offers the functions of :mod:`.kernels` that :func:`_loop` calls, under
+    A kernel set offers the functions of :mod:`.kernels` that the iteration calls, under
     their contracts, and the host side of its arrays: ``xp`` (the array namespace),
     ``empty(n, dtype)``, ``asarray`` (host to the set's memory), ``to_host``, ``on_host(fn,
     *args, writes=())`` (a numpy routine on host copies, the arrays at ``writes`` copied
@@ -120,40 +121,16 @@ def kernel_set(options: CGOptions):
     return array_kernel_set(options.array_module)
 
 
-def run_on_kernels(
-    ks,
-    operator,
-    heights,
-    options,
-    *,
-    pixel_area,
-    h_scale,
-    p_init,
-    load,
-    displacement,
-    constraint,
-) -> Outcome:
-    """:func:`polonsky_keer` on the kernel set ``ks`` (:func:`kernel_set`), its kernels'
-    threads already set: a :class:`.cg_iteration.CGIteration` run, and its outcome."""
-    state = CGIteration(
-        ks,
-        operator,
-        heights,
-        options,
-        pixel_area=pixel_area,
-        h_scale=h_scale,
-        p_init=p_init,
-        load=load,
-        displacement=displacement,
-        constraint=constraint,
-    )
+def run_to_outcome(state: CGIteration) -> Outcome:
+    """Run a :class:`.cg_iteration.CGIteration` set up on its kernel set (within the set's
+    ``kernel_threads``) to its end, and build its outcome."""
     state.run()
     p, u, h = state.host_fields()
     return finish_outcome(
-        constraint,
-        options.tol,
-        options.raise_on_failure,
-        pixel_area,
+        state.constraint,
+        state.tol,
+        state.raise_on_failure,
+        state.pixel_area,
         p=p,
         u=u,
         h=h,

@@ -104,7 +104,7 @@ class CGIteration:
     (an empty free set), :meth:`_gap_moments`, :meth:`_next_direction`, then either
     :meth:`_without_descent` or :meth:`_take_step`, :meth:`_choose_conjugation`,
     :meth:`_follow_u` and :meth:`_judge`. The outcome is built from :meth:`host_fields` and
-    :meth:`counters` (:func:`.cg.run_on_kernels`).
+    :meth:`counters` (:func:`.cg.run_to_outcome`).
     """
 
     def __init__(
