@@ -78,3 +78,25 @@ def test_a_scan_sets_the_law_itself(rough_sphere):
     h, dx = rough_sphere
     with pytest.raises(ContactInputError, match="solve_scan sets plasticity itself"):
         solve_scan(h, dx, E_STAR, LOADS, [PenetrationHardness(1e8)], plasticity=None)
+
+
+def test_a_missing_start_is_the_series_own_previous_load(rough_sphere, scans):
+    """A start of None at a load (a neighbour that did not solve it) starts that load as a
+    series without neighbours does: from its previous load scaled up, the first from nothing.
+    The same starts give the same iterates: results equal to the last bit."""
+    h, dx = rough_sphere
+    law = PenetrationHardness(P_Y[2])
+    independent = scans[0][2]
+    with_none = solve_load_series(h, dx, E_STAR, LOADS, plasticity=law, warm_starts=[None] * 3)
+    for a, b in zip(with_none, independent, strict=True):
+        np.testing.assert_array_equal(a.pressure, b.pressure)
+        assert a.iterations == b.iterations
+    neighbour = scans[1][1]  # 200 MPa's series in the scan
+    mixed = solve_load_series(
+        h, dx, E_STAR, LOADS, plasticity=law, warm_starts=[None, neighbour[1].pressure, None]
+    )
+    assert [r.success for r in mixed] == [True] * 3
+    np.testing.assert_array_equal(mixed[0].pressure, independent[0].pressure)
+    for a, b in zip(mixed, independent, strict=True):
+        np.testing.assert_array_equal(a.contact, b.contact)
+        np.testing.assert_allclose(a.pressure, b.pressure, rtol=0, atol=1e-6 * P_Y[2])

@@ -250,11 +250,12 @@ def solve_load_series(
     raise_on_failure : bool
         As in :func:`solve`. With False a step that does not converge is returned with
         ``success=False`` and the series goes on from its state: check every result.
-    warm_starts : sequence of array_like, optional
+    warm_starts : sequence of array_like or None, optional
         One starting pressure (Pa) per load, e.g. the pressures of the same loads under a
-        neighbouring law (:func:`solve_scan`). Without it each step starts from the previous
-        step's pressure scaled to its load. The plastic history always comes from the
-        series' own previous step.
+        neighbouring law (:func:`solve_scan`); an entry may be None (no neighbour at that
+        load). Where no start is given each step starts from the previous step's pressure
+        scaled to its load. The plastic history always comes from the series' own previous
+        step.
 
     Returns
     -------
@@ -296,7 +297,9 @@ def solve_load_series(
     prev = None
     with solve_pools(opts.threads):  # as in solve
         for i, w in enumerate(arr):
-            start = _scaled_start(prev, w) if starts is None else starts[i]
+            start = starts[i] if starts is not None else None
+            if start is None:
+                start = _scaled_start(prev, w)
             first_coarse = bool(coarse_to_fine) and i == 0 and starts is None
             try:
                 res = _solve_step(
@@ -371,15 +374,15 @@ def _plastic_history(opts, plastic_displacement, shape) -> np.ndarray | None:
     return check_plastic_history(plastic_displacement, shape)
 
 
-def _checked_starts(warm_starts, count: int, shape) -> list[np.ndarray] | None:
-    """One validated starting pressure per load, or None."""
+def _checked_starts(warm_starts, count: int, shape) -> list[np.ndarray | None] | None:
+    """One validated starting pressure (or None) per load, or None."""
     if warm_starts is None:
         return None
     if len(warm_starts) != count:
         raise ContactInputError(
             f"warm_starts must hold one pressure per load ({count}), got {len(warm_starts)}"
         )
-    return [check_warm_start(w, shape) for w in warm_starts]
+    return [None if w is None else check_warm_start(w, shape) for w in warm_starts]
 
 
 def _scaled_start(prev, load):
