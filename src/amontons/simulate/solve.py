@@ -69,10 +69,18 @@ SOLVER_BACKENDS = {"cpu": None, "cupy": "cupy"}
 
 
 def solve_scene(
-    scene: Scene, indenter: Indenter, *, threads: int = 1, backend: str = "cpu"
+    scene: Scene,
+    indenter: Indenter,
+    *,
+    threads: int = 1,
+    backend: str = "cpu",
+    warm_starts: list[np.ndarray | None] | None = None,
 ) -> SceneSolution:
     """The scene's load series on its indenter (one ContactResult per load, as fields), on
-    the solver engine ``backend`` (config ``solver_backend``: ``cpu`` or ``cupy``)."""
+    the solver engine ``backend`` (config ``solver_backend``: ``cpu`` or ``cupy``).
+    ``warm_starts``: a starting pressure (Pa) or None per load, such as a neighbouring scan
+    value's solution (:mod:`amontons.simulate.scan_start`); None starts each load from the
+    previous one's."""
     start = time.perf_counter()
     results = solve_load_series(
         indenter.heights,
@@ -84,6 +92,7 @@ def solve_scene(
         plasticity=scene.plasticity,
         threads=threads,
         backend=SOLVER_BACKENDS[backend],
+        warm_starts=warm_starts,
     )
     for result in results:
         log.info(
