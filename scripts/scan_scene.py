@@ -1,7 +1,9 @@
 """Rule scan_scene: one value of a parameter scan (docs/study.md). The base scene with its
-parameter set to the value, solved over the measured loads (warm-started load to load),
-rendered like the microscope sees it, and compared with the measured contact under the base
-scene's registration."""
+parameter set to the value, solved over the measured loads, each load starting from the
+neighbouring value's pressure at that load (the value before it in the scan's chain;
+amontons.simulate.scan_start) or else from the previous load, rendered like the microscope
+sees it, and compared with the measured contact under the base scene's registration. Its
+own pressures are the next value's start."""
 
 import logging
 import os
@@ -21,6 +23,7 @@ from amontons.simulate.compare import compare_loads, sheet_load_index
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
+from amontons.simulate.scan_start import read_scan_start, write_scan_start
 from amontons.simulate.solve import solve_scene
 from amontons.simulate.surface import afm_indenter, afm_scene, load_levelled_map
 
@@ -32,8 +35,10 @@ def main(
     psf_path: str,
     registration_path: str,
     fluorescence,
+    neighbour_path: str | None,
     fields_path: str,
     point_path: str,
+    start_path: str,
     scan: dict,
     base_config: dict,
     value: float,
@@ -64,21 +69,39 @@ def main(
         # and best_scan_value says so.
         log.warning("%s = %g: the AFM scan holds no load's window", scan["parameter"], value)
         write_load_series(fields_path, [], [], record)
+        write_scan_start(start_path, [], [], None, value)
         # the scan's size and the largest window in it: what best_scan_value says why with
         write_json(point_path, {**record, **covered, "log_area_distance": None,
                                 "outside_window": None, "loads": []})  # fmt: skip
         return
     indenter = afm_indenter(levelled, scene, levelled_path)
+    starts = None
+    if neighbour_path is not None:
+        starts, started = read_scan_start(
+            neighbour_path, scene.loads_n, indenter.heights.shape, indenter.spacing_m
+        )
+        log.info("%s = %g: %d of %d loads start from the neighbouring value", scan["parameter"],
+                 value, started, len(scene.loads_n))  # fmt: skip
     try:
-        solution = solve_scene(scene, indenter, threads=threads, backend=solver_backend)
+        solution = solve_scene(
+            scene, indenter, threads=threads, backend=solver_backend, warm_starts=starts
+        )
     except FreeBoundaryError as error:
         # A value so soft that the contact outgrows the base scene's window (which holds the
         # measured contact with room to spare) matches the measurement worse than any value
         # whose contact fits: recorded, never best, and the run goes on.
         log.warning("%s = %g: %s", scan["parameter"], value, error)
         write_load_series(fields_path, [], [], {**scene.to_record(), **record})
+        write_scan_start(start_path, [], [], None, value)
         write_json(point_path, {**record, "log_area_distance": None, "outside_window": str(error)})
         return
+    write_scan_start(
+        start_path,
+        scene.loads_n,
+        [f["pressure"] for f in solution.fields],
+        indenter.spacing_m,
+        value,
+    )
     settings = OtsuSettings.from_config(otsu)
     pixel_m = image_pixel_m(pixel_nm, pixel_table)
     rendered = render_load_series(
@@ -164,8 +187,10 @@ if __name__ == "__main__":
         psf_path=sm.input.psf,
         registration_path=sm.input.registration,
         fluorescence=sm.input.fluorescence,
+        neighbour_path=sm.input.warm_start[0] if sm.input.warm_start else None,
         fields_path=sm.output.fields,
         point_path=sm.output.point,
+        start_path=sm.output.start,
         scan=sm.params.scan,
         base_config=sm.params.base,
         value=float(sm.wildcards.value),

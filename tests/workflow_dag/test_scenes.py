@@ -11,6 +11,8 @@ import tifffile
 from amontons.config.scenes import SCAN_COLUMNS
 from amontons.io.tiff import write_image
 from amontons.simulate.scan_grid import scan_values, value_label
+from amontons.workflow.paths import SCAN_START
+from amontons.workflow.scenes import SCAN_CHAIN_ORDER
 
 
 def _wildcards(**values):
@@ -69,6 +71,29 @@ def test_a_scan_has_one_point_per_value_around_the_sheets_prior(small):
         wildcards = _wildcards(material=small.spheres.material_of(sphere), sphere=sphere, scan=scan)
         points = scenes.scan_points(wildcards)
         assert [p.split("/")[-2] for p in points] == labels
+
+
+def test_a_scans_values_run_as_one_chain_each_from_the_one_before(small):
+    """Every value of a sphere's scan but the first reads the start of the value before it in
+    SCAN_CHAIN_ORDER, so the values form one chain from the largest value down (or the
+    smallest up), and no value reads a start that nothing writes."""
+    scenes = small.scenes
+    sphere = next(iter(small.spheres))
+    material = small.spheres.material_of(sphere)
+    for scan, spec in scenes.scans.items():
+        chain = scenes.scan_chain(sphere, scan)
+        assert sorted(chain, key=float) == sorted(scenes.scan_value_labels(sphere, scan), key=float)
+        descending = SCAN_CHAIN_ORDER[spec["parameter"]] < 0
+        assert [float(v) for v in chain] == sorted(map(float, chain), reverse=descending)
+        reads = [
+            scenes.scan_neighbour_start(
+                _wildcards(material=material, sphere=sphere, scan=scan, value=value)
+            )
+            for value in chain
+        ]
+        assert reads[0] == []
+        for before, read in zip(chain, reads[1:], strict=False):
+            assert read == [scenes.paths.scan_value(SCAN_START, material, sphere, scan, before)]
 
 
 def test_without_scans_there_is_no_scan_and_no_study_output(make_run):

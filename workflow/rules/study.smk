@@ -1,5 +1,6 @@
 # The study (docs/study.md): which contact model explains the experiment. Parameter scans of
-# p_Y and k on each sphere's AFM map, each value a job of its own; the best value per sphere;
+# p_Y and k on each sphere's AFM map, each value a job of its own that starts from the value
+# before it (a chain per sphere and scan, one cluster job: profiles/slurm); the best value;
 # the appendix's figures B.8-B.13 and the model-comparison table. Nothing here runs unless
 # run_scans lists a scan.
 
@@ -11,9 +12,12 @@ rule scan_scene:
         registration=RUN.scenes.scan_base_registration,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
         pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
+        # the value before this one in the scan's chain: its pressures start this value's
+        warm_start=RUN.scenes.scan_neighbour_start,
     output:
         point=PATHS.scan_value(SCAN_POINT),
         fields=PATHS.scan_value(RENDERED),
+        start=PATHS.scan_value(SCAN_START),
     log:
         f"{SCAN_LOGS}/{{value}}/scan_scene.log",
     benchmark:

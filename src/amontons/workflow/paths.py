@@ -34,6 +34,7 @@ COMPARISON = f"{COMPARISON_FIGURE}.csv"
 REGISTRATION = "registration.json"
 SCENE_FIT = "scene_fit.json"
 SCAN_POINT = "scan_point.json"
+SCAN_START = "start.h5"  # a scan value's pressures, the next value's start
 SCAN_TABLE = "scan.csv"
 BEST = "best.json"
 TRUTH = "truth.json"

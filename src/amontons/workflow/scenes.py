@@ -20,6 +20,12 @@ from amontons.workflow.spheres import AFM_BEFORE, Spheres
 PRIOR_FREE_SCALES = {"p_y_mpa": "p_Y/E*", "k_mpa_per_nm": "k·Δx/E*"}
 
 
+# The order a scan's values run in, each starting from the one before: -1 from the largest
+# value down, +1 from the smallest up; per parameter, the order that took fewer CG
+# iterations on the virtual PS and PMMA-4mm spheres (benchmarks/bench_scan_warm_start.py;
+# docs/study.md §1, "Warm-started values").
+SCAN_CHAIN_ORDER = {"p_y_mpa": -1, "k_mpa_per_nm": +1}
+
 # AFM formats whose scan size the DAG reads from the header (amontons.io.pixel_probe).
 HEADER_SIZED_AFM = (".tif", ".tiff")
 
@@ -283,6 +289,22 @@ class Scenes:
                 scale, spec["prior_free_range"], spec["prior_free_steps"], spec["spacing"]
             )
         return [value_label(v) for v in values]
+
+    def scan_chain(self, sphere: str, scan: str) -> list[str]:
+        """A scan's values in the order they run (:data:`SCAN_CHAIN_ORDER`), each starting
+        from the one before (amontons.simulate.scan_start)."""
+        labels = sorted(self.scan_value_labels(sphere, scan), key=float)
+        return labels[::-1] if SCAN_CHAIN_ORDER[self.scans[scan]["parameter"]] < 0 else labels
+
+    def scan_neighbour_start(self, wildcards) -> list[str]:
+        """The start file of the value before this one in its scan's chain; none for the
+        first."""
+        chain = self.scan_chain(wildcards.sphere, wildcards.scan)
+        index = chain.index(wildcards.value)
+        if index == 0:
+            return []
+        where = (wildcards.material, wildcards.sphere, wildcards.scan, chain[index - 1])
+        return [self.paths.scan_value(files.SCAN_START, *where)]
 
     def scan_points(self, wildcards) -> list[str]:
         """Every value's result of one sphere's scan."""

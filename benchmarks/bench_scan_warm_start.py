@@ -1,0 +1,143 @@
+"""Benchmark 7, part D: the pipeline's own scan, its values warm-started from their neighbours.
+
+A sphere's p_Y or k scan as the pipeline runs it (rule scan_scene: the scan's scene at each
+value on the sphere's levelled AFM map, its measured loads, the run's preset), each value's
+load series solved
+
+* ``independent``: from nothing, each load from the previous one (the pipeline until
+  2026-11-28);
+* ``descending`` / ``ascending``: each load from the neighbouring value's pressure at the
+  same load (:mod:`amontons.simulate.scan_start`), the values in that order;
+
+against one elastic load series of the same sphere (its run's elastic scene), solved first
+and timed in the same process. Prints per value and order the CG iterations and wall time,
+each order's total over the elastic series', and the largest change of a value's contact
+areas against the independent solves (relative): the warm start may move a converged
+solution only within the solver's tolerance.
+
+    python benchmarks/bench_scan_warm_start.py --configfile config/config.yaml --sphere PS
+
+Needs the run's raw data and levelled maps (``make reproduce`` or the run of
+``--configfile``). One thread, as a scan job runs; medians of ``--repeats`` solves.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import platform
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from amontons.contact import FreeBoundaryError
+from amontons.simulate.scan import scene_config_at
+from amontons.simulate.solve import solve_scene
+from amontons.simulate.surface import afm_indenter, afm_scene, load_levelled_map
+from amontons.workflow.paths import LEVELLED_MAP
+from amontons.workflow.run import WorkflowRun
+
+REPO = Path(__file__).resolve().parents[1]
+ORDERS = ("independent", "descending", "ascending")
+
+
+def sphere_scene(run, name: str, config: dict, sphere: str, levelled, levelled_path: str):
+    """The scene ``name`` under ``config`` on the sphere's map, and its indenter."""
+    scene, _ = afm_scene(name, config, sphere, run.spheres.scene_record(sphere), levelled)
+    return scene, afm_indenter(levelled, scene, levelled_path)
+
+
+def timed_series(scene, indenter, starts=None):
+    """(solution or None, iterations, wall s) of one load series."""
+    t0 = time.perf_counter()
+    try:
+        solution = solve_scene(scene, indenter, warm_starts=starts)
+    except FreeBoundaryError:
+        return None, 0, time.perf_counter() - t0
+    iterations = sum(row["iterations"] for row in solution.per_load)
+    return solution, iterations, time.perf_counter() - t0
+
+
+def scan_order(run, scan: str, sphere: str, levelled, path: str, order: str) -> list[dict]:
+    """Every value of the scan solved in ``order``: value, iterations, wall s, areas (µm²)."""
+    spec = run.scenes.scans[scan]
+    base = run.scenes.config(spec["scene"])
+    values = [float(v) for v in run.scenes.scan_value_labels(sphere, scan)]
+    if order == "descending":
+        values = values[::-1]
+    rows, previous = [], None
+    for value in values:
+        config = scene_config_at(base, spec["parameter"], value)
+        scene, indenter = sphere_scene(run, spec["scene"], config, sphere, levelled, path)
+        starts = None
+        if order != "independent" and previous is not None:
+            starts = [f["pressure"] for f in previous.fields]
+        solution, iterations, wall = timed_series(scene, indenter, starts)
+        areas = [] if solution is None else [row["area_um2"] for row in solution.per_load]
+        rows.append({"value": value, "iterations": iterations, "wall_s": wall, "areas": areas})
+        previous = solution
+    return sorted(rows, key=lambda row: row["value"])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--configfile", type=Path, default=REPO / "config" / "config.yaml")
+    parser.add_argument("--sphere", default="PS")
+    parser.add_argument("--scans", nargs="+", default=["p_y", "k"])
+    parser.add_argument("--orders", nargs="+", default=list(ORDERS), choices=ORDERS)
+    parser.add_argument("--repeats", type=int, default=1)
+    args = parser.parse_args()
+    config = yaml.safe_load(args.configfile.read_text())
+    run = WorkflowRun.from_config(config, REPO / "workflow", str(args.configfile))
+    material = run.spheres.material_of(args.sphere)
+    path = run.paths.measured(LEVELLED_MAP, material, args.sphere)
+    levelled = load_levelled_map(path)
+    print(f"# {__doc__.splitlines()[0]}")
+    print(
+        f"# {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, {platform.node()}, "
+        f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}, {args.configfile}, "
+        f"sphere {args.sphere}"
+    )
+    elastic_name = run.scenes.first("elastic", "microscope") or run.scenes.first("elastic")
+    elastic = sphere_scene(
+        run, elastic_name, run.scenes.config(elastic_name), args.sphere, levelled, path
+    )
+    # the first solve of each grid plans its transforms (FFTW wisdom): not timed
+    _, elastic_iterations, _ = timed_series(*elastic)
+    walls = [timed_series(*elastic)[2] for _ in range(max(args.repeats, 3))]
+    elastic_wall = statistics.median(walls)
+    print(f"elastic series ({elastic_name}): {elastic_iterations} iterations, {elastic_wall:.2f} s")
+    for scan in args.scans:
+        results = {}
+        for order in args.orders:
+            repeats = [scan_order(run, scan, args.sphere, levelled, path, order)
+                       for _ in range(args.repeats)]  # fmt: skip
+            results[order] = repeats[0]
+            wall = statistics.median(sum(r["wall_s"] for r in rows) for rows in repeats)
+            iterations = sum(r["iterations"] for r in repeats[0])
+            print(
+                f"{scan} {order}: {iterations} iterations, {wall:.2f} s, "
+                f"{wall / elastic_wall:.2f}× the elastic series, "
+                f"{iterations / elastic_iterations:.2f}× its iterations"
+            )
+            for row in repeats[0]:
+                print(f"    {row['value']:10.4g}: {row['iterations']:5d} it, {row['wall_s']:.2f} s")
+        base = results.get("independent")
+        for order, rows in results.items():
+            if base is None or order == "independent":
+                continue
+            change = max(
+                (abs(a / b - 1) for r, q in zip(rows, base, strict=True)
+                 for a, b in zip(r["areas"], q["areas"], strict=True) if b > 0),
+                default=0.0,
+            )  # fmt: skip
+            print(f"{scan} {order}: largest area change against independent {change:.2e}")
+
+
+if __name__ == "__main__":
+    np.set_printoptions(precision=4)
+    main()
