@@ -172,10 +172,17 @@ def test_slurm_dry_run_gives_every_job_measured_resources_that_grow_with_the_gri
     docs/accuracy.md on each job's own grid)."""
     jobs, stdout = _slurm_jobs(project, "config/config.yaml")
     assert len(jobs) > 150
-    # the few-second jobs go in bundles (the profile's groups), the solves on their own
+    # the few-second jobs go in bundles (the profile's groups), the solves on their own, and
+    # each sphere's scan is one chain of values: one group job per sphere and scan
     assert "Group job figures" in stdout and "Group job measurements" in stdout
     grouped = re.findall(r"^    rule (\w+):", stdout, re.M)
-    assert "fit_scene" in grouped and "scan_scene" not in grouped
+    assert "fit_scene" in grouped and "simulate_scene" not in grouped
+    # a group job's members are indented; the next top-level job starts at the line's start
+    chains = re.findall(r"Group job scan_chain.*?(?=\n\[|\Z)", stdout, re.S)
+    assert len(chains) == 10  # 5 spheres x 2 scans
+    for chain in chains:
+        members = re.findall(r"^\s+wildcards: (material=.+, value=.+)$", chain, re.M)
+        assert len(members) == 7 and len({m.rsplit("value=", 1)[0] for m in members}) == 1
     for rule, wildcards, resources in jobs:
         assert int(resources["mem_mb"]) >= 500 and int(resources["runtime"]) >= 2, (rule, wildcards)
         assert resources["slurm_partition"] == "YOUR_PARTITION"
