@@ -5,7 +5,7 @@ import logging
 from amontons.io.files import write_json
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.scan_lines import line_levelling_mode
-from amontons.measure.topography import measure_topography
+from amontons.measure.topography import measure_topography, write_sphere_fits
 from amontons.plots import plot_topography
 from amontons.runlog import run_logged
 
@@ -16,6 +16,7 @@ def main(
     before_path: str,
     after_path: str,
     topography_path: str,
+    fits_path: str,
     figure_paths: list[str],
     afm_pixel_nm: float | None,
     nan_policy: str,
@@ -46,6 +47,7 @@ def main(
         topo.after.line_levelling.applied,
     )
     write_json(topography_path, topo.to_record())
+    write_sphere_fits(fits_path, topo)
     plot_topography(
         topo.before.roughness * 1e9,
         topo.after.roughness * 1e9,
@@ -64,6 +66,7 @@ if __name__ == "__main__":
         before_path=sm.input.before,
         after_path=sm.input.after,
         topography_path=sm.output.topography,
+        fits_path=sm.output.fits,
         figure_paths=[sm.output.png, sm.output.pdf],
         afm_pixel_nm=sm.params.afm_pixel_nm,
         nan_policy=sm.params.nan_policy,

@@ -18,7 +18,7 @@ from amontons.io.files import read_json, write_table
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.flattening import SMOOTHING_PX
 from amontons.measure.scan_lines import line_levelling_mode
-from amontons.measure.topography import measure_topography
+from amontons.measure.topography import measure_topography, read_sphere_fits
 from amontons.runlog import run_logged
 from amontons.simulate.flattening import (
     flattened_region,
@@ -50,6 +50,7 @@ def _title(name: str, depth) -> str:
 def main(
     before_path: str,
     after_path: str,
+    fits_path: str,
     k_scan: dict,
     table_path: str,
     figure_paths: list[str],
@@ -63,6 +64,7 @@ def main(
         nan_policy=afm["nan_policy"],
         channel=afm["channel"],
         line_levelling=line_levelling_mode(afm["line_levelling"]),
+        known_fits=read_sphere_fits(fits_path),  # measure_topography's: no second fit
     )
     best = read_json(k_scan["best"])
     if not is_decided(best):  # the k scan solved nothing: no model to show
@@ -142,6 +144,7 @@ if __name__ == "__main__":
         sm.log[0],
         before_path=sm.input.before,
         after_path=sm.input.after,
+        fits_path=sm.input.fits,
         k_scan=sm.params.k_scan,
         table_path=sm.output.table,
         figure_paths=[sm.output.png, sm.output.pdf],

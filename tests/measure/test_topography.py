@@ -11,7 +11,13 @@ from amontons.io.heightmap import HeightMap
 from amontons.io.layout import RawDataError, afm_file
 from amontons.io.tiff import read_image, write_image
 from amontons.measure.flattening import unchanged_level
-from amontons.measure.topography import measure_topography, sphere_cap, square_pixels
+from amontons.measure.topography import (
+    measure_topography,
+    read_sphere_fits,
+    sphere_cap,
+    square_pixels,
+    write_sphere_fits,
+)
 
 PIXEL = 32e-9
 
@@ -41,6 +47,34 @@ def test_flattening_is_the_depth_of_the_cut(tmp_path):
     # Depth of the cut to the noise of two scans (5 σ of √2 × 0.2 nm = 1.4 nm).
     assert -topo.change_m.min() == pytest.approx((before - after).max(), abs=1.5e-9)
     assert topo.before.radius_m == pytest.approx(0.3e-3, rel=0.02)
+
+
+def test_the_maps_levelled_again_by_the_written_fits_are_the_same_to_the_bit(tmp_path):
+    """A later step (Fig. B.9) levels the scans by the fits measure_topography wrote instead
+    of fitting again: the same roughness, change and flattening, every array to the bit,
+    with scan-line offsets levelled (a row shifted in the before scan) and without."""
+    _scans(tmp_path, np.random.default_rng(5))
+    image = read_image(tmp_path / "afm_before.tif").data.astype(np.float64)
+    image[100:, :] += 3e-9  # a scan-line offset that 'auto' levels
+    write_image(tmp_path / "afm_before.tif", image, PIXEL)
+    paths = (tmp_path / "afm_before.tif", tmp_path / "afm_after.tif")
+    fitted = measure_topography(*paths, None, nan_policy="fail")
+    assert fitted.before.line_levelling.applied
+    write_sphere_fits(tmp_path / "fits.h5", fitted)
+    again = measure_topography(
+        *paths, None, nan_policy="fail", known_fits=read_sphere_fits(tmp_path / "fits.h5")
+    )
+    for name in ("before", "after"):
+        ours, theirs = getattr(again, name), getattr(fitted, name)
+        assert np.array_equal(ours.roughness, theirs.roughness)
+        assert (ours.radius_m, ours.apex_xy_m, ours.apex_height_m) == (
+            theirs.radius_m,
+            theirs.apex_xy_m,
+            theirs.apex_height_m,
+        )
+        assert np.array_equal(ours.line_offsets, theirs.line_offsets)
+    assert np.array_equal(again.change_m, fitted.change_m)
+    assert again.to_record() == fitted.to_record()
 
 
 def test_nan_pixels_fail_or_are_filled_as_the_config_says(tmp_path):

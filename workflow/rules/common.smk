@@ -34,6 +34,7 @@ from amontons.workflow.paths import (
     RENDERED,
     RENDER_TABLE,
     SCAN_POINT,
+    SPHERE_FITS,
     SCAN_START,
     SCAN_TABLE,
     SCENE_FIT,

@@ -176,6 +176,8 @@ rule plot_flattening_maps:
         lambda wc: flat_files(RUN.study.k_scan(wc)),
         before=lambda wc: afm_path(wc.sphere, "afm_before"),
         after=lambda wc: afm_path(wc.sphere, "afm_after"),
+        # the scans' sphere fits: the maps are levelled again without fitting
+        fits=f"{MEASURED}/{SPHERE_FITS}",
     output:
         table=f"{STUDY}/B9_flattening.csv",
         png=report(

@@ -7,6 +7,7 @@ rule measure_topography:
         after=lambda wc: afm_path(wc.sphere, "afm_after"),
     output:
         topography=f"{MEASURED}/topography.json",
+        fits=f"{MEASURED}/{SPHERE_FITS}",
         png=report(
             f"{MEASURED}/topography.png",
             caption="../report/topography.rst",

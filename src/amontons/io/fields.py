@@ -98,3 +98,27 @@ def read_levelled_map(path: str | Path) -> tuple[np.ndarray, float, dict]:
     with h5py.File(path, "r") as h5:
         attrs = {key: _decoded(value) for key, value in h5.attrs.items()}
         return h5["heights"][()], float(attrs.pop("pixel_m")), attrs
+
+
+def write_named_records(
+    path: str | Path, records: Mapping[str, Mapping], arrays: Mapping[str, Mapping[str, np.ndarray]]
+) -> None:
+    """One group per name: its record as attributes, its arrays as datasets, float64 values
+    kept to the bit (units are the keys' suffixes). Written atomically."""
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+        for name, record in records.items():
+            group = h5.create_group(name)
+            for key, value in record.items():
+                group.attrs[key] = _attribute(value)
+            for key, data in arrays.get(name, {}).items():
+                group.create_dataset(key, data=np.asarray(data), compression="gzip")
+
+
+def read_named_records(path: str | Path) -> tuple[dict[str, dict], dict[str, dict]]:
+    """(records, arrays) per name, as written by write_named_records."""
+    with h5py.File(path, "r") as h5:
+        records = {
+            name: {key: _decoded(value) for key, value in h5[name].attrs.items()} for name in h5
+        }
+        arrays = {name: {key: h5[name][key][()] for key in h5[name]} for name in h5}
+    return records, arrays

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from scipy import ndimage, optimize
 
+from amontons.io.fields import read_named_records, write_named_records
 from amontons.io.heightmap import HeightMap, TopographyError, read_height_map
 from amontons.io.layout import RawDataError
 from amontons.measure.flattening import Flattening, measure_flattening
@@ -96,10 +97,86 @@ def level_sphere(heights: np.ndarray, pixel_m: float, *, line_levelling: str = "
         raise TopographyError(str(error)) from error
     if lines.applied:
         radius, apex, z0 = _fit_sphere_once(heights - lines.offsets_m[:, None], pixel_m)
+    return sphere_fit_with(heights, pixel_m, FitParameters(radius, apex, z0, lines))
+
+
+@dataclass(frozen=True)
+class FitParameters:
+    """What a sphere fit found: radius (m), apex (x, y) from the map centre (m), apex height
+    (m), and the scan lines' levelling."""
+
+    radius_m: float
+    apex_xy_m: tuple[float, float]
+    apex_height_m: float
+    line_levelling: LineLevelling
+
+
+def sphere_fit_with(heights: np.ndarray, pixel_m: float, fit: FitParameters) -> SphereFit:
+    """The map levelled by a known fit: its roughness is the map minus the scan-line offsets
+    and the sphere, less its mean (m), computed as :func:`level_sphere` computes it, so a
+    fit read back from :func:`write_sphere_fits` gives the same roughness to the bit."""
     roughness = (
-        heights - lines.offsets_m[:, None] - sphere_cap(heights.shape, pixel_m, radius, apex, z0)
+        heights
+        - fit.line_levelling.offsets_m[:, None]
+        - sphere_cap(heights.shape, pixel_m, fit.radius_m, fit.apex_xy_m, fit.apex_height_m)
     )
-    return SphereFit(radius, apex, z0, roughness - roughness.mean(), lines)
+    return SphereFit(
+        fit.radius_m,
+        fit.apex_xy_m,
+        fit.apex_height_m,
+        roughness - roughness.mean(),
+        fit.line_levelling,
+    )
+
+
+# The two scans of a sphere, as named in the fits' file.
+SCANS = ("before", "after")
+
+
+def write_sphere_fits(path: str | Path, topography: Topography) -> None:
+    """Both scans' sphere fits and scan-line offsets (HDF5, float64 to the bit), so that a
+    later step levels the maps again without fitting (:func:`read_sphere_fits`)."""
+    records, arrays = {}, {}
+    for name, fit in zip(SCANS, (topography.before, topography.after), strict=True):
+        lines = fit.line_levelling
+        records[name] = {
+            "radius_m": fit.radius_m,
+            "apex_x_m": fit.apex_xy_m[0],
+            "apex_y_m": fit.apex_xy_m[1],
+            "apex_height_m": fit.apex_height_m,
+            "line_mode": lines.mode,
+            "lines_applied": bool(lines.applied),
+            "stepped_rows": int(lines.stepped_rows),
+            "every_row": bool(lines.every_row),
+            "step_noise_m": float(lines.step_noise_m),
+        }
+        arrays[name] = {"line_offsets_m": lines.offsets_m}
+    write_named_records(path, records, arrays)
+
+
+def read_sphere_fits(path: str | Path) -> tuple[FitParameters, FitParameters]:
+    """The fits :func:`write_sphere_fits` wrote, (before, after)."""
+    records, arrays = read_named_records(path)
+    fits = []
+    for name in SCANS:
+        r = records[name]
+        lines = LineLevelling(
+            r["line_mode"],
+            bool(r["lines_applied"]),
+            arrays[name]["line_offsets_m"],
+            int(r["stepped_rows"]),
+            bool(r["every_row"]),
+            float(r["step_noise_m"]),
+        )
+        fits.append(
+            FitParameters(
+                float(r["radius_m"]),
+                (float(r["apex_x_m"]), float(r["apex_y_m"])),
+                float(r["apex_height_m"]),
+                lines,
+            )
+        )
+    return fits[0], fits[1]
 
 
 @dataclass(frozen=True)
@@ -186,13 +263,16 @@ def measure_topography(
     nan_policy: str,
     channel: str | None = None,
     line_levelling: str = "auto",
+    known_fits: tuple[FitParameters, FitParameters] | None = None,
 ) -> Topography:
     """Level both scans (sphere fit, scan-line offsets as ``line_levelling`` says: ``auto``,
     ``on``, ``off``) and take their roughness statistics and their difference, the plastic
     flattening (appendix Fig. B.9; :func:`amontons.measure.flattening.measure_flattening`).
     Both scans must cover the same field on the same grid (a repeated scan of the same area).
     ``channel`` names the height channel of a vendor file (None: the format's default). Scans
-    with non-square pixels are resampled to square ones first (:func:`square_pixels`)."""
+    with non-square pixels are resampled to square ones first (:func:`square_pixels`).
+    ``known_fits``: the scans' fits as :func:`read_sphere_fits` gives them, which a step
+    after this measurement passes instead of fitting again (the same result to the bit)."""
     files = []
     for path in (before_path, after_path):
         try:
@@ -224,7 +304,11 @@ def measure_topography(
             f"{before.pixel_m * 1e9:.4g} nm)"
         )
     try:
-        fits = [level_sphere(m.heights, m.pixel_m, line_levelling=line_levelling) for m in maps]
+        if known_fits is None:
+            fits = [level_sphere(m.heights, m.pixel_m, line_levelling=line_levelling) for m in maps]
+        else:
+            pairs = zip(maps, known_fits, strict=True)
+            fits = [sphere_fit_with(m.heights, m.pixel_m, f) for m, f in pairs]
     except TopographyError as error:
         raise RawDataError(f"{before.path}, {after.path}: {error}") from error
     difference, difference_lines = _levelled_difference(

@@ -20,6 +20,7 @@ VALUE = "{value}"
 
 # Files that one rule writes and another rule, or a target, reads: named once, here.
 LEVELLED_MAP = "afm_before_levelled.h5"
+SPHERE_FITS = "topography_fits.h5"  # both AFM scans' sphere fits, to level them again
 CONTACT_AREA = "contact_area.csv"
 PSF = "psf.json"
 LOAD_AREA_FIT = "load_area_fit.json"
