@@ -26,7 +26,12 @@ from amontons.simulate.flattening import (
     window_slices,
 )
 from amontons.simulate.scan import grid_best_label, grid_best_text, is_decided
-from amontons.study_figures import MapPanel, plot_height_maps, write_undecided_k_scan
+from amontons.study_figures import (
+    MapPanel,
+    grid_best_path,
+    plot_height_maps,
+    write_undecided_k_scan,
+)
 
 log = logging.getLogger(__name__)
 
@@ -70,10 +75,7 @@ def main(
     if not is_decided(best):  # the k scan solved nothing: no model to show
         write_undecided_k_scan(best, table_path, figure_paths, label)
         return
-    path = next(
-        p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["grid_best"]
-    )
-    fields, _, attrs = read_load_series(path)
+    fields, per_load, attrs = read_load_series(grid_best_path(k_scan["rendered"], best))
     last = fields[-1]
     solver_pixel = attrs["pixel_nm"] * 1e-9
     window = window_slices(
@@ -125,7 +127,7 @@ def main(
     ]
     table = pd.DataFrame(rows)
     table["best_k_mpa_per_nm"] = best["grid_best"]
-    table["load_mn"] = read_load_series(path)[1][-1]["load_mn"]
+    table["load_mn"] = per_load[-1]["load_mn"]
     write_table(table_path, table)
     log.info("\n%s", table.to_string(index=False))
     plot_height_maps(

@@ -20,7 +20,13 @@ from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.register import Registration, warp_to_measured
 from amontons.simulate.render import area_fraction_map
 from amontons.simulate.scan import grid_best_text, is_decided, significant
-from amontons.study_figures import MapPanel, crop_box, plot_map_grid, write_undecided_k_scan
+from amontons.study_figures import (
+    MapPanel,
+    crop_box,
+    grid_best_path,
+    plot_map_grid,
+    write_undecided_k_scan,
+)
 
 log = logging.getLogger(__name__)
 
@@ -58,9 +64,7 @@ def main(
     if not is_decided(best):  # the k scan solved nothing: no model to show
         write_undecided_k_scan(best, table_path, figure_paths, label)
         return
-    best_path = next(
-        p for p in k_scan["rendered"] if read_load_series(p)[2]["value"] == best["grid_best"]
-    )
+    best_path = grid_best_path(k_scan["rendered"], best)
     hardening_registration = Registration.from_record(read_json(k_scan["registration"]))
     elastic_registration = Registration.from_record(read_json(elastic["registration"]))
     series = {

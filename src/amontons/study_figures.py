@@ -15,6 +15,7 @@ import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from amontons.io.fields import read_load_series_settings  # noqa: E402
 from amontons.io.files import write_table  # noqa: E402
 from amontons.plots import _save, amontons_axes, plot_unmeasured  # noqa: E402
 
@@ -217,6 +218,14 @@ def plot_normalised_study(
         _plain_log_ticks(ax)
     fig.suptitle(title, fontsize=9)
     _save(fig, paths)
+
+
+def grid_best_path(rendered_paths: Sequence[str], best: dict) -> str:
+    """The rendered series (rendered.h5) of a scan's grid's best value, found by the value
+    each file's settings record (their fields are not read)."""
+    return next(
+        p for p in rendered_paths if read_load_series_settings(p)["value"] == best["grid_best"]
+    )
 
 
 def write_undecided_k_scan(

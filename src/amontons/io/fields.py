@@ -57,8 +57,8 @@ def write_load_series(
 
 def read_load_series(path: str | Path) -> tuple[list[dict], list[dict], dict]:
     """(fields per load, diagnostics per load, settings) as written by write_load_series."""
+    settings = read_load_series_settings(path)
     with h5py.File(path, "r") as h5:
-        settings = {key: _decoded(value) for key, value in h5.attrs.items()}
         groups = sorted(h5, key=lambda name: int(name.split("_")[1]))
         fields, per_load = [], []
         for name in groups:
@@ -71,6 +71,12 @@ def read_load_series(path: str | Path) -> tuple[list[dict], list[dict], dict]:
                 }
             )
     return fields, per_load, settings
+
+
+def read_load_series_settings(path: str | Path) -> dict:
+    """The settings of a file of write_load_series alone, without reading its fields."""
+    with h5py.File(path, "r") as h5:
+        return {key: _decoded(value) for key, value in h5.attrs.items()}
 
 
 def _decoded(value):

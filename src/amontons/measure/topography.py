@@ -23,19 +23,22 @@ from amontons.physics.roughness import RoughnessStatistics, roughness_statistics
 
 
 @dataclass(frozen=True)
-class SphereFit:
-    """Least-squares sphere through a height map.
-
-    radius_m, apex (x, y) in m from the map centre, apex height in m; ``roughness`` is the map
-    minus the sphere (and minus scan-line offsets, when removed), m; ``line_levelling`` what
-    was done to the scan lines.
-    """
+class FitParameters:
+    """What a sphere fit found: radius (m), apex (x, y) from the map centre (m), apex height
+    (m), and what was done to the scan lines (their offsets, m)."""
 
     radius_m: float
     apex_xy_m: tuple[float, float]
     apex_height_m: float
-    roughness: np.ndarray
     line_levelling: LineLevelling
+
+
+@dataclass(frozen=True)
+class SphereFit(FitParameters):
+    """Least-squares sphere through a height map: its parameters and the ``roughness``, the
+    map minus the sphere (and minus scan-line offsets, when removed), m."""
+
+    roughness: np.ndarray
 
     @property
     def line_offsets(self) -> np.ndarray:
@@ -100,17 +103,6 @@ def level_sphere(heights: np.ndarray, pixel_m: float, *, line_levelling: str = "
     return sphere_fit_with(heights, pixel_m, FitParameters(radius, apex, z0, lines))
 
 
-@dataclass(frozen=True)
-class FitParameters:
-    """What a sphere fit found: radius (m), apex (x, y) from the map centre (m), apex height
-    (m), and the scan lines' levelling."""
-
-    radius_m: float
-    apex_xy_m: tuple[float, float]
-    apex_height_m: float
-    line_levelling: LineLevelling
-
-
 def sphere_fit_with(heights: np.ndarray, pixel_m: float, fit: FitParameters) -> SphereFit:
     """The map levelled by a known fit: its roughness is the map minus the scan-line offsets
     and the sphere, less its mean (m), computed as :func:`level_sphere` computes it, so a
@@ -124,8 +116,8 @@ def sphere_fit_with(heights: np.ndarray, pixel_m: float, fit: FitParameters) -> 
         fit.radius_m,
         fit.apex_xy_m,
         fit.apex_height_m,
-        roughness - roughness.mean(),
         fit.line_levelling,
+        roughness - roughness.mean(),
     )
 
 
