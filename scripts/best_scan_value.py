@@ -9,20 +9,20 @@ import pandas as pd
 from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_json, write_table
 from amontons.runlog import run_logged
-from amontons.simulate.scan import (
-    ScanError,
+from amontons.simulate.scan_best import (
     ScanPoint,
     best_scan_value,
     log_area_scatter,
     not_decided_record,
 )
+from amontons.simulate.scan_grid import ScanError
 
 log = logging.getLogger(__name__)
 
 
 def write_not_decided(records: list[dict], table_path: str, best_path: str, scan_name: str):
     """A scan with nothing to judge: every value's row, none solved, and best.json saying
-    why (amontons.simulate.scan.not_decided_record). An answer, not a failure."""
+    why (amontons.simulate.scan_best.not_decided_record). An answer, not a failure."""
     best = {"scan": scan_name, **not_decided_record(records)}
     log.warning("%s: not decided: %s", scan_name, best["not_decided"])
     rows = [

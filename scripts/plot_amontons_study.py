@@ -10,7 +10,7 @@ import pandas as pd
 
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
-from amontons.simulate.scan import is_decided
+from amontons.simulate.scan_record import is_decided
 from amontons.study_figures import plot_normalised_study
 
 log = logging.getLogger(__name__)

@@ -25,7 +25,7 @@ from amontons.simulate.flattening import (
     offset_from_centre_m,
     window_slices,
 )
-from amontons.simulate.scan import grid_best_label, grid_best_text, is_decided
+from amontons.simulate.scan_record import grid_best_label, grid_best_text, is_decided
 from amontons.study_figures import (
     MapPanel,
     grid_best_path,

@@ -19,7 +19,7 @@ from amontons.runlog import run_logged
 from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.register import Registration, warp_to_measured
 from amontons.simulate.render import area_fraction_map
-from amontons.simulate.scan import grid_best_text, is_decided, significant
+from amontons.simulate.scan_record import grid_best_text, is_decided, significant
 from amontons.study_figures import (
     MapPanel,
     crop_box,

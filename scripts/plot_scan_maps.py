@@ -14,7 +14,7 @@ from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
 from amontons.simulate.register import Registration, warp_to_measured
-from amontons.simulate.scan import estimate_text, is_decided
+from amontons.simulate.scan_record import estimate_text, is_decided
 from amontons.study_figures import MapPanel, crop_box, plot_map_grid
 
 log = logging.getLogger(__name__)

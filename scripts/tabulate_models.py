@@ -14,7 +14,7 @@ from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
 from amontons.simulate.compare import largest_compared
 from amontons.simulate.fits import model_table_rows
-from amontons.simulate.scan import estimate_columns
+from amontons.simulate.scan_record import estimate_columns
 
 log = logging.getLogger(__name__)
 

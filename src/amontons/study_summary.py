@@ -21,8 +21,14 @@ from pathlib import Path
 import pandas as pd
 
 from amontons.config.scenes import SCAN_MODELS
-from amontons.simulate.fits import NOT_DECIDED, NOT_DECIDED_SOURCE
-from amontons.simulate.scan import PARAMETER_SYMBOLS, interval_text, is_decided, significant
+from amontons.simulate.scan_record import (
+    NOT_DECIDED,
+    NOT_DECIDED_SOURCE,
+    PARAMETER_SYMBOLS,
+    interval_text,
+    is_decided,
+    significant,
+)
 
 # The models of the verdict, in the order the study discusses them (docs/study.md §4), and
 # how a reader names them.
@@ -158,7 +164,7 @@ def _exponent_text(value, difference) -> str:
 
 def _not_decided(row: Mapping, model: str) -> bool:
     """Whether a verdict row's ``model`` comes from a scan that was not decided (its AFM
-    scan held no load: amontons.simulate.scan.not_decided_record)."""
+    scan held no load: amontons.simulate.scan_best.not_decided_record)."""
     source = row.get(f"{model}_source")
     return isinstance(source, str) and source.endswith(NOT_DECIDED_SOURCE)
 

@@ -5,15 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from amontons.simulate.scan import (
-    ScanError,
-    ScanPoint,
-    best_scan_value,
-    log_area_distance,
-    log_area_scatter,
-    scan_values,
-    scene_config_at,
-)
+from amontons.simulate.scan import log_area_distance, scene_config_at
+from amontons.simulate.scan_best import ScanPoint, best_scan_value, log_area_scatter
+from amontons.simulate.scan_grid import ScanError, scan_values
 
 
 def test_log_scan_spans_the_range_with_equal_ratios():

@@ -6,14 +6,13 @@ import math
 import numpy as np
 import pytest
 
-from amontons.simulate.scan import (
-    ScanPoint,
-    best_scan_value,
+from amontons.simulate.scan_best import ScanPoint, best_scan_value
+from amontons.simulate.scan_grid import scan_values
+from amontons.simulate.scan_record import (
     estimate_columns,
     estimate_text,
     grid_best_text,
     interval_text,
-    scan_values,
     significant,
 )
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from amontons.simulate.scan import interval_text, significant
+from amontons.simulate.scan_record import interval_text, significant
 
 pytestmark = pytest.mark.workflow
 

@@ -8,13 +8,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from amontons.fits import fit_power_law
+from amontons.simulate.scan_record import NOT_DECIDED, NOT_DECIDED_SOURCE
 
 # fit_power_law's standard errors need three points: a scene with fewer loads is not fitted.
 MIN_FIT_LOADS = 3
-# best.json's key that holds why a scan was not decided (amontons.simulate.scan), and how
-# the model table's source names such a scan.
-NOT_DECIDED = "not_decided"
-NOT_DECIDED_SOURCE = "not decided"
 # The exponent columns of a scene that was not fitted: empty, with left_out saying why.
 _NO_EXPONENT = {"estimate": None, "ci_low": None, "ci_high": None}
 

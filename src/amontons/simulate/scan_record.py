@@ -1,0 +1,76 @@
+"""A scan's best.json read back and put in words (docs/study.md §1, §6): whether it is decided,
+its estimate as model-table columns, and the sentences figures and tables state it in. Pure
+Python: a figure or a table that only reads the record imports no statistics."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+# best.json's key that holds why a scan was not decided (amontons.simulate.scan_best), and
+# how the model table's source names such a scan.
+NOT_DECIDED = "not_decided"
+NOT_DECIDED_SOURCE = "not decided"
+# How a parameter is written in figures and tables: symbol and unit.
+PARAMETER_SYMBOLS = {"p_y_mpa": ("p_Y", "MPa"), "k_mpa_per_nm": ("k", "MPa/nm")}
+
+
+def is_decided(best: Mapping) -> bool:
+    """Whether a best.json record holds a judgement (else :data:`NOT_DECIDED` says why)."""
+    return NOT_DECIDED not in best
+
+
+def estimate_columns(best: Mapping | None) -> dict:
+    """A scan's estimate and the interval that belongs to it, as model-table columns, from its
+    best.json record (``None``, for a scene's row, or a scan not decided: empty columns). The
+    interval's ends are ``None`` where it is open at the scan's end."""
+    if best is None or not is_decided(best):
+        return {"estimate": None, "estimate_low": None, "estimate_high": None}
+    low, high = best["scatter_interval"]
+    return {"estimate": best["estimate"], "estimate_low": low, "estimate_high": high}
+
+
+def significant(value: float, digits: int = 3) -> str:
+    """``value`` to ``digits`` significant digits, in plain notation where it is short
+    (4.47, 0.447, 2170, 40000)."""
+    return f"{float(f'{value:.{digits}g}'):g}"
+
+
+def interval_text(low: float | None, high: float | None) -> str:
+    """A scan's interval as '4.61–6.13'; with an end the scan does not bound, '2170 to open',
+    and with neither, 'open both ways'."""
+    if low is None and high is None:
+        return "open both ways"
+    ends = ["open" if end is None else significant(end) for end in (low, high)]
+    return (" to " if None in (low, high) else "–").join(ends)
+
+
+def estimate_text(best: Mapping) -> str:
+    """A best.json record as figures and tables state it: the parameter's estimate, its
+    interval at its confidence, and the grid's best named as such ('k = 5.31 MPa/nm (95%
+    interval 4.61–6.13; grid's best 4.47)')."""
+    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    low, high = best["scatter_interval"]
+    return (
+        f"{symbol} = {significant(best['estimate'])} {unit} ({best['confidence']:.0%} interval "
+        f"{interval_text(low, high)}; grid's best {significant(best['grid_best'])})"
+    )
+
+
+def grid_best_text(best: Mapping) -> str:
+    """The grid's best value of a best.json record, for a figure that shows the model there,
+    with the estimate beside it ("the grid's best k = 4.47 MPa/nm (estimate 5.31, 95%
+    interval 4.61–6.13)")."""
+    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    low, high = best["scatter_interval"]
+    return (
+        f"the grid's best {symbol} = {significant(best['grid_best'])} {unit} (estimate "
+        f"{significant(best['estimate'])}, {best['confidence']:.0%} interval "
+        f"{interval_text(low, high)})"
+    )
+
+
+def grid_best_label(best: Mapping) -> str:
+    """The grid's best value of a best.json record, short, for a legend or a panel
+    ("grid's best k = 4.47 MPa/nm")."""
+    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    return f"grid's best {symbol} = {significant(best['grid_best'])} {unit}"
