@@ -1,5 +1,7 @@
 """Rule compare_scene: a scene's rendered contact registered on the sphere's measured
-fluorescence images, and compared load by load (areas, their ratio, IoU, pixel agreement)."""
+fluorescence images, and compared load by load (areas, their ratio, IoU, pixel agreement).
+The sphere's first microscope scene finds the registration; the others keep it
+(amontons.simulate.compare.scene_registration)."""
 
 import logging
 
@@ -18,7 +20,7 @@ from amontons.simulate.compare import (
     afm_scan_centre_in_image_m,
     compare_loads,
     outside_scan_record,
-    register_at_largest_load,
+    scene_registration,
     sheet_load_index,
     warped_mask,
 )
@@ -31,6 +33,7 @@ def main(
     rendered_path: str,
     solve_path: str,
     fluorescence,
+    sphere_registration_path: str | None,
     table_path: str,
     registration_path: str,
     figure_paths: list[str],
@@ -39,6 +42,7 @@ def main(
     images: dict,
     otsu: dict,
     data_label: str,
+    scene: str,
     label: str,
 ) -> None:
     settings = OtsuSettings.from_config(otsu)
@@ -81,7 +85,17 @@ def main(
             figure_paths,
         )
         return
-    registration = register_at_largest_load(rendered, [images[i].data for i in simulated])
+    sphere_record = (
+        None if sphere_registration_path is None else read_json(sphere_registration_path)
+    )
+    registration, found_here = scene_registration(
+        rendered, [images[i].data for i in simulated], sphere_record
+    )
+    log.info(
+        "registration %s: %s",
+        "found on this scene" if found_here else f"the sphere's ({sphere_registration_path})",
+        registration,
+    )
     solver_areas = [row["area_um2"] * 1e-12 for row in solve["loads"]]
     rows = compare_loads(
         [f * 1e-3 for f in simulated_mn],
@@ -107,7 +121,10 @@ def main(
         registration_path,
         {
             **registration.to_record(),
-            "registered_at_load_mn": simulated_mn[-1],
+            "registered_at_load_mn": (
+                simulated_mn[-1] if found_here else sphere_record["registered_at_load_mn"]
+            ),
+            "registered_on": scene if found_here else sphere_record["registered_on"],
             "definition": "measured position = rotate(mirror(simulated position about the "
             "rendered image's centre)) + measured image centre + shift; mirror flips columns, "
             "rotation counter-clockwise as displayed",
@@ -141,6 +158,9 @@ if __name__ == "__main__":
         rendered_path=sm.input.rendered,
         solve_path=sm.input.solve,
         fluorescence=sm.input.fluorescence,
+        sphere_registration_path=(
+            sm.input.sphere_registration[0] if sm.input.sphere_registration else None
+        ),
         table_path=sm.output.table,
         registration_path=sm.output.registration,
         figure_paths=[sm.output.png, sm.output.pdf],
@@ -149,5 +169,6 @@ if __name__ == "__main__":
         images=sm.params.images,
         otsu=sm.params.otsu,
         data_label=sm.params.data_label,
+        scene=sm.wildcards.scene,
         label=f"{sm.wildcards.sphere}, scene {sm.wildcards.scene}",
     )

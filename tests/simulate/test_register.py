@@ -14,12 +14,15 @@ import time
 import numpy as np
 import pytest
 
+from amontons.measure.area import otsu_contact_area
+from amontons.simulate.compare import OUTSIDE_SCAN, scene_registration
 from amontons.simulate.register import (
     Registration,
     overlay_score,
     register,
     warp_to_measured,
 )
+from amontons.simulate.render import Rendered
 
 SIM_SHAPE = (200, 220)
 MEAS_SHAPE = (256, 256)
@@ -193,3 +196,37 @@ def test_a_256_px_image_registers_within_seconds(simulated):
     start = time.perf_counter()
     register(simulated, measured)
     assert time.perf_counter() - start < 10.0
+
+
+def _rendered(image: np.ndarray) -> Rendered:
+    """A rendered load for scene_registration, on 100 nm pixels (its Otsu contact unused)."""
+    return Rendered(image, 1e-7, otsu_contact_area(image, 1e-7))
+
+
+def test_a_scene_keeps_the_spheres_registration_and_scores_it_on_its_own_image(simulated):
+    # The sphere's registration is taken as it is, not searched again: a record 0.4 px and
+    # 0.3° off this scene's own optimum comes back unchanged, mirror, angle and shift exact.
+    measured = _measured(True, 37.0, (3.4, -7.2))
+    sphere = Registration(True, 37.3, (3.8, -7.2), 0.5)
+    record = {**sphere.to_record(), "registered_on": "elastic", "registered_at_load_mn": 300.0}
+    # A second scene's rendering: the same islands, 20 % brighter (another model's contact).
+    scene = [_rendered(0.5 * simulated), _rendered(1.2 * simulated)]
+    found, found_here = scene_registration(scene, [measured, measured], record)
+    assert not found_here
+    assert (found.mirrored, found.rotation_deg, found.shift_px) == (True, 37.3, (3.8, -7.2))
+    # Its score is this scene's at its largest load, to round-off (the same warp and sums).
+    assert found.score == pytest.approx(overlay_score(1.2 * simulated, measured, sphere), 1e-12)
+    assert found.score != sphere.score
+
+
+@pytest.mark.parametrize("record", [None, {"status": OUTSIDE_SCAN, "registered_at_load_mn": None}])
+def test_a_scene_without_the_spheres_registration_finds_it(simulated, record):
+    # None: this scene is the one that finds the sphere's registration; an outside-scan record:
+    # the scene that should have found it simulated no load. Either way it is searched here,
+    # to the tolerances of test_a_known_transform_is_recovered.
+    measured = _measured(True, -120.0, (8.1, 4.7))
+    found, found_here = scene_registration([_rendered(simulated)], [measured], record)
+    assert found_here
+    assert found.mirrored is True
+    assert _angle_error(found.rotation_deg, -120.0) < 1.0
+    assert np.allclose(found.shift_px, (8.1, 4.7), atol=0.5), found

@@ -172,6 +172,13 @@ def test_a_scan_without_a_prior_runs_over_its_dimensionless_range(make_run, tmp_
     # the scans register on the elastic scene, the first microscope scene PS still runs
     assert run.scenes.registration_scene("PS", "k") == "elastic"
     assert with_prior.scenes.registration_scene("PS", "k") == "hardening"
+    # the sphere's registration is found on that scene, and every other scene reads it
+    assert run.scenes.sphere_registration_scene("PS") == "elastic"
+    where = {"material": "PS", "sphere": "PS"}
+    assert run.scenes.sphere_registration(SimpleNamespace(scene="elastic", **where)) == []
+    assert run.scenes.sphere_registration(SimpleNamespace(scene="hardening", **where)) == [
+        run.paths.scene("registration.json", "PS", "PS", "elastic")
+    ]
     lines = [line for line in run.left_out() if line.startswith("sphere PS ")]
     assert any(
         "scan k runs over its prior-free range (k·Δx/E* 0.01 to 100" in line for line in lines

@@ -141,6 +141,8 @@ rule compare_scene:
         rendered=rules.render_scene.output.rendered,
         solve=rules.simulate_scene.output.solve,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
+        # the sphere's registration, found once on its first microscope scene
+        sphere_registration=RUN.scenes.sphere_registration,
     output:
         table=f"{SCENE}/{COMPARISON}",
         registration=f"{SCENE}/{REGISTRATION}",

@@ -1,9 +1,11 @@
 """Simulated against measured contact, load by load (docs/simulate.md, "Compare").
 
 Registration first: the AFM frame (in which a scene is simulated) and the microscope frame
-differ by a shift and, for real data, a rotation and a mirror. They are found once, by
-cross-correlating the rendered simulation with the measured image at the largest load
-(:func:`amontons.simulate.register.register`), and that one registration serves every load.
+differ by a shift and, for real data, a rotation and a mirror. They belong to the sphere, not
+to the model, so they are found once per sphere, by cross-correlating one scene's rendered
+simulation with the measured image at the largest load
+(:func:`amontons.simulate.register.register`), and that one registration serves every load
+and every scene of the sphere (:func:`scene_registration`).
 
 Per load: the measured and simulated Otsu areas and their ratio; the intersection over union
 of the two masks (the simulated one warped onto the measured image's grid); and the per-pixel
@@ -13,12 +15,12 @@ agreement, the fraction of the measured image's pixels on which both masks say t
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from amontons.measure.area import ContactArea
-from amontons.simulate.register import Registration, register, warp_to_measured
+from amontons.simulate.register import Registration, overlay_score, register, warp_to_measured
 from amontons.simulate.render import Rendered
 
 
@@ -109,6 +111,27 @@ def register_at_largest_load(
     """The registration of the largest load's rendering on its measured image."""
     measured = np.asarray(measured_images[-1], dtype=float)
     return register(rendered[-1].image, measured)
+
+
+def scene_registration(
+    rendered: Sequence[Rendered],
+    measured_images: Sequence[np.ndarray],
+    sphere_record: Mapping | None,
+) -> tuple[Registration, bool]:
+    """The registration a scene is compared under, and whether it was found here.
+
+    ``sphere_record``: the sphere's registration.json, found on another scene of the sphere.
+    Its transform is kept, scored on this scene's largest load: a model changes the contact's
+    size, not where the sphere lies, and a scene's own search lands within 0.007° and 0.03 px
+    of it (docs/simulate.md §5). Where there is none (``None``: this scene finds the sphere's),
+    or that scene simulated no load (its window outside the AFM scan), the transform is found
+    here, on this scene's largest load.
+    """
+    if sphere_record is None or sphere_record.get("status") == OUTSIDE_SCAN:
+        return register_at_largest_load(rendered, measured_images), True
+    found = Registration.from_record(sphere_record)
+    measured = np.asarray(measured_images[-1], dtype=float)
+    return replace(found, score=overlay_score(rendered[-1].image, measured, found)), False
 
 
 def compare_loads(

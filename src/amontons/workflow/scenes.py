@@ -119,6 +119,21 @@ class Scenes:
             and self.missing_prior(sphere, scene) is None
         ]
 
+    def sphere_registration_scene(self, sphere: str) -> str | None:
+        """The scene a sphere's AFM frame is registered on the microscope's once (docs/simulate.md,
+        "Compare"): its first running microscope scene (the elastic scene in the configs); None
+        where it runs none."""
+        runs = [s for s in self.runnable(sphere) if self.has_optics(s)]
+        return runs[0] if runs else None
+
+    def sphere_registration(self, wildcards) -> list[str]:
+        """What a scene's comparison registers by: the sphere's registration, found on
+        :meth:`sphere_registration_scene` (nothing for that scene itself, which finds it)."""
+        scene = self.sphere_registration_scene(wildcards.sphere)
+        if scene is None or scene == wildcards.scene:
+            return []
+        return [self.paths.scene(files.REGISTRATION, wildcards.material, wildcards.sphere, scene)]
+
     def registration_scene(self, sphere: str, scan: str) -> str | None:
         """The scene whose registration a sphere's scan is judged under: its base scene, or,
         where the sphere does not run it (no prior), its first microscope scene; None where it
