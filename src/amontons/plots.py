@@ -120,13 +120,17 @@ def fit_titles(fig) -> None:
             return
 
 
+# Every figure's resolution (dots per inch).
+FIGURE_DPI = 150
+
+
 def _save(fig, paths: list[str]) -> None:
     """Fit the titles (fit_titles), then write ``fig`` to each path (format from the
     extension), atomically, and close it."""
     fit_titles(fig)
     for path in paths:
         with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=150, format=str(path).rsplit(".", 1)[-1])
+            fig.savefig(tmp, dpi=FIGURE_DPI, format=str(path).rsplit(".", 1)[-1])
     plt.close(fig)
 
 

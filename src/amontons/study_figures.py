@@ -4,7 +4,7 @@ data it is given (the scripts write the same data to a CSV beside the figure).""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import matplotlib
 
@@ -17,7 +17,8 @@ import pandas as pd  # noqa: E402
 
 from amontons.io.fields import read_load_series_settings  # noqa: E402
 from amontons.io.files import write_table  # noqa: E402
-from amontons.plots import _save, amontons_axes, plot_unmeasured  # noqa: E402
+from amontons.plots import FIGURE_DPI, _save, amontons_axes, plot_unmeasured  # noqa: E402
+from amontons.simulate.grid import block_mean  # noqa: E402
 
 
 @dataclass(frozen=True)
@@ -53,6 +54,34 @@ def _plain_log_ticks(ax) -> None:
         axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
+# The widths of the map panels (in): a map is drawn with no more pixels than its panel shows
+# at the figures' resolution (Figs. B.8, B.11 and B.9).
+_GRID_PANEL_IN = 1.6
+_HEIGHT_PANEL_IN = 3.2
+_GRID_PANEL_PX = round(_GRID_PANEL_IN * FIGURE_DPI)
+_HEIGHT_PANEL_PX = round(_HEIGHT_PANEL_IN * FIGURE_DPI)
+
+
+def at_display_resolution(panel: MapPanel, pixel_um: float, panel_px: int) -> MapPanel:
+    """``panel`` with its image (and outline) block-averaged to at most ``panel_px`` pixels a
+    side, its pixel (µm) and marker moved to the coarser grid; unchanged where it is no wider.
+    A block k covers pixels f·k … f·k + f - 1, so a position p lands at (p - (f - 1)/2)/f."""
+    factor = int(np.ceil(max(panel.image.shape) / panel_px))
+    if factor <= 1:
+        return panel
+    marker = panel.marker
+    if marker is not None:
+        marker = tuple((m - (factor - 1) / 2) / factor for m in marker)
+    return replace(
+        panel,
+        image=block_mean(panel.image, factor),
+        # the outline's fraction per block, drawn at 0.5: where most of the block is inside
+        outline=None if panel.outline is None else block_mean(panel.outline, factor),
+        marker=marker,
+        pixel_um=(panel.pixel_um or pixel_um) * factor,
+    )
+
+
 def _extent(shape, pixel_um: float) -> list[float]:
     rows, cols = shape
     return [-cols * pixel_um / 2, cols * pixel_um / 2, rows * pixel_um / 2, -rows * pixel_um / 2]
@@ -86,6 +115,11 @@ def _draw(ax, panel: MapPanel, pixel_um: float, cmap: str, limits=None) -> None:
     ax.set_yticks([])
 
 
+def _drawn_at(panel_px: int) -> str:
+    """The caption's note of the resolution maps are drawn at."""
+    return f"maps wider than {panel_px} px drawn as block means to at most {panel_px} px a side"
+
+
 def plot_map_grid(
     rows: Sequence[Sequence[MapPanel | None]],
     row_labels: Sequence[str],
@@ -102,7 +136,7 @@ def plot_map_grid(
     fig, axes = plt.subplots(
         n_rows,
         n_cols,
-        figsize=(1.6 * n_cols + 0.8, 1.7 * n_rows + 0.6),
+        figsize=(_GRID_PANEL_IN * n_cols + 0.8, 1.7 * n_rows + 0.6),
         squeeze=False,
         constrained_layout=True,
     )
@@ -117,11 +151,15 @@ def plot_map_grid(
             if panel is None:
                 ax.axis("off")
                 continue
-            _draw(ax, panel, pixel_um, cmap, limits)
+            shown = at_display_resolution(panel, pixel_um, _GRID_PANEL_PX)
+            _draw(ax, shown, pixel_um, cmap, limits)
             if c == 0:
                 ax.set_ylabel(label, fontsize=7)
     side = rows[0][0].image.shape[1] * pixel_um if rows[0][0] is not None else 0
-    fig.suptitle(f"{title} (each panel {side:.0f} µm wide)", fontsize=8)
+    fig.suptitle(
+        f"{title} (each panel {side:.0f} µm wide; {_drawn_at(_GRID_PANEL_PX)})",
+        fontsize=8,
+    )
     _save(fig, paths)
 
 
@@ -129,16 +167,29 @@ def plot_height_maps(panels: Sequence[MapPanel], title: str, paths: list[str]) -
     """Fig. B.9: height maps (nm; each panel with its own ``pixel_um``) side by side on one
     colour scale, each with the flattened region outlined and its centre marked."""
     fig, axes = plt.subplots(
-        1, len(panels), figsize=(3.2 * len(panels), 3.6), squeeze=False, constrained_layout=True
+        1,
+        len(panels),
+        figsize=(_HEIGHT_PANEL_IN * len(panels), 3.6),
+        squeeze=False,
+        constrained_layout=True,
     )
     values = np.concatenate([p.image.ravel() for p in panels])
     limits = tuple(np.percentile(values, [1, 99]))
     for ax, panel in zip(axes[0], panels, strict=True):
-        _draw(ax, panel, 1.0, "viridis", limits)
+        _draw(
+            ax,
+            at_display_resolution(panel, 1.0, _HEIGHT_PANEL_PX),
+            1.0,
+            "viridis",
+            limits,
+        )
     side = panels[0].image.shape[1] * panels[0].pixel_um
     mappable = plt.cm.ScalarMappable(norm=matplotlib.colors.Normalize(*limits), cmap="viridis")
     fig.colorbar(mappable, ax=list(axes[0]), shrink=0.8, label="height (nm)")
-    fig.suptitle(f"{title} (each panel {side:.1f} µm wide)", fontsize=8)
+    fig.suptitle(
+        f"{title} (each panel {side:.1f} µm wide; {_drawn_at(_HEIGHT_PANEL_PX)})",
+        fontsize=8,
+    )
     _save(fig, paths)
 
 

@@ -3,13 +3,22 @@
 Two ways, one per need: :func:`resample` interpolates a field at given positions (AFM scans,
 the gap at image pixel centres); :class:`PixelAverager` averages a field over each image pixel
 from the nearest solver pixel of each sub-sample, so a contact patch's edge counts by the
-fraction of the image pixel it covers.
+fraction of the image pixel it covers. :func:`block_mean` averages whole blocks of an image (the
+registration's coarse search; maps drawn at a figure's resolution).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage, sparse
+
+
+def block_mean(image: np.ndarray, factor: int) -> np.ndarray:
+    """Mean over ``factor`` × ``factor`` blocks, the rows and columns that fill no whole block
+    (at the end of each axis, fewer than ``factor``) dropped."""
+    rows, cols = (n // factor * factor for n in image.shape)
+    blocks = np.asarray(image, dtype=float)[:rows, :cols]
+    return blocks.reshape(rows // factor, factor, cols // factor, factor).mean(axis=(1, 3))
 
 
 def resample(

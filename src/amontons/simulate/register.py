@@ -61,6 +61,8 @@ from scipy import fft as sfft
 from scipy.ndimage import map_coordinates
 from scipy.optimize import minimize, minimize_scalar
 
+from amontons.simulate.grid import block_mean
+
 # The coarse search works on images about this many pixels across (px).
 _COARSE_SIZE_PX = 128
 # A downsampled image narrower than this (px) has too little left to register on.
@@ -240,14 +242,6 @@ def _signal_canvas_shape(signal: np.ndarray) -> tuple[int, int]:
     return side, side
 
 
-def _block_mean(image: np.ndarray, factor: int) -> np.ndarray:
-    """Mean over factor × factor blocks, after dropping the rows and columns that do not fill
-    a block (at the end of each axis)."""
-    rows, cols = (n // factor * factor for n in image.shape)
-    blocks = image[:rows, :cols].reshape(rows // factor, factor, cols // factor, factor)
-    return blocks.mean(axis=(1, 3))
-
-
 class _ShiftCorrelator:
     """Pearson correlation of a fixed measured image with a canvas placed at every integer
     offset, by FFT. Offset index k (per axis) puts canvas pixel i on measured pixel
@@ -371,8 +365,8 @@ def _coarse_candidates(
     """The best local maxima over angle of the correlation on block-averaged images; shifts
     in full-resolution px, scores on the coarse images."""
     factor = _coarse_factor(signal.shape, measured.shape)
-    small_signal = _block_mean(signal, factor)
-    small_measured = _block_mean(measured, factor)
+    small_signal = block_mean(signal, factor)
+    small_measured = block_mean(measured, factor)
     small_measured -= small_measured.mean()
     if _is_featureless(small_signal) or _is_featureless(small_measured):
         raise ValueError("an image has no feature larger than the coarse-search block")
