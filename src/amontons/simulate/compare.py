@@ -130,8 +130,8 @@ def scene_registration(
     if sphere_record is None or sphere_record.get("status") == OUTSIDE_SCAN:
         return register_at_largest_load(rendered, measured_images), True
     found = Registration.from_record(sphere_record)
-    measured = np.asarray(measured_images[-1], dtype=float)
-    return replace(found, score=overlay_score(rendered[-1].image, measured, found)), False
+    score = overlay_score(rendered[-1].image, measured_images[-1], found)
+    return replace(found, score=score), False
 
 
 def compare_loads(
