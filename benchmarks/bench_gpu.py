@@ -75,7 +75,9 @@ def fft_pair_seconds(backend: str, shape, repeats: int) -> float:
 def main() -> None:
     ap = parser(__doc__.splitlines()[0])
     # cupy-array: the array code on the GPU without its CUDA kernels, the baseline
-    ap.add_argument("--backend", default="cupy", choices=("cupy", "cupy-array", "numpy-array"))
+    ap.add_argument(
+        "--backend", default="cupy", choices=("cupy", "cupy-terms", "cupy-array", "numpy-array")
+    )
     ap.add_argument("--device-only", action="store_true", help="no CPU solve to compare with")
     ap.add_argument(
         "--cpu-repeats", type=int, default=None, help="CPU solves timed (default: --repeats)"

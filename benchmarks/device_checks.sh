@@ -29,7 +29,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)  # absolute: the benchmark steps run in benchmarks/
 failed=0
 python=${PYTHON:-python3}
-steps=" ${STEPS:-machine warm gpu gpu_large baseline profile tests} "
+steps=" ${STEPS:-machine warm gpu gpu_large scan baseline profile tests baseline_array} "
 backend=${BACKEND:-cupy}
 cores=$(nproc)
 if compgen -G ".whl/*.whl" > /dev/null; then
@@ -43,11 +43,11 @@ export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
 if [[ ${QUICK:-0} == 1 ]]; then
     gpu_sizes=(64 128) large_sizes=(256) scaling_size=256 repeats=1 threads=(1 2)
     padded_size=128 padded_threads=(1 2)
-    profile_size=128 baseline_sizes=(128)
+    profile_size=128 baseline_sizes=(128) scan_rounds=1
 else
     gpu_sizes=(512 2048) large_sizes=(4096) scaling_size=2048 repeats=3 threads=(1 8 16 4 2)
     padded_size=1024 padded_threads=(1 8)
-    profile_size=2048 baseline_sizes=(2048 4096)
+    profile_size=2048 baseline_sizes=(2048 4096) scan_rounds=2
 fi
 
 step() {  # step NAME SECONDS COMMAND...: run COMMAND for at most SECONDS, logged
@@ -73,7 +73,7 @@ step gpu 170 "$python" bench_gpu.py --backend "$backend" --sizes "${gpu_sizes[@]
     --laws elastic hardness --threads "$cores" --repeats "$repeats" --cpu-repeats 1
 step gpu_large 60 "$python" bench_gpu.py --backend "$backend" --device-only \
     --sizes "${large_sizes[@]}" --repeats "$repeats"
-step baseline 60 "$python" bench_gpu.py --backend "${BACKEND_BASELINE:-cupy-array}" \
+step baseline 60 "$python" bench_gpu.py --backend "${BACKEND_BASELINE:-cupy-terms}" \
     --device-only --sizes "${baseline_sizes[@]}" --repeats "$repeats"
 # where the host's time goes in the GPU route's solves: the 45 costliest functions
 step profile 40 bash -c "\"$python\" -m cProfile -s tottime bench_gpu.py --backend $backend \
@@ -84,7 +84,15 @@ step scaling 170 "$python" bench_iteration.py --sizes "$scaling_size" --bc perio
 step scaling_padded 120 "$python" bench_iteration.py --sizes "$padded_size" --bc non-periodic \
     --paths fused --thread-counts "${padded_threads[@]}" --repeats "$repeats"
 cd .. || exit 1
+# a whole scan (the bundle of bench_gpu_scan.py prepare, carried) on the GPU and on the CPU
+if [[ -f .scan_bundle/jobs.json ]]; then
+    step scan 150 "$python" benchmarks/bench_gpu_scan.py run --bundle .scan_bundle \
+        --backends "$backend" cpu --threads "$cores" --rounds "$scan_rounds"
+fi
 step tests 80 "$python" -m pytest -q -p no:cacheprovider \
     tests/contact/test_array_kernels.py tests/contact/test_device_kernels.py \
     tests/contact/test_thread_pools.py
+cd benchmarks || exit 1
+step baseline_array 40 "$python" bench_gpu.py --backend "${BACKEND_BASELINE_ARRAY:-cupy-array}" \
+    --device-only --sizes "${baseline_sizes[0]}" --repeats "$repeats"
 exit "$failed"

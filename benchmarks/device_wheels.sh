@@ -13,7 +13,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 py_version=${1:-3.12}
 python=${PYTHON:-python3}
-missing=(pyfftw jsonschema jsonschema-specifications referencing rpds-py)
+missing=(pyfftw jsonschema jsonschema-specifications referencing rpds-py ptufile pylibCZIrw
+    validators xmltodict)
 rm -rf .whl
 mkdir .whl
 "$python" -m pip wheel --quiet --no-deps --wheel-dir .whl .

@@ -9,7 +9,8 @@ function loops over the points with each parameter bound to its element by refer
 what the body wrote. Array arguments must have the declared dtype exactly, as CuPy's kernels
 with concrete types require; Python numbers are converted. Compiled with
 ``-ffp-contract=off``: no multiply-add is fused on any CPU, so the C++ evaluates each
-expression as numpy does.
+expression as numpy does. Its ``compile_reducing`` builds each reducing kernel into a
+function that folds the sums in the order its CUDA launch does (:func:`c_reducing_function`).
 """
 
 from __future__ import annotations
@@ -23,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from amontons.contact.array_backends import ArrayModule
+from amontons.contact.array_backends import SCALAR_TYPES, ArrayModule
+from amontons.contact.device_sources import MAX_HELPER, REDUCE_BLOCK, reduce_blocks
 
 TYPES = {
     "float64": ("double", np.float64),
@@ -90,9 +92,8 @@ class HarnessKernel:
 _LIBRARIES: dict[str, ctypes.CDLL] = {}
 
 
-def compile_source(source) -> HarnessKernel:
-    """``source`` compiled with g++ (cached per text for the session)."""
-    code = PRELUDE + source.preamble + c_function(source) + "\n"
+def _library(code: str) -> ctypes.CDLL:
+    """``code`` compiled with g++ (cached per text for the session)."""
     key = hashlib.sha256(code.encode()).hexdigest()[:16]
     if key not in _LIBRARIES:
         folder = Path(tempfile.mkdtemp(prefix="amontons-harness-"))
@@ -104,9 +105,88 @@ def compile_source(source) -> HarnessKernel:
             capture_output=True,
         )
         _LIBRARIES[key] = ctypes.CDLL(str(folder / "k.so"))
-    return HarnessKernel(_LIBRARIES[key], source)
+    return _LIBRARIES[key]
+
+
+def compile_source(source) -> HarnessKernel:
+    """``source`` compiled with g++."""
+    return HarnessKernel(_library(PRELUDE + source.preamble + c_function(source) + "\n"), source)
+
+
+def c_reducing_function(kernel) -> str:
+    """The C++ function of a ``ReducingKernel`` that computes what its CUDA launch does
+    (amontons.contact.device_sources.cuda_source), the threads of each block in turn: each
+    thread ``tid`` of block ``b`` folds its points ``b·B + tid + k·blocks·B`` in order, then
+    the block's tree folds the slots level by level, as the barriers order them on a GPU.
+    The points' bodies are independent, so running them in another order changes nothing."""
+    b = REDUCE_BLOCK
+    return f"""
+extern "C" void {kernel.name}({kernel.signature(extra="const long long blocks")}) {{
+    static double shared[{len(kernel.reduced) * b}];
+    for (long long block = 0; block < blocks; ++block) {{
+        for (unsigned int tid = 0; tid < {b}; ++tid) {{
+            {kernel.initial()}
+            for (long long i = block * {b} + tid; i < n; i += blocks * {b}) {{
+{kernel.point_code()}
+            }}
+            {kernel.block_store()}
+        }}
+        for (unsigned int s = {b // 2}; s > 0; s >>= 1) {{
+            for (unsigned int tid = 0; tid < s; ++tid) {{ {kernel.tree_step()} }}
+        }}
+        {kernel.block_result("block")}
+    }}
+}}
+"""
+
+
+CTYPES = {"float64": ctypes.c_double, "int32": ctypes.c_int, "uint8": ctypes.c_ubyte,
+          "int8": ctypes.c_byte}  # fmt: skip
+
+
+def compile_reducing(kernel):
+    """A ``ReducingKernel`` compiled with g++, called as the CuPy launcher is
+    (amontons.contact.array_backends): its arguments, then its ``(blocks, K)`` partials back."""
+    code = PRELUDE + kernel.source.preamble + MAX_HELPER + c_reducing_function(kernel)
+    fn = getattr(_library(code), kernel.name)
+    spec = kernel.arguments()
+
+    def launch(*args):
+        arrays = [a for (kind, _, _), a in zip(spec, args, strict=True) if kind in ("in", "out")]
+        n = arrays[0].size
+        converted, held = [], []  # held: the arrays made here, alive through the call
+        for (kind, t, name), a in zip(spec, args, strict=True):
+            if kind == "scalar":
+                assert isinstance(a, int | float), (kernel.name, name, type(a))
+                converted.append(CTYPES[t](SCALAR_TYPES[t](a)))
+                continue
+            if kind == "broadcast":
+                a = np.full(1, float(a)) if isinstance(a, int | float) else a
+                held.append(a)
+                step = 0 if a.size == 1 else 1
+                assert a.dtype == TYPES[t][1] and a.size in (1, n), (kernel.name, name)
+                converted += [a.ctypes.data_as(ctypes.c_void_p), ctypes.c_longlong(step)]
+                continue
+            assert a.dtype == TYPES[t][1] and a.size == n, (kernel.name, name)
+            assert a.flags.c_contiguous, (kernel.name, name)
+            converted.append(a.ctypes.data_as(ctypes.c_void_p))
+        blocks = reduce_blocks(n)
+        partials = np.empty((blocks, len(kernel.reduced)))
+        fn(ctypes.c_longlong(n), ctypes.c_longlong(blocks), *converted,
+           partials.ctypes.data_as(ctypes.c_void_p))  # fmt: skip
+        return partials
+
+    return launch
 
 
 def harness_module() -> ArrayModule:
     """numpy, with the CUDA sources compiled as C++ (module docstring)."""
-    return ArrayModule("numpy-harness", np, np.asarray, np.add.at, lambda fn: fn, compile_source)
+    return ArrayModule(
+        "numpy-harness",
+        np,
+        np.asarray,
+        np.add.at,
+        lambda fn: fn,
+        compile_source,
+        compile_reducing,
+    )

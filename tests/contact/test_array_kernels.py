@@ -88,6 +88,11 @@ BACKENDS = [
         "cupy-array",
         marks=pytest.mark.skipif(not _device(), reason="no CuPy or no CUDA device"),
     ),
+    # the CUDA kernels that write their terms, summed by CuPy (the reducing kernels' baseline)
+    pytest.param(
+        "cupy-terms",
+        marks=pytest.mark.skipif(not _device(), reason="no CuPy or no CUDA device"),
+    ),
 ]
 
 

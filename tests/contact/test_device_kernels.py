@@ -28,11 +28,22 @@ import pytest
 from amontons.contact import self_affine, sphere
 from amontons.contact.array_backends import NUMPY
 from amontons.contact.array_convolution import ArrayConvolution
-from amontons.contact.array_kernels import ArrayKernels, DeviceKernels
+from amontons.contact.array_kernels import (
+    ArrayKernels,
+    DeviceKernels,
+    ReducingKernels,
+    fold_partials,
+)
 from amontons.contact.cg import run_to_outcome
 from amontons.contact.cg_iteration import CGIteration
 from amontons.contact.constraints import BoundedWall, HardWall
 from amontons.contact.convolution import fast_padded_shape
+from amontons.contact.device_sources import (
+    REDUCE_BLOCK,
+    REDUCE_MAX_BLOCKS,
+    REDUCING_STEP,
+    reduce_blocks,
+)
 from amontons.contact.options import CGOptions
 
 
@@ -183,3 +194,150 @@ def test_whole_solve_agrees_with_the_array_code(device, name):
     assert np.array_equal(dev.pressure, arr.pressure)
     if p_y is not None:
         assert np.any(arr.pressure >= p_y * (1 - 1e-12))  # the bound is reached somewhere
+
+
+# -- the reducing kernels (ReducingKernels, the set backend="cupy" runs) --
+#
+# Their element-wise results are the same expressions as the array code's: compared to the
+# last bit. Their sums fold each thread's points, then each block's tree, then the blocks,
+# where numpy sums pairwise: they agree to round-off, SUM_RTOL of the sum of the magnitudes
+# (a sum of N = 5e4 terms in another order differs by at most ~N·eps of it; pairwise and
+# blocked orders stay near log2(N)·eps ~ 4e-15). Counts and maxima are exact.
+SUM_RTOL = 1e-13
+
+
+@pytest.fixture(scope="module")
+def reducing():
+    return ReducingKernels(harness_module())
+
+
+def _close(got, want, magnitude):
+    assert abs(got - want) <= SUM_RTOL * magnitude, (got, want, magnitude)
+
+
+def test_reducing_gap_moments(reducing):
+    s = _state()
+    args = (s["u"], 1.3, s["h"], s["m"], s["t"], 0.2)
+    a = np.abs((1.3 * s["u"] - s["h"] - 0.2) * s["m"])
+    scales = (a.sum(), (a * a).sum(), (a * np.abs(s["t"])).sum(), np.abs(s["t"]).sum())
+    for got, want, scale in zip(
+        reducing.gap_moments(*args), A.gap_moments(*args), scales, strict=True
+    ):
+        _close(got, want, scale)
+
+
+@pytest.mark.parametrize("bounded", [False, True])
+def test_reducing_direction(reducing, bounded):
+    s = _state()
+    p_max = s["p_max"] if bounded else np.full(1, np.inf)
+    out = {}
+    for name, ks in (("reducing", reducing), ("array", A)):
+        t, violators = s["t"].copy(), np.zeros(1, np.int64)
+        total = ks.direction(
+            s["u"], 1.1, s["h"], s["m"], t, 0.1, 0.7, 0.05, s["p"], p_max, bounded, violators,
+            None, None,
+        )  # fmt: skip
+        out[name] = (t, int(violators[0]), float(total))
+    assert np.array_equal(out["reducing"][0], out["array"][0])
+    assert out["reducing"][1] == out["array"][1] > 0
+    _close(out["reducing"][2], out["array"][2], np.abs(out["array"][0]).sum())
+
+
+def test_reducing_step_dots(reducing):
+    s = _state()
+    got = reducing.step_dots(s["r"].copy(), s["t"], s["m"], np.zeros(1), False)
+    want = A.step_dots(s["r"].copy(), s["t"], s["m"], np.zeros(1), False)
+    _close(got[0], want[0], np.abs(s["r"] * s["t"]).sum())
+    _close(got[1], want[1], np.abs(s["r"] * s["m"]).sum())
+
+
+def test_reducing_relative_change(reducing):
+    s = _state()
+    p_new = s["p"] * 1.01 + 0.001
+    got = reducing.relative_change(p_new, 1.2, s["p"], 1.1)
+    want = A.relative_change(p_new, 1.2, s["p"], 1.1)
+    for g, w in zip(got, want, strict=True):
+        _close(g, w, abs(w))
+
+
+@pytest.mark.parametrize("bounded", [False, True])
+@pytest.mark.parametrize("events", [0, 4, 200])
+@pytest.mark.parametrize(("keep_mask", "with_u"), [(False, True), (True, True)])
+def test_reducing_update(reducing, bounded, events, keep_mask, with_u):
+    """The step's fields to the last bit, its counts and records exact, its sums to
+    round-off; the counts reach event_counts and changed_points without a transfer."""
+    rng = np.random.default_rng(events + 10 * bounded)
+    case = kernel_cases.update_case(rng, N, bounded, events, closed=True)
+    out = {}
+    for name, ks in (("reducing", reducing), ("array", A)):
+        c = {k: v.copy() for k, v in case.items()}
+        idx, val = np.zeros((1, ks.SLOTS), np.int64), np.zeros((1, ks.SLOTS))
+        counts = np.zeros((1, 2), np.int64)
+        p_new = c["p"] if not keep_mask else np.empty(N)
+        fields = [c[k] for k in ("u", "r", "t", "h", "m", "p_max")]
+        records = (np.zeros(1, np.int64), idx, val, counts, keep_mask, with_u, None, None, 32)
+        result = ks.update(c["p"], p_new, *fields, bounded, 1.0, 0.1, 0.3, *records)
+        changed = [a.copy() for a in ks.changed_points(counts, idx, val)]
+        out[name] = (result, c, p_new, ks.event_counts(counts), counts.copy(), changed)
+    (o_r, c_r, p_r, k_r, n_r, ch_r), (o_a, c_a, p_a, k_a, n_a, ch_a) = out.values()
+    assert k_r == k_a and np.array_equal(n_r, n_a)
+    if events:
+        assert sum(k_a) >= 2 * events * 0.9  # the case made the events it was meant to
+    assert np.array_equal(p_r, p_a)
+    for field in ("m", "t", "u", "p"):
+        assert np.array_equal(c_r[field], c_a[field]), field
+    _close(o_r[0], o_a[0], np.abs(p_a).sum())
+    assert o_r[1] == o_a[1]  # the worst penetration: a maximum
+    _close(o_r[2], o_a[2], np.abs(p_a).sum())
+    assert o_r[3] == o_a[3]
+    if bounded and events:
+        assert o_a[2] > 0  # points at the bound
+    if o_a[3]:
+        assert all(np.array_equal(x, y) for x, y in zip(ch_r, ch_a, strict=True))
+
+
+def test_reducing_partials_fold_in_a_fixed_order():
+    """The harness's blocks are the device launch's: a point count's partials have
+    reduce_blocks rows, and the fold of a sum whose terms cancel exactly in index order
+    (1, -1, 1, ...) but not in floating point if taken carelessly stays exact here."""
+    kernel = harness.compile_reducing(REDUCING_STEP)
+    n = 3 * REDUCE_BLOCK * REDUCE_MAX_BLOCKS + 17  # threads with several points each
+    r = np.ones(n)
+    t = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    partials = kernel(r, t, np.ones(n, np.uint8))
+    assert partials.shape == (reduce_blocks(n), 2) == (REDUCE_MAX_BLOCKS, 2)
+    assert fold_partials(partials, REDUCING_STEP.reduced) == [float(t.sum()), float(n)]
+
+
+@pytest.mark.parametrize("name", sorted(SOLVES))
+def test_reducing_whole_solve_agrees_with_the_array_code(reducing, name):
+    """Same status, iterations and contact set; pressures within 1e-10 of the peak, the
+    GPU route's tolerance against the CPU path (tests/contact/test_array_kernels.py): the
+    sums' order moves each iterate by round-off, which the tolerance of the solve (1e-8)
+    does not amplify beyond it."""
+    make, periodic, control, p_y = SOLVES[name]
+    h = make()
+    padded = None if periodic else fast_padded_shape(h.shape)
+    constraint = HardWall() if p_y is None else BoundedWall(np.full(h.shape, p_y))
+    outs = []
+    for ks in (reducing, A):
+        op = ArrayConvolution(h.shape, 1.0, 1.0, np, padded)
+        it = CGIteration(
+            ks,
+            op,
+            h,
+            CGOptions(tol=1e-8, max_iter=3000),
+            pixel_area=1.0,
+            h_scale=float(h.std()),
+            p_init=np.ones_like(h),
+            constraint=constraint,
+            load=control.get("load"),
+            displacement=control.get("displacement"),
+        )
+        outs.append(run_to_outcome(it))
+    red, arr = outs
+    assert red.status == arr.status == 0
+    assert red.iterations == arr.iterations
+    peak = float(np.abs(arr.pressure).max())
+    assert float(np.abs(red.pressure - arr.pressure).max()) <= 1e-10 * peak
+    assert np.array_equal(red.pressure > 0, arr.pressure > 0)

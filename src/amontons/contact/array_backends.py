@@ -6,7 +6,9 @@ the same array code on the CPU so that CI, without a GPU, tests its logic.
 the array set: ``"cupy"``, ``"numpy-array"`` (for tests: the GPU route's code on numpy
 arrays, which the numba set outruns on a CPU) and ``"cupy-array"`` (for benchmarks: the
 array code on the GPU without its CUDA kernels, the baseline those kernels are timed
-against on the same device).
+against on the same device) and ``"cupy-terms"`` (for benchmarks: the CUDA kernels that
+write their terms to memory and sum them with CuPy, one launch per sum: the route's second
+version, the baseline of the reducing kernels that ``"cupy"`` runs).
 
 This is the one module that imports CuPy, and it does so lazily, inside
 :func:`_load_cupy`: CuPy is an optional dependency that most installations lack, and its
@@ -22,12 +24,16 @@ from functools import lru_cache, partial
 
 import numpy as np
 
+from .device_sources import REDUCE_BLOCK, cuda_source, reduce_blocks
 from .errors import BackendUnavailableError
 
 CUPY = "cupy"
 NUMPY_ARRAY = "numpy-array"
 CUPY_ARRAY = "cupy-array"
-ARRAY_BACKENDS = (CUPY, NUMPY_ARRAY, CUPY_ARRAY)
+CUPY_TERMS = "cupy-terms"
+ARRAY_BACKENDS = (CUPY, NUMPY_ARRAY, CUPY_ARRAY, CUPY_TERMS)
+# a reducing kernel's scalar parameters as the device reads them (.device_sources.TYPES)
+SCALAR_TYPES = {"float64": np.float64, "int32": np.int32, "uint8": np.uint8, "int8": np.int8}
 INSTALL_HINT = "pip install 'amontons[gpu]' (CuPy for CUDA 12, cupy-cuda12x)"
 
 
@@ -41,7 +47,11 @@ class ArrayModule:
     arrays and scalars into one kernel (``cupy.fuse``; identity on numpy); ``compile``:
     builds an element-wise kernel from its source (a :class:`.device_sources.KernelSource`),
     callable as CuPy's are (inputs, then outputs), or None where the
-    namespace runs no CUDA source (numpy: the array set then runs its array code).
+    namespace runs no CUDA source (numpy: the array set then runs its array code);
+    ``compile_reducing``: builds a :class:`.device_sources.ReducingKernel`, called with its
+    arguments in the order of ``ReducingKernel.arguments`` and returning its ``(blocks, K)``
+    partials as an array of the namespace, or None (the set then sums the terms its
+    element-wise kernels write).
     """
 
     name: str
@@ -50,6 +60,7 @@ class ArrayModule:
     add_at: object
     fuse: object
     compile: object = None
+    compile_reducing: object = None
 
 
 def _identity(fn):
@@ -65,7 +76,7 @@ def array_module(name: str) -> ArrayModule:
     Raises
     ------
     BackendUnavailableError
-        ``"cupy"`` or ``"cupy-array"`` without CuPy or without a CUDA device.
+        ``"cupy"``, ``"cupy-array"`` or ``"cupy-terms"`` without CuPy or a CUDA device.
     ValueError
         Another name.
     """
@@ -74,7 +85,9 @@ def array_module(name: str) -> ArrayModule:
     if name == CUPY:
         return _load_cupy()
     if name == CUPY_ARRAY:
-        return replace(_load_cupy(), name=CUPY_ARRAY, compile=None)
+        return replace(_load_cupy(), name=CUPY_ARRAY, compile=None, compile_reducing=None)
+    if name == CUPY_TERMS:
+        return replace(_load_cupy(), name=CUPY_TERMS, compile_reducing=None)
     raise ValueError(f"unknown array backend {name!r}; expected one of {ARRAY_BACKENDS}")
 
 
@@ -102,7 +115,13 @@ def _load_cupy() -> ArrayModule:
             "with an NVIDIA GPU, or use backend=None for the CPU solver"
         )
     return ArrayModule(
-        CUPY, cupy, cupy.asnumpy, cupyx.scatter_add, cupy.fuse, partial(_cupy_kernel, cupy)
+        CUPY,
+        cupy,
+        cupy.asnumpy,
+        cupyx.scatter_add,
+        cupy.fuse,
+        partial(_cupy_kernel, cupy),
+        partial(_cupy_reducing_kernel, cupy),
     )
 
 
@@ -111,3 +130,39 @@ def _cupy_kernel(cupy, source):
     return cupy.ElementwiseKernel(
         source.in_params, source.out_params, source.body, source.name, preamble=source.preamble
     )
+
+
+def _cupy_reducing_kernel(cupy, kernel):
+    """The launcher of ``kernel`` (a .device_sources.ReducingKernel) on CuPy: its arguments
+    in ``kernel.arguments()`` order (scalars as Python numbers, arrays flat and contiguous of
+    the declared types and of one size, a broadcast one also a number or of one value);
+    returns the ``(blocks, K)`` partials."""
+    raw = cupy.RawKernel(cuda_source(kernel), kernel.name)
+    spec = kernel.arguments()
+    count = len(kernel.reduced)
+    ones = {}  # a broadcast number as a one-value device array, made once per value
+
+    def broadcast(value, n):
+        if not isinstance(value, cupy.ndarray):
+            if float(value) not in ones:
+                ones[float(value)] = cupy.full(1, float(value))
+            value = ones[float(value)]
+        return [value, np.int64(0 if value.size == 1 else 1)]
+
+    def launch(*args):
+        pairs = zip(spec, args, strict=True)
+        n = next(a.size for (kind, _, _), a in pairs if kind in ("in", "out"))
+        blocks = reduce_blocks(n)
+        partials = cupy.empty((blocks, count))
+        typed = []
+        for (kind, t, _), a in zip(spec, args, strict=True):
+            if kind == "scalar":
+                typed.append(SCALAR_TYPES[t](a))
+            elif kind == "broadcast":
+                typed += broadcast(a, n)
+            else:
+                typed.append(a)
+        raw((blocks,), (REDUCE_BLOCK,), (np.int64(n), *typed, partials))
+        return partials
+
+    return launch

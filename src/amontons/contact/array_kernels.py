@@ -97,10 +97,13 @@ def _where(xp):
 def array_kernel_set(name: str) -> ArrayKernels:
     """The array kernel set on the namespace of backend ``name``
     (:func:`.array_backends.array_module`; raises there without CuPy or a device):
-    :class:`DeviceKernels` where the namespace compiles CUDA source (CuPy), else
-    :class:`ArrayKernels`."""
+    :class:`ReducingKernels` where the namespace compiles CUDA source with its sums (CuPy,
+    ``"cupy"``), :class:`DeviceKernels` where only the element-wise passes
+    (``"cupy-terms"``), else :class:`ArrayKernels`."""
     module = array_module(name)
-    return ArrayKernels(module) if module.compile is None else DeviceKernels(module)
+    if module.compile is None:
+        return ArrayKernels(module)
+    return DeviceKernels(module) if module.compile_reducing is None else ReducingKernels(module)
 
 
 class ArrayKernels:
@@ -400,3 +403,122 @@ class DeviceKernels(ArrayKernels):
         on_bound = at_bound.sum() if bounded else xp.zeros(())
         events = (clipped, joined, cval, added)
         return self._step_results(p_new, gj.max(), on_bound, events, counts, idx, val, record_max)
+
+
+def fold_partials(partials: np.ndarray, reduced) -> list[float]:
+    """The sums and maxima of a reducing kernel from its ``(blocks, K)`` partials (host
+    numpy), the ops of ``reduced`` (``.device_sources.ReducingKernel.reduced``): each column
+    folded in block order (numpy's pairwise sum of a contiguous row), so a given point count
+    always sums in the same order."""
+    columns = np.ascontiguousarray(partials.T)
+    return [
+        float(np.sum(col) if op == "sum" else np.max(col))
+        for col, (_, op) in zip(columns, reduced, strict=True)
+    ]
+
+
+class ReducingKernels(DeviceKernels):
+    """The device set whose every-iteration kernels (``gap_moments``, ``direction``,
+    ``step_dots``, ``update``) and ``relative_change`` each run as one reducing kernel of
+    :mod:`.device_sources`: the element-wise pass and its sums in one launch, whose blocks'
+    partials the host reads in one transfer and folds (:func:`fold_partials`), in place of a
+    pass that writes its terms and one launch per sum (:class:`DeviceKernels`). The sums are
+    taken in another order than the array code's, so they agree with it to round-off (as
+    the numba set's do); the element-wise results are the same expressions."""
+
+    def __init__(self, module: ArrayModule):
+        super().__init__(module)
+        build = module.compile_reducing
+        self._gap_reduce = build(src.REDUCING_GAP)
+        self._direction_reduce = build(src.REDUCING_DIRECTION)
+        self._step_reduce = build(src.REDUCING_STEP)
+        self._update_reduce = build(src.REDUCING_UPDATE)
+        self._change_reduce = build(src.REDUCING_RELATIVE_CHANGE)
+        # (counts array, clipped, added) of the last update: its host copy, which spares
+        # event_counts and changed_points a transfer; forgotten when rescale_free rewrites
+        self._counted = None
+
+    def _folded(self, kernel, spec, *args) -> list[float]:
+        """``kernel``'s sums and maxima on the host: one launch, one transfer."""
+        return fold_partials(self.to_host(kernel(*args)), spec.reduced)
+
+    def gap_moments(self, u, sigma, h, m, t, shift):
+        """``(Σ_m a, Σ_m a², Σ_m a·t, Σ t)`` of ``a = sigma·u - h - shift`` on ``m``."""
+        return tuple(self._folded(self._gap_reduce, src.REDUCING_GAP, u, sigma, h, shift, m, t))
+
+    def direction(self, u, sigma, h, m, t, d, beta, shift, p, p_max, bounded, violators, vidx, vg):
+        """As :meth:`ArrayKernels.direction`: ``t`` in place, the violators counted into
+        ``violators[0]``; returns ``Σ t`` as a 0-d array of the namespace (folded on the
+        device: the loop does not read either)."""
+        ub = self._bound(p_max, bounded)
+        partials = self._direction_reduce(u, sigma, h, d, beta, shift, m, p, ub, t)
+        totals = partials.sum(axis=0)
+        violators[0] = totals[0].astype(violators.dtype)
+        return totals[1]
+
+    def step_dots(self, r, t, m, compliance, winkler):
+        """With ``winkler``, ``r += compliance·t`` in place; ``(Σ r·t, Σ_m r)``."""
+        if winkler:
+            r += compliance * t
+        rt, rm = self._folded(self._step_reduce, src.REDUCING_STEP, r, t, m)
+        return rt, rm
+
+    def update(
+        self, p, p_new, u, r, t, h, m, p_max, bounded, sigma, d, tau, violators, idx, val,
+        counts, keep_mask, with_u, vidx, vg, record_max,
+    ):  # fmt: skip
+        """As :meth:`ArrayKernels.update`: the step, its sums and its event counts in one
+        kernel and one transfer; the records, when they fit, from its flags."""
+        xp = self.xp
+        if p_new is not p:
+            p_new[...] = p
+        n = p.size
+        clipped, joined = xp.empty(n, np.int8), xp.empty(n, np.int8)
+        cval, added = xp.empty(n), xp.empty(n)
+        ub = self._bound(p_max, bounded)
+        args = (r, h, sigma, d, tau, tau / sigma, ub, int(keep_mask), int(with_u))
+        outs = (p_new, m, t, u, clipped, joined, cval, added)
+        psum, pen, at_bound, n_clip, n_add = self._folded(
+            self._update_reduce, src.REDUCING_UPDATE, *args, *outs
+        )
+        counts[0] = xp.asarray([int(n_clip), int(n_add)], dtype=counts.dtype)
+        self._counted = (counts, int(n_clip), int(n_add))
+        n_events = int(n_clip) + int(n_add)
+        complete = not (n_events > 0 and n_events > min(record_max, SLOTS))
+        if n_events and complete:
+            where_clip = xp.flatnonzero(clipped)
+            where_join = xp.flatnonzero(joined)
+            self._record(idx, val, where_clip, cval[where_clip], where_join, added[where_join])
+        return psum, pen, at_bound if bounded else 0.0, complete
+
+    def _counts_of(self, counts):
+        """The last update's ``(clipped, added)`` where ``counts`` holds them, else None."""
+        if self._counted is not None and self._counted[0] is counts:
+            return self._counted[1:]
+        return None
+
+    def event_counts(self, counts) -> tuple[int, int]:
+        """The points ``update`` clipped and added: its host copy, else one transfer."""
+        known = self._counts_of(counts)
+        return known if known is not None else super().event_counts(counts)
+
+    def changed_points(self, counts, idx_buf, val_buf):
+        """As :meth:`ArrayKernels.changed_points`, the count from the last update's host
+        copy where it wrote ``counts``."""
+        known = self._counts_of(counts)
+        if known is None:
+            return super().changed_points(counts, idx_buf, val_buf)
+        k = sum(known)
+        return idx_buf[0, :k], val_buf[0, :k]
+
+    def rescale_free(self, p, u, v, m_old, m_new, t, p_max, s, with_u, idx, val, counts):
+        """As :meth:`ArrayKernels.rescale_free` (which rewrites ``counts``)."""
+        self._counted = None
+        return super().rescale_free(p, u, v, m_old, m_new, t, p_max, s, with_u, idx, val, counts)
+
+    def relative_change(self, p_new, s_new, p, s_old):
+        """``(Σ|s_new·p_new - s_old·p|, Σ s_new·p_new)``."""
+        change, total = self._folded(
+            self._change_reduce, src.REDUCING_RELATIVE_CHANGE, p_new, s_new, p, s_old
+        )
+        return change, total

@@ -124,3 +124,195 @@ UPDATE = KernelSource(
     at_bound = p * (sigma * p >= ub);
     """,
 )
+
+# relative_change's terms: q = s_new·p_new and |q - s_old·p|
+RELATIVE_CHANGE = KernelSource(
+    "amontons_relative_change",
+    "float64 p_new, float64 s_new, float64 p, float64 s_old",
+    "float64 q, float64 change",
+    "q = s_new * p_new; change = fabs(q - s_old * p);",
+)
+
+
+# -- the passes with their sums: one launch each, a block's partial sums per launch ---------
+#
+# A reducing kernel runs a KernelSource's body over the points with a grid-stride loop and
+# reduces some of its values (inputs, stored outputs, or per-point locals the body writes that
+# are kept nowhere) in the same pass: each thread folds its points in index order, each block
+# folds its threads' values through a shared-memory tree, and block b writes its partials
+# into row b of a (blocks, K) array. The host (or one small sum on the device) folds the rows.
+# So an iteration's pass and its sums are one launch and one read, where the terms kernels
+# wrote the terms to memory and summed them with one launch each; the order of each sum is
+# fixed by the point count alone (REDUCE_BLOCK, reduce_blocks), so a device's sums are
+# deterministic, and tests/contact/cuda_harness.py folds in the same order on the CPU.
+
+REDUCE_BLOCK = 256  # threads per block: the width of the shared-memory tree (a power of 2)
+REDUCE_MAX_BLOCKS = 1024  # about an H100's resident threads (132 SMs × 2048) at 256 a block
+
+TYPES = {"float64": "double", "uint8": "unsigned char", "int8": "signed char", "int32": "int"}
+
+# the fold of a max: NaN wins, as numpy's and CuPy's max propagate it
+MAX_HELPER = """
+__device__ inline double amontons_max(double a, double b) { return (a != a || a > b) ? a : b; }
+"""
+
+
+def reduce_blocks(n: int) -> int:
+    """The blocks of a reducing kernel's launch over ``n`` points: one per REDUCE_BLOCK
+    points, at most REDUCE_MAX_BLOCKS (the rows of its partials)."""
+    return max(1, min(REDUCE_MAX_BLOCKS, -(-n // REDUCE_BLOCK)))
+
+
+def parse_params(text: str) -> list[tuple[str, str]]:
+    """``"float64 u, uint8 m"`` as ``[("float64", "u"), ("uint8", "m")]``."""
+    return [tuple(p.split()) for p in text.split(",")]
+
+
+@dataclass(frozen=True)
+class ReducingKernel:
+    """A :class:`KernelSource` run as one pass that also reduces: ``scalars`` are the input
+    parameters passed as one value, ``broadcast`` those passed as one value or one per point
+    (a bound: ``inf``, or a pressure per pixel), the others arrays of the points; ``stored`` the
+    output parameters written to arrays (the others are per-point locals of the body);
+    ``reduced`` the ``(parameter, "sum" | "max")`` folded over the points, in the order of the
+    partials' columns (an output's value after the body)."""
+
+    source: KernelSource
+    scalars: tuple[str, ...]
+    stored: tuple[str, ...]
+    reduced: tuple[tuple[str, str], ...]
+    broadcast: tuple[str, ...] = ()
+
+    @property
+    def name(self) -> str:
+        return f"{self.source.name}_reduce"
+
+    def arguments(self) -> list[tuple[str, str, str]]:
+        """The kernel's parameters after the point count, as ``(kind, type, name)``: kind
+        ``scalar``, ``broadcast`` (an array of one value or one per point, with its step
+        through the points: 0 or 1), ``in`` (an input array) or ``out`` (a stored output
+        array); then the partials."""
+
+        def kind(name):
+            if name in self.scalars:
+                return "scalar"
+            return "broadcast" if name in self.broadcast else "in"
+
+        ins = [(kind(name), t, name) for t, name in parse_params(self.source.in_params)]
+        outs = [("out", t, n) for t, n in parse_params(self.source.out_params) if n in self.stored]
+        return ins + outs
+
+    def point_code(self) -> str:
+        """The body at point ``i``, bound as CuPy binds an element-wise kernel's parameters,
+        then the fold of each reduced value into ``acc<k>``."""
+        lines = []
+        for kind, t, name in self.arguments():
+            if kind == "in":
+                lines.append(f"const {TYPES[t]} {name} = {name}_[i];")
+            elif kind == "broadcast":
+                lines.append(f"const {TYPES[t]} {name} = {name}_[i * {name}_step];")
+            elif kind == "out":
+                lines.append(f"{TYPES[t]}& {name} = {name}_[i];")
+        for t, name in parse_params(self.source.out_params):
+            if name not in self.stored:
+                lines.append(f"{TYPES[t]} {name};")
+        lines.append("{" + self.source.body + "}")
+        for k, (name, op) in enumerate(self.reduced):
+            lines.append(f"acc{k} = {fold(op, f'acc{k}', f'(double)({name})')};")
+        return "\n".join(lines)
+
+    def signature(self, extra: str = "") -> str:
+        """The parameters' C declarations: the point count, the arguments, the partials."""
+        decls = ["const long long n", *([extra] if extra else [])]
+        for kind, t, name in self.arguments():
+            if kind == "scalar":
+                decls.append(f"const {TYPES[t]} {name}")
+            elif kind == "in":
+                decls.append(f"const {TYPES[t]}* {name}_")
+            elif kind == "broadcast":
+                decls += [f"const {TYPES[t]}* {name}_", f"const long long {name}_step"]
+            else:
+                decls.append(f"{TYPES[t]}* {name}_")
+        return ", ".join([*decls, "double* partials"])
+
+    def initial(self) -> str:
+        """The accumulators' declarations at their identities."""
+        return " ".join(
+            f"double acc{k} = {'0.0' if op == 'sum' else '-1.0 / 0.0'};"
+            for k, (_, op) in enumerate(self.reduced)
+        )
+
+    def _slot(self, k: int, offset: str = "") -> str:
+        return f"shared[{k} * {REDUCE_BLOCK} + tid{offset}]"
+
+    def block_store(self) -> str:
+        """Thread ``tid``'s accumulators into the block's shared array (its tree's leaves)."""
+        return " ".join(f"{self._slot(k)} = acc{k};" for k in range(len(self.reduced)))
+
+    def tree_step(self) -> str:
+        """One level of the block's tree at thread ``tid`` (< ``s``): its slot folds in the
+        slot ``s`` after it."""
+        return " ".join(
+            f"{self._slot(k)} = {fold(op, self._slot(k), self._slot(k, ' + s'))};"
+            for k, (_, op) in enumerate(self.reduced)
+        )
+
+    def block_result(self, block: str) -> str:
+        """The tree's roots into row ``block`` of the partials."""
+        count = len(self.reduced)
+        return " ".join(
+            f"partials[{block} * {count} + {k}] = shared[{k} * {REDUCE_BLOCK}];"
+            for k in range(count)
+        )
+
+
+def fold(op: str, a: str, b: str) -> str:
+    """The C expression folding ``b`` into ``a``."""
+    return f"{a} + {b}" if op == "sum" else f"amontons_max({a}, {b})"
+
+
+def cuda_source(kernel: ReducingKernel) -> str:
+    """The CUDA C source of ``kernel`` (``extern "C"``, named ``kernel.name``): launched with
+    :func:`reduce_blocks` blocks of :data:`REDUCE_BLOCK` threads, it writes row b of the
+    ``(blocks, K)`` partials (module comment above)."""
+    return f"""{kernel.source.preamble}{MAX_HELPER}
+extern "C" __global__ void {kernel.name}({kernel.signature()}) {{
+    __shared__ double shared[{len(kernel.reduced) * REDUCE_BLOCK}];
+    const unsigned int tid = threadIdx.x;
+    {kernel.initial()}
+    const long long stride = (long long)gridDim.x * blockDim.x;
+    for (long long i = (long long)blockIdx.x * blockDim.x + tid; i < n; i += stride) {{
+{kernel.point_code()}
+    }}
+    {kernel.block_store()}
+    __syncthreads();
+    for (unsigned int s = {REDUCE_BLOCK // 2}; s > 0; s >>= 1) {{
+        if (tid < s) {{ {kernel.tree_step()} }}
+        __syncthreads();
+    }}
+    if (tid == 0) {{ {kernel.block_result("blockIdx.x")} }}
+}}
+"""
+
+
+REDUCING_GAP = ReducingKernel(
+    GAP_TERMS, ("sigma", "shift"), (), (("a", "sum"), ("a2", "sum"), ("at", "sum"), ("t", "sum"))
+)
+REDUCING_DIRECTION = ReducingKernel(
+    DIRECTION,
+    ("sigma", "d", "beta", "shift"),
+    ("t",),
+    (("violator", "sum"), ("t", "sum")),
+    broadcast=("ub",),
+)
+REDUCING_STEP = ReducingKernel(STEP_TERMS, (), (), (("rt", "sum"), ("rm", "sum")))
+REDUCING_UPDATE = ReducingKernel(
+    UPDATE,
+    ("sigma", "d", "tau", "step", "keep_mask", "with_u"),
+    ("p", "m", "t", "u", "clipped", "joined", "cval", "added"),
+    (("p", "sum"), ("gj", "max"), ("at_bound", "sum"), ("clipped", "sum"), ("joined", "sum")),
+    broadcast=("ub",),
+)
+REDUCING_RELATIVE_CHANGE = ReducingKernel(
+    RELATIVE_CHANGE, ("s_new", "s_old"), (), (("change", "sum"), ("q", "sum"))
+)

@@ -49,15 +49,16 @@ def resolve_backend(backend: str | None, *, arrays: bool = False) -> str:
     """Return the backend name to use: ``"pyfftw"`` if available, else ``"numpy"``.
 
     With ``arrays`` (a solve's backend) the names of the array kernel set are accepted too
-    (:data:`.array_backends.ARRAY_BACKENDS`: ``"cupy"``, ``"numpy-array"`` for tests and
-    ``"cupy-array"`` for benchmarks); the CuPy ones are checked to be runnable here.
+    (:data:`.array_backends.ARRAY_BACKENDS`: ``"cupy"``, ``"numpy-array"`` for tests,
+    ``"cupy-array"`` and ``"cupy-terms"`` for benchmarks); the CuPy ones are checked to be
+    runnable here.
 
     Raises
     ------
     ContactInputError
         (a ValueError) For an unknown name, or ``"pyfftw"`` requested but not importable.
     BackendUnavailableError
-        ``"cupy"`` or ``"cupy-array"`` without CuPy or without a CUDA device.
+        ``"cupy"``, ``"cupy-array"`` or ``"cupy-terms"`` without CuPy or a CUDA device.
     """
     if backend is None:
         return "pyfftw" if HAVE_PYFFTW else "numpy"

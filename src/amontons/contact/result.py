@@ -146,7 +146,7 @@ class SolveInfo:
         Coarse grids solved for a coarse-to-fine start, coarsest first; empty when none ran.
     plasticity : PenetrationHardness or ContactHardening or None
         The plasticity law, None for an elastic solve.
-    backend : {"pyfftw", "numpy", "cupy", "numpy-array", "cupy-array"}
+    backend : {"pyfftw", "numpy", "cupy", "numpy-array", "cupy-array", "cupy-terms"}
         Backend used: an FFT backend of the CPU solver, or the array kernel set's
         namespace (``"cupy"`` on the GPU).
     threads : int
