@@ -5,9 +5,10 @@ the periodic benchmark surface and of the non-periodic rough sphere (Hockney pad
 ``elastic``, or ``hardness``, penetration hardness p_y = HARDNESS·E* (a share of the
 contact then sits at p_y: the row's "at p_y" column), on the CPU solver
 (numba kernels, pyfftw, ``--threads``) and on the array kernel set of ``--backend``
-(``cupy``: the GPU, its iteration's kernels as CUDA kernels; ``cupy-array``: the GPU, the
-array code alone, the baseline of those kernels; ``numpy-array``: the array code on numpy,
-to try this script without a GPU). Per solve: wall time (median of ``--repeats``, after
+(``cupy``: the GPU, its iteration's kernels as CUDA kernels that take their sums;
+``cupy-terms``: the previous kernels, their terms summed by CuPy; ``cupy-array``: the GPU,
+the array code alone; ``numpy-array``: the array code on numpy, to try this script without
+a GPU). Per solve: wall time (median of ``--repeats``, after
 one untimed solve that builds the plans and compiles the fused kernels), iterations, ms per
 iteration and its ratio to one
 forward + inverse real FFT of the convolution's grid on the same backend (a cuFFT pair on a
@@ -26,10 +27,12 @@ from __future__ import annotations
 
 import itertools
 import time
+from pathlib import Path
 
 import numpy as np
 from _common import E_STAR, header, parser, rough_load, rough_surface, sphere_problem, table
 
+import amontons
 from amontons.contact import PenetrationHardness, solve
 from amontons.contact.array_backends import array_module
 from amontons.contact.convolution import fast_padded_shape
@@ -53,16 +56,32 @@ def _timed(repeats, **kw):
 
 def fft_pair_seconds(backend: str, shape, repeats: int) -> float:
     """Median wall time (s) of one real forward + inverse 2-D FFT of ``shape`` on the array
-    backend, the device synchronised after each."""
-    xp = array_module(backend).xp
+    backend, the device synchronised after each: the backend's planned transforms where it
+    has them (``ArrayModule.fft_pair``: cuFFT's plans run directly, what its convolution
+    calls), else ``xp.fft``."""
+    module = array_module(backend)
+    xp = module.xp
     runtime = getattr(getattr(xp, "cuda", None), "runtime", None)  # CuPy's; none on numpy
+    a = xp.asarray(np.random.default_rng(0).random(shape))
+    planned = getattr(module, "fft_pair", None)  # None too in a tree from before it
+    if planned is not None:
+        fft = planned(shape)
+        spectrum = xp.empty((shape[0], shape[1] // 2 + 1), dtype=np.complex128)
+        back = xp.empty(shape)
+
+        def transforms():
+            fft.forward(a, spectrum)
+            fft.inverse(spectrum, back)
+    else:
+
+        def transforms():
+            xp.fft.irfft2(xp.fft.rfft2(a), s=shape)
 
     def pair():
-        xp.fft.irfft2(xp.fft.rfft2(a), s=shape)
+        transforms()
         if runtime is not None:
             runtime.deviceSynchronize()
 
-    a = xp.asarray(np.random.default_rng(0).random(shape))
     pair()  # plans
     times = []
     for _ in range(max(repeats, 5)):
@@ -74,7 +93,7 @@ def fft_pair_seconds(backend: str, shape, repeats: int) -> float:
 
 def main() -> None:
     ap = parser(__doc__.splitlines()[0])
-    # cupy-array: the array code on the GPU without its CUDA kernels, the baseline
+    # cupy-terms, cupy-array: the route's earlier versions on the GPU, its baselines
     ap.add_argument(
         "--backend", default="cupy", choices=("cupy", "cupy-terms", "cupy-array", "numpy-array")
     )
@@ -89,6 +108,7 @@ def main() -> None:
     sizes = args.sizes or ([128, 256] if args.quick else [1024, 2048])
     repeats = args.repeats or 3
     header(f"GPU route ({args.backend}) vs the CPU solver", args)
+    print(f"# amontons from {Path(amontons.__file__).parent}")  # the tree measured
     rows = []
     for n in sizes:
         for bc, law in itertools.product(("periodic", "padded"), args.laws):

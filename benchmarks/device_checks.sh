@@ -1,35 +1,40 @@
 #!/usr/bin/env bash
 # The checks that need a device machine, as one command: the CuPy route's agreement with the
-# CPU path and its time to solution (issue 39), and on request the CPU solver's scaling over
-# many cores (issue 38). Prepare the wheels here first (benchmarks/device_wheels.sh), then,
-# with the device tool, in one call whose steps' limits add up to 490 s:
+# CPU path and its time to solution (issues 39, 50), a whole scan on the GPU and on the CPU,
+# where a GPU solve's time goes, and on request the CPU solver's scaling over many cores
+# (issue 38). Prepare here first (benchmarks/README.md, "Device checks"): the wheels
+# (benchmarks/device_wheels.sh), optionally the scan's bundle (bench_gpu_scan.py prepare) and
+# an earlier tree's src/ in .base_src (the same machine's before). Then, with the device
+# tool, in one call:
 #
 #     run  command: bash benchmarks/device_checks.sh
-#          carry: [".whl"]   timeout_s: 510
+#          carry: [".whl", ".scan_bundle", ".base_src"]   timeout_s: 500
 #
-# The limits are ceilings for a fresh machine (FFTW plans measured, kernels compiled). The
-# steps that measure an issue's target come first: the GPU route against the CPU solver at
-# 512² and 2048², elastic and penetration hardness (the CPU solve timed once); 4096² on the
-# device alone; the array code without the CUDA kernels (backend cupy-array) at 2048² and
-# 4096², their baseline on the same device; a profile of the host's time in the 2048²
-# device solves; the CuPy tests last, their kernels compiled by then. STEPS="dispatch
-# scaling" (190 s more; scaling measured on 2026-11-26) times a pass of slabs' dispatch on
-# 1-16 threads (bench_slab_dispatch.py), then runs benchmark 1 at 2048² on 1, 8, 16, 4 and 2
-# threads; scaling_padded (120 s more, not yet run on a device) a padded 1024² window on 1
-# and 8 threads.
+# The steps' limits are ceilings for a fresh machine (FFTW plans measured, kernels compiled)
+# and add up to 710 s; on 2026-11-28 a fresh H100 machine ran them all in 367 s. The steps
+# that measure an issue's target come first: the GPU route against the CPU solver at 512² and
+# 2048², elastic and penetration hardness (the CPU solve timed once); 4096² on the device
+# alone; the scan (when .scan_bundle is there); the phases of a 2048² solve
+# (bench_gpu_phases.py); the before tree (when .base_src is there); the CuPy tests; a
+# profile of the host's time. STEPS="baseline baseline_array" times the route's earlier
+# versions (cupy-terms, cupy-array) at 2048² and 4096²; STEPS="dispatch scaling" (190 s
+# more; scaling measured on 2026-11-26) times a pass of slabs' dispatch on 1-16 threads
+# (bench_slab_dispatch.py), then runs benchmark 1 at 2048² on 1, 8, 16, 4 and 2 threads;
+# scaling_padded (120 s more, not yet run on a device) a padded 1024² window on 1 and 8
+# threads.
 # Each step has its own time limit, so that a slow one leaves the others their time, and
 # writes its log to $OUT/<step>.log as it runs: what a stopped step printed still comes
 # back. Steps run in the order below, whatever the order in STEPS.
 # QUICK=1 runs every step on small grids and BACKEND=numpy-array the GPU route's code on
-# numpy (BACKEND_BASELINE=numpy-array the baseline's): together they try the script on any
-# machine in a minute.
+# numpy (BACKEND_BASELINE, BACKEND_BASELINE_ARRAY=numpy-array the baselines'): together they
+# try the script on any machine in three minutes.
 set -uo pipefail
 out=${OUT:-/tmp/device-checks}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)  # absolute: the benchmark steps run in benchmarks/
 failed=0
 python=${PYTHON:-python3}
-steps=" ${STEPS:-machine warm gpu gpu_large scan baseline profile tests baseline_array} "
+steps=" ${STEPS:-machine warm gpu gpu_large scan phases before tests profile} "
 backend=${BACKEND:-cupy}
 cores=$(nproc)
 if compgen -G ".whl/*.whl" > /dev/null; then
@@ -66,8 +71,9 @@ step machine 20 bash -c "nvidia-smi --query-gpu=name,memory.total,driver_version
     numpy, numba, pyfftw, amontons; print(sys.version); print(\"numpy\", numpy.__version__, \
     \"numba\", numba.__version__, \"pyfftw\", pyfftw.__version__)'; \"$python\" -c 'import \
     cupy; print(\"cupy\", cupy.__version__, cupy.cuda.runtime.getDeviceCount(), \"device(s)\")'"
-# the numba kernels compile once into their disk cache (26-46 s on a 2-core VM)
-step warm 60 "$python" -c "from amontons.contact.kernel_cache import main; main()"
+# the numba kernels compile once into their disk cache (26-46 s on a 2-core VM; over 60 s on
+# a fresh device machine, 2026-11-28)
+step warm 90 "$python" -c "from amontons.contact.kernel_cache import main; main()"
 cd benchmarks || exit 1
 step gpu 170 "$python" bench_gpu.py --backend "$backend" --sizes "${gpu_sizes[@]}" \
     --laws elastic hardness --threads "$cores" --repeats "$repeats" --cpu-repeats 1
@@ -75,6 +81,17 @@ step gpu_large 60 "$python" bench_gpu.py --backend "$backend" --device-only \
     --sizes "${large_sizes[@]}" --repeats "$repeats"
 step baseline 60 "$python" bench_gpu.py --backend "${BACKEND_BASELINE:-cupy-terms}" \
     --device-only --sizes "${baseline_sizes[@]}" --repeats "$repeats"
+# where a solve's time goes, phase by phase, each between two synchronisations
+step phases 40 bash -c "\"$python\" bench_gpu_phases.py --backend $backend --size $profile_size \
+    --bc periodic && \"$python\" bench_gpu_phases.py --backend $backend --size $profile_size \
+    --bc padded"
+# the route as an earlier tree has it (.base_src/src, carried), on the same machine: the
+# before of a change (benchmarks/README.md, "The GPU route")
+if [[ -d ../.base_src/src ]]; then
+    step before 60 env PYTHONPATH="$(cd ../.base_src/src && pwd):${PYTHONPATH#*:}" \
+        "$python" bench_gpu.py --backend "$backend" --device-only \
+        --sizes "${baseline_sizes[@]}" --repeats "$repeats"
+fi
 # where the host's time goes in the GPU route's solves: the 45 costliest functions
 step profile 40 bash -c "\"$python\" -m cProfile -s tottime bench_gpu.py --backend $backend \
     --device-only --sizes $profile_size --repeats 3 | head -75"

@@ -32,6 +32,7 @@ TYPES = {
     "uint8": ("unsigned char", np.uint8),
     "int8": ("signed char", np.int8),
     "int32": ("int", np.int32),
+    "int64": ("long long", np.int64),
 }
 PRELUDE = """
 #include <cmath>
@@ -44,15 +45,24 @@ COMPILER = shutil.which("g++")
 
 
 def _params(text: str) -> list[tuple[str, str]]:
-    return [tuple(p.split()) for p in text.split(",")]
+    """``(type, name)`` per parameter; a ``raw`` one (a whole array) as ``("raw float64",
+    name)``."""
+    return [(" ".join(p.split()[:-1]), p.split()[-1]) for p in text.split(",")]
+
+
+def _raw(type_name: str) -> str | None:
+    """The element type of a ``raw`` parameter, else None."""
+    return type_name.split()[1] if type_name.startswith("raw ") else None
 
 
 def c_function(source) -> str:
-    """The C++ function of a ``KernelSource``: ``name(n, inputs..., outputs...)``."""
+    """The C++ function of a ``KernelSource``: ``name(n, inputs..., outputs...)``; a ``raw``
+    input is the whole array, indexed by the body (with ``i``, the point's index)."""
     ins, outs = _params(source.in_params), _params(source.out_params)
-    args = ["long long n"] + [f"const {TYPES[t][0]}* {n}_" for t, n in ins]
+    args = ["long long n"] + [f"const {TYPES[_raw(t) or t][0]}* {n}{'' if _raw(t) else '_'}"
+                              for t, n in ins]  # fmt: skip
     args += [f"{TYPES[t][0]}* {n}_" for t, n in outs]
-    loads = " ".join(f"const {TYPES[t][0]}& {n} = {n}_[i];" for t, n in ins)
+    loads = " ".join(f"const {TYPES[t][0]}& {n} = {n}_[i];" for t, n in ins if not _raw(t))
     refs = " ".join(f"{TYPES[t][0]}& {n} = {n}_[i];" for t, n in outs)
     loop = f"for (long long i = 0; i < n; ++i) {{ {loads} {refs} {source.body} }}"
     return f'extern "C" void {source.name}({", ".join(args)}) {{ {loop} }}'
@@ -71,14 +81,24 @@ class HarnessKernel:
         n_in = len(self.ins)
         inputs, outputs = args[:n_in], args[n_in:]
         assert len(outputs) == len(self.outs), self.source.name
-        n = max(np.size(a) for a in args)
-        arrays = [self._input(a, t, n) for (t, _), a in zip(self.ins, inputs, strict=True)]
+        n = max(
+            np.size(a) for (t, _), a in zip(self.ins + self.outs, args, strict=True) if not _raw(t)
+        )
+        arrays = [
+            self._whole(a, _raw(t)) if _raw(t) else self._input(a, t, n)
+            for (t, _), a in zip(self.ins, inputs, strict=True)
+        ]
         for (t, name), out in zip(self.outs, outputs, strict=True):
             assert out.dtype == TYPES[t][1] and out.size == n, (self.source.name, name)
             assert out.flags.c_contiguous, (self.source.name, name)
         pointers = [a.ctypes.data_as(ctypes.c_void_p) for a in (*arrays, *outputs)]
         self.fn(ctypes.c_longlong(n), *pointers)
         return outputs
+
+    def _whole(self, value, type_name: str) -> np.ndarray:
+        """A ``raw`` input: the array as it is, of the declared type and contiguous."""
+        assert value.dtype == TYPES[type_name][1] and value.flags.c_contiguous, self.source.name
+        return value
 
     def _input(self, value, type_name: str, n: int) -> np.ndarray:
         dtype = TYPES[type_name][1]

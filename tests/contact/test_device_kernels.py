@@ -1,5 +1,6 @@
 """The GPU kernel set's CUDA kernels (amontons.contact.device_sources, run by
-``DeviceKernels`` on CuPy) against the array code they replace (``ArrayKernels``).
+``DeviceKernels`` and ``ReducingKernels`` on CuPy) against the array code they replace
+(``ArrayKernels``).
 
 Without a GPU the sources are compiled as C++ (tests/contact/cuda_harness.py) and called on
 numpy arrays as CuPy calls them, so the kernels' arithmetic and ``DeviceKernels``' glue (the
@@ -14,7 +15,8 @@ with the same numpy reductions the array code applies to its temporaries: so the
 wise results, the sums and whole solves (every iterate) are the same bytes, and any
 difference is a changed expression. (On a GPU, nvcc's multiply-adds and CuPy's reductions
 make them agree to round-off instead: tests/contact/test_array_kernels.py holds the device's
-whole solves to the CPU path within 1e-10 of the peak pressure.)
+whole solves to the CPU path within 1e-10 of the peak pressure.) The reducing kernels'
+sums, folded block by block, are held to round-off instead (their section below).
 """
 
 from __future__ import annotations
@@ -341,3 +343,22 @@ def test_reducing_whole_solve_agrees_with_the_array_code(reducing, name):
     peak = float(np.abs(arr.pressure).max())
     assert float(np.abs(red.pressure - arr.pressure).max()) <= 1e-10 * peak
     assert np.array_equal(red.pressure > 0, arr.pressure > 0)
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_point_responses_in_one_pass(device, periodic):
+    """The changed points' responses in one pass (DeviceKernels) are the array code's, point
+    by point in the same order, to the last bit; a point repeated adds twice."""
+    shape = (40, 48)
+    padded = None if periodic else fast_padded_shape(shape)
+    green = ArrayConvolution(shape, 1.0, 1.0, np, padded).real_space_kernel()
+    rng = np.random.default_rng(8)
+    u0 = rng.normal(size=shape)
+    idx = np.array([0, 5, 39 * 48 + 47, 5, 1000, 17 * 48], dtype=np.int64)
+    vals = rng.normal(size=idx.size)
+    u_d, u_a = u0.copy(), u0.copy()
+    device.add_point_responses(u_d, green, idx, vals)
+    A.add_point_responses(u_a, green, idx, vals)
+    assert np.array_equal(u_d, u_a) and not np.array_equal(u_a, u0)
+    device.add_point_responses(u_d, green, idx[:0], vals[:0])  # no point: nothing
+    assert np.array_equal(u_d, u_a)

@@ -30,9 +30,13 @@ differences are the ones a GPU asks for:
   on rare paths (a restart of the free set, the bounded load step's shortened or restarted
   step) run on host copies through :meth:`ArrayKernels.on_host`.
 
-On CuPy the set is :class:`DeviceKernels`: the element-wise passes of the four kernels of
-every iteration run as the CUDA kernels of :mod:`.device_sources` (one launch per pass, in
-place of one per array operation), the sums as above.
+On CuPy (``backend="cupy"``) the set is :class:`ReducingKernels`: the four kernels of every
+iteration and ``relative_change`` each run as one CUDA kernel of :mod:`.device_sources` that
+also takes the pass's sums (per-block partials, folded on the host after one transfer, in an
+order fixed by the grid size: deterministic on a device, equal to the array code's sums to
+round-off), and the changed points' responses as one kernel. :class:`DeviceKernels`
+(``backend="cupy-terms"``, a benchmarks' baseline) runs the same passes as element-wise
+kernels whose terms CuPy then sums, one launch per sum.
 
 Arrays are flat float64 of the namespace (the free set ``m`` uint8), in the units of
 :mod:`.kernels`.
@@ -356,6 +360,20 @@ class DeviceKernels(ArrayKernels):
         self._direction = build(src.DIRECTION)
         self._step_terms = build(src.STEP_TERMS)
         self._update = build(src.UPDATE)
+        self._point_responses = build(src.POINT_RESPONSES)
+
+    def add_point_responses(self, u, green, idx, values):
+        """As :meth:`ArrayKernels.add_point_responses`, every point in one pass over ``u``
+        (``idx`` int64 and ``values`` float64, contiguous, of the namespace), where the array
+        code gathers the kernel and updates ``u`` once per point, and reads the points on
+        the host to loop over them."""
+        k = int(idx.size)
+        if k == 0:
+            return
+        n1 = u.shape[1]
+        big0, big1 = green.shape
+        flat = self.xp.ascontiguousarray(green).reshape(-1)
+        self._point_responses(flat, idx, values, k, n1, big0, big1, u)
 
     def _terms(self, n: int, count: int) -> list:
         """``count`` uninitialised float64 arrays of ``n`` points."""
@@ -481,7 +499,9 @@ class ReducingKernels(DeviceKernels):
         psum, pen, at_bound, n_clip, n_add = self._folded(
             self._update_reduce, src.REDUCING_UPDATE, *args, *outs
         )
-        counts[0] = xp.asarray([int(n_clip), int(n_add)], dtype=counts.dtype)
+        # two scalar fills (launches that wait for nothing), not a copy from the host, which
+        # would wait for the device
+        counts[0, 0], counts[0, 1] = int(n_clip), int(n_add)
         self._counted = (counts, int(n_clip), int(n_add))
         n_events = int(n_clip) + int(n_add)
         complete = not (n_events > 0 and n_events > min(record_max, SLOTS))

@@ -475,9 +475,9 @@ def array_operator(shape, spacing, e_star, periodic, backend) -> ArrayConvolutio
     """The cached :class:`.array_convolution.ArrayConvolution` of an array backend
     (:data:`.array_backends.ARRAY_BACKENDS`), padded to :func:`fast_padded_shape` when not
     periodic (the CPU operator's grid)."""
-    xp = array_module(backend).xp
+    module = array_module(backend)
     padded = None if periodic else fast_padded_shape(shape)
-    return ArrayConvolution(shape, spacing, e_star, xp, padded)
+    return ArrayConvolution(shape, spacing, e_star, module.xp, padded, module.fft_pair)
 
 
 def operator_for(opts, shape, spacing, e_star):

@@ -1,14 +1,17 @@
-"""The GPU kernel set's hot element-wise passes as CUDA C sources, one kernel per pass.
+"""The GPU kernel set's hot element-wise passes as CUDA C sources, one kernel per pass
+(and, below, the same passes as reducing kernels that take their sums in the same launch).
 
-On CuPy, :class:`.array_kernels.DeviceKernels` runs the element-wise part of the four
-kernels of every iteration (``gap_moments``, ``direction``, ``step_dots``, ``update``) as
-these user-defined kernels (``cupy.ElementwiseKernel``) in place of the array code of
-:class:`.array_kernels.ArrayKernels`, which launches one kernel per operation and allocates
-a temporary for each (about fifty for ``update``); on a GPU an iteration's time was those
-launches, not its memory traffic (benchmarks/README.md, "The GPU route"). The sums stay the
-namespace's own reductions over the terms these kernels write: CuPy's one-input sums run
-on many blocks, where a user-defined ``ReductionKernel`` of several inputs reduces a whole
-grid in one block (ten times slower at 2048², measured: the same README).
+On CuPy, :class:`.array_kernels.DeviceKernels` (``backend="cupy-terms"``) runs the
+element-wise part of the four kernels of every iteration (``gap_moments``, ``direction``,
+``step_dots``, ``update``) as these user-defined kernels (``cupy.ElementwiseKernel``) in
+place of the array code of :class:`.array_kernels.ArrayKernels`, which launches one kernel
+per operation and allocates a temporary for each (about fifty for ``update``); on a GPU an
+iteration's time was those launches, not its memory traffic (benchmarks/README.md, "The GPU
+route"). Its sums are the namespace's own reductions over the terms these kernels write:
+CuPy's one-input sums run on many blocks, where a user-defined ``ReductionKernel`` of
+several inputs reduces a whole grid in one block (ten times slower at 2048², measured: the
+same README). :class:`.array_kernels.ReducingKernels` (``backend="cupy"``) runs the same
+bodies as the reducing kernels below, which take those sums themselves, block by block.
 
 Each source is plain data, compiled by the namespace (:attr:`.array_backends.ArrayModule.
 compile`); tests/contact/cuda_harness.py compiles the same text as C++ on the CPU, so that
@@ -125,6 +128,27 @@ UPDATE = KernelSource(
     """,
 )
 
+# add_point_responses: u[i] += Σ_k vals_k · green[(row - a_k) mod big0, (col - b_k) mod big1]
+# for the k changed points (a_k, b_k) = divmod(idx_k, n1), in one pass over u (i: the flat
+# index of u's element, as CuPy names it; green, idx and vals whole arrays, "raw"), the
+# points added one after the other as the array code adds them
+POINT_RESPONSES = KernelSource(
+    "amontons_point_responses",
+    "raw float64 green, raw int64 idx, raw float64 vals, int32 k, int64 n1, int64 big0, int64 big1",
+    "float64 u",
+    """
+    const long long row = i / n1, col = i % n1;
+    for (int j = 0; j < k; ++j) {
+        const long long a = idx[j] / n1, b = idx[j] % n1;
+        long long r = (row - a) % big0;
+        long long c = (col - b) % big1;
+        r = r < 0 ? r + big0 : r;
+        c = c < 0 ? c + big1 : c;
+        u = u + vals[j] * green[r * big1 + c];
+    }
+    """,
+)
+
 # relative_change's terms: q = s_new·p_new and |q - s_old·p|
 RELATIVE_CHANGE = KernelSource(
     "amontons_relative_change",
@@ -149,7 +173,13 @@ RELATIVE_CHANGE = KernelSource(
 REDUCE_BLOCK = 256  # threads per block: the width of the shared-memory tree (a power of 2)
 REDUCE_MAX_BLOCKS = 1024  # about an H100's resident threads (132 SMs × 2048) at 256 a block
 
-TYPES = {"float64": "double", "uint8": "unsigned char", "int8": "signed char", "int32": "int"}
+TYPES = {
+    "float64": "double",
+    "uint8": "unsigned char",
+    "int8": "signed char",
+    "int32": "int",
+    "int64": "long long",
+}
 
 # the fold of a max: NaN wins, as numpy's and CuPy's max propagate it
 MAX_HELPER = """
@@ -164,7 +194,8 @@ def reduce_blocks(n: int) -> int:
 
 
 def parse_params(text: str) -> list[tuple[str, str]]:
-    """``"float64 u, uint8 m"`` as ``[("float64", "u"), ("uint8", "m")]``."""
+    """``"float64 u, uint8 m"`` as ``[("float64", "u"), ("uint8", "m")]`` (the element-wise
+    parameters; a reducing kernel has no ``raw`` one)."""
     return [tuple(p.split()) for p in text.split(",")]
 
 
