@@ -105,8 +105,7 @@ def solve(
         GPU (:mod:`amontons.contact.array_kernels`; ``pip install amontons[gpu]``), results
         as numpy arrays; without CuPy or a CUDA device it raises
         :class:`BackendUnavailableError`. (``"numpy-array"``: the GPU route's code on numpy,
-        for tests; ``"cupy-array"``: without its CUDA kernels, and
-        ``"cupy-terms"``: its kernels without their sums, benchmarks' baselines.)
+        for tests; ``"cupy-array"``, ``"cupy-terms"``: its earlier versions, baselines.)
     plasticity : PenetrationHardness or ContactHardening, optional
         Plasticity law of appendix B.2.3 (None: purely elastic). The result's
         ``plastic_displacement`` is then the plastic displacement of the indenter (m, <= 0

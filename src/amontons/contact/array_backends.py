@@ -24,7 +24,6 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from .device_sources import REDUCE_BLOCK, cuda_source, reduce_blocks
 from .errors import BackendUnavailableError
 
 CUPY = "cupy"
@@ -190,7 +189,7 @@ def _cupy_reducing_kernel(cupy, kernel):
     in ``kernel.arguments()`` order (scalars as Python numbers, arrays flat and contiguous of
     the declared types and of one size, a broadcast one also a number or of one value);
     returns the ``(blocks, K)`` partials."""
-    raw = cupy.RawKernel(cuda_source(kernel), kernel.name)
+    raw = cupy.RawKernel(kernel.cuda_source(), kernel.name)
     spec = kernel.arguments()
     count = len(kernel.reduced)
     ones = {}  # a broadcast number as a one-value device array, made once per value
@@ -205,7 +204,7 @@ def _cupy_reducing_kernel(cupy, kernel):
     def launch(*args):
         pairs = zip(spec, args, strict=True)
         n = next(a.size for (kind, _, _), a in pairs if kind in ("in", "out"))
-        blocks = reduce_blocks(n)
+        blocks = kernel.blocks(n)
         partials = cupy.empty((blocks, count))
         typed = []
         for (kind, t, _), a in zip(spec, args, strict=True):
@@ -215,7 +214,7 @@ def _cupy_reducing_kernel(cupy, kernel):
                 typed += broadcast(a, n)
             else:
                 typed.append(a)
-        raw((blocks,), (REDUCE_BLOCK,), (np.int64(n), *typed, partials))
+        raw((blocks,), (kernel.threads,), (np.int64(n), *typed, partials))
         return partials
 
     return launch

@@ -218,6 +218,16 @@ class ReducingKernel:
     def name(self) -> str:
         return f"{self.source.name}_reduce"
 
+    threads = REDUCE_BLOCK  # per block of a launch
+
+    def blocks(self, n: int) -> int:
+        """The blocks of a launch over ``n`` points (:func:`reduce_blocks`)."""
+        return reduce_blocks(n)
+
+    def cuda_source(self) -> str:
+        """Its CUDA C source (:func:`cuda_source`)."""
+        return cuda_source(self)
+
     def arguments(self) -> list[tuple[str, str, str]]:
         """The kernel's parameters after the point count, as ``(kind, type, name)``: kind
         ``scalar``, ``broadcast`` (an array of one value or one per point, with its step
