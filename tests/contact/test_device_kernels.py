@@ -298,17 +298,47 @@ def test_reducing_update(reducing, bounded, events, keep_mask, with_u):
         assert all(np.array_equal(x, y) for x, y in zip(ch_r, ch_a, strict=True))
 
 
-def test_reducing_partials_fold_in_a_fixed_order():
-    """The harness's blocks are the device launch's: a point count's partials have
-    reduce_blocks rows, and the fold of a sum whose terms cancel exactly in index order
-    (1, -1, 1, ...) but not in floating point if taken carelessly stays exact here."""
+def _launch_order_partials(x: np.ndarray, blocks: int) -> np.ndarray:
+    """The per-block sums of ``x`` in a CUDA launch's order, emulated in numpy: thread g =
+    b·B + tid folds x[g], x[g + G], ... (G = blocks·B) one after the other, then each
+    block's tree adds slot tid + s into slot tid, s = B/2, ..., 1."""
+    width = blocks * REDUCE_BLOCK
+    rows = -(-x.size // width)
+    padded = np.zeros(rows * width)  # + 0.0 changes no sum
+    padded[: x.size] = x
+    acc = np.zeros(width)
+    for row in padded.reshape(rows, width):
+        acc = acc + row
+    tree = acc.reshape(blocks, REDUCE_BLOCK)
+    s = REDUCE_BLOCK // 2
+    while s:
+        tree[:, :s] = tree[:, :s] + tree[:, s : 2 * s]
+        s //= 2
+    return tree[:, 0]
+
+
+def test_reducing_partials_fold_in_the_launch_order():
+    """The harness's partials are, to the last bit, a CUDA launch's fold (emulated above) of
+    terms over sixteen decades, whose sums depend on their order: a block's plain numpy sum
+    differs from it in some block, so another order would fail here."""
     kernel = harness.compile_reducing(REDUCING_STEP)
     n = 3 * REDUCE_BLOCK * REDUCE_MAX_BLOCKS + 17  # threads with several points each
-    r = np.ones(n)
-    t = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    rng = np.random.default_rng(11)
+    r = rng.normal(size=n) * 10.0 ** rng.integers(-8, 8, n)
+    t = rng.normal(size=n)
     partials = kernel(r, t, np.ones(n, np.uint8))
-    assert partials.shape == (reduce_blocks(n), 2) == (REDUCE_MAX_BLOCKS, 2)
-    assert fold_partials(partials, REDUCING_STEP.reduced) == [float(t.sum()), float(n)]
+    blocks = reduce_blocks(n)
+    assert partials.shape == (blocks, 2) == (REDUCE_MAX_BLOCKS, 2)
+    want = _launch_order_partials(r * t, blocks)
+    assert np.array_equal(partials[:, 0], want)
+    assert np.array_equal(partials[:, 1], _launch_order_partials(r, blocks))
+    # the same blocks' points summed in index order (numpy's pairwise sum): another order,
+    # other bits in some block, so the equality above pins the order
+    block_of = (np.arange(n) % (blocks * REDUCE_BLOCK)) // REDUCE_BLOCK
+    terms = r * t
+    other = np.array([np.sum(terms[block_of == b]) for b in range(16)])
+    assert not np.array_equal(other, want[:16])
+    assert fold_partials(partials, REDUCING_STEP.reduced)[0] == float(np.sum(want))
 
 
 @pytest.mark.parametrize("name", sorted(SOLVES))

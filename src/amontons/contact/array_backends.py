@@ -7,8 +7,9 @@ the array set: ``"cupy"``, ``"numpy-array"`` (for tests: the GPU route's code on
 arrays, which the numba set outruns on a CPU) and ``"cupy-array"`` (for benchmarks: the
 array code on the GPU without its CUDA kernels, the baseline those kernels are timed
 against on the same device) and ``"cupy-terms"`` (for benchmarks: the CUDA kernels that
-write their terms to memory and sum them with CuPy, one launch per sum: the route's second
-version, the baseline of the reducing kernels that ``"cupy"`` runs).
+write their terms to memory and sum them with CuPy, one launch per sum, with ``cupy.fft``:
+the route's second version, the baseline of the reducing kernels that ``"cupy"`` runs; its
+point responses are the one-kernel ones of the current version).
 
 This is the one module that imports CuPy, and it does so lazily, inside
 :func:`_load_cupy`: CuPy is an optional dependency that most installations lack, and its
@@ -201,19 +202,30 @@ def _cupy_reducing_kernel(cupy, kernel):
             value = ones[float(value)]
         return [value, np.int64(0 if value.size == 1 else 1)]
 
+    def checked(a, t, name, sizes):
+        # the kernel reads raw pointers: a wrong type, layout or size would read past the
+        # array without an error
+        if a.dtype != SCALAR_TYPES[t] or not a.flags.c_contiguous or a.size not in sizes:
+            raise ValueError(
+                f"{kernel.name}: {name} must be a C-contiguous {t} array of {sizes} "
+                f"values, got {a.dtype} of {a.size} (contiguous: {a.flags.c_contiguous})"
+            )
+        return a
+
     def launch(*args):
         pairs = zip(spec, args, strict=True)
         n = next(a.size for (kind, _, _), a in pairs if kind in ("in", "out"))
         blocks = kernel.blocks(n)
         partials = cupy.empty((blocks, count))
         typed = []
-        for (kind, t, _), a in zip(spec, args, strict=True):
+        for (kind, t, name), a in zip(spec, args, strict=True):
             if kind == "scalar":
                 typed.append(SCALAR_TYPES[t](a))
             elif kind == "broadcast":
-                typed += broadcast(a, n)
+                value, step = broadcast(a, n)
+                typed += [checked(value, t, name, (1, n)), step]
             else:
-                typed.append(a)
+                typed.append(checked(a, t, name, (n,)))
         raw((blocks,), (kernel.threads,), (np.int64(n), *typed, partials))
         return partials
 

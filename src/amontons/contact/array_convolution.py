@@ -15,9 +15,11 @@ Where the namespace offers planned transforms (``ArrayModule.fft_pair``: cuFFT's
 directly on CuPy, ``numpy.fft`` on numpy), a call is the forward transform of ``p`` (into a
 zero-padded buffer of the grid's when padded), one in-place product with the spectrum
 divided by the grid's size (the inverse's normalisation folded in) and the inverse into
-``out`` (through the padded buffer when padded): three or four launches and no temporary,
+``out`` (through the padded buffer when padded): three launches periodic, five padded (the
+copies into and out of the window), no temporary when ``p`` and ``out`` are contiguous,
 where ``xp.fft`` pads into a new array, copies the spectrum (cuFFT's inverse overwrites its
-input), normalises in a pass of its own and leaves the window to copy.
+input), normalises in a pass of its own and leaves the window to copy. The price is memory:
+the cached operator keeps its spectrum, the padded buffers and both plans' work areas.
 
 The plain (unpruned) transform: the row pruning of the CPU operator saves a quarter of the
 FFT work, which on a GPU is not measured (an iteration's time there went to kernel
