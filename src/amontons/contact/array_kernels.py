@@ -245,17 +245,24 @@ class ArrayKernels:
         they fit, the records; one host read. Returns ``(Σ p_new, pen, at_bound, records
         complete)``."""
         xp = self.xp
-        clip, join, cval, added = events
+        clip, join = events[:2]
         counted = (xp.count_nonzero(clip), xp.count_nonzero(join))
         counts[0] = xp.stack(counted)
         psum, pen, at_bound, n_clip, n_add = self._floats(p_new.sum(), pen, at_bound, *counted)
-        n_events = int(n_clip) + int(n_add)
+        complete = self._record_events(int(n_clip) + int(n_add), events, idx, val, record_max)
+        return psum, pen, at_bound, complete
+
+    def _record_events(self, n_events, events, idx, val, record_max) -> bool:
+        """The step's clipped then joined points (``events`` as in :meth:`_step_results`)
+        into ``idx[0]``, ``val[0]`` when their number ``n_events`` fits the records
+        (``min(record_max, SLOTS)``); whether the records are complete."""
         complete = not (n_events > 0 and n_events > min(record_max, SLOTS))
         if n_events and complete:
-            where_clip = xp.flatnonzero(clip)
-            where_join = xp.flatnonzero(join)
+            clip, join, cval, added = events
+            where_clip = self.xp.flatnonzero(clip)
+            where_join = self.xp.flatnonzero(join)
             self._record(idx, val, where_clip, cval[where_clip], where_join, added[where_join])
-        return psum, pen, at_bound, complete
+        return complete
 
     def _record(self, idx, val, *pairs):
         """Write the ``(indices, values)`` pairs one after the other into ``idx[0]``,
@@ -503,12 +510,8 @@ class ReducingKernels(DeviceKernels):
         # would wait for the device
         counts[0, 0], counts[0, 1] = int(n_clip), int(n_add)
         self._counted = (counts, int(n_clip), int(n_add))
-        n_events = int(n_clip) + int(n_add)
-        complete = not (n_events > 0 and n_events > min(record_max, SLOTS))
-        if n_events and complete:
-            where_clip = xp.flatnonzero(clipped)
-            where_join = xp.flatnonzero(joined)
-            self._record(idx, val, where_clip, cval[where_clip], where_join, added[where_join])
+        events = (clipped, joined, cval, added)
+        complete = self._record_events(int(n_clip) + int(n_add), events, idx, val, record_max)
         return psum, pen, at_bound if bounded else 0.0, complete
 
     def _counts_of(self, counts):
