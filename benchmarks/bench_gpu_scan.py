@@ -9,9 +9,10 @@ into it, written as ``jobs.json``;
 
 ``run`` (on the device): every value of the bundle's scan in its chain order, each
 starting from the one before as in a run, through ``scripts/scan_scene.py``'s own
-``main`` once with ``solver_backend: cupy`` and once on the CPU solver with ``--threads``,
-then the best value of each (``amontons.simulate.scan_best``, as rule best_scan_value).
-Prints per value the job's wall time and the solves' (``wall_time_s``), the criterion D
+``solve_value`` once with ``solver_backend: cupy`` and once on the CPU solver with
+``--threads``, then the best value of each (``amontons.simulate.scan_best``, as rule
+best_scan_value). Prints per value its wall time in the scan job and the solves'
+(``wall_time_s``), the criterion D
 of both and their difference, the totals, their ratio and the two best values.
 
     python benchmarks/bench_gpu_scan.py prepare --run-dir /path/to/a/full/run \\
@@ -120,35 +121,37 @@ def _in_bundle(value, bundle: Path):
 
 def run_scan(bundle: Path, backend: str, threads: int, work: Path) -> list[dict]:
     """Every value of the bundle's scan on ``backend`` (``cpu`` or ``cupy``), in chain
-    order; each value's job wall time (s) and its point record."""
+    order, as the scan job solves them (its inputs read once, each value from the one
+    before); each value's wall time (s) and its point record."""
     spec = json.loads((bundle / "jobs.json").read_text())
     inputs = {k: _in_bundle(v, bundle) for k, v in spec["inputs"].items()}
     script = _scan_script()
-    rows, neighbour = [], None
+    context = script.ScanContext(
+        levelled_path=inputs["levelled"],
+        psf_path=inputs["psf"],
+        registration_path=inputs["registration"],
+        fluorescence=inputs["fluorescence"],
+        pixel_table=inputs["pixel_table"],
+        threads=threads,
+        solver_backend=backend,
+        **spec["job"],
+    )
+    rows, previous = [], script.ScanStart()
     for value in spec["chain"]:
         folder = work / backend / value
         folder.mkdir(parents=True, exist_ok=True)
         start = time.perf_counter()
-        script.main(
-            levelled_path=inputs["levelled"],
-            psf_path=inputs["psf"],
-            registration_path=inputs["registration"],
-            fluorescence=inputs["fluorescence"],
-            neighbour_path=neighbour,
-            fields_path=str(folder / "rendered.h5"),
-            point_path=str(folder / "scan_point.json"),
-            start_path=str(folder / "start.h5"),
-            value=float(value),
-            pixel_table=inputs["pixel_table"],
-            threads=threads,
-            solver_backend=backend,
-            **spec["job"],
+        previous = script.solve_value(
+            context,
+            float(value),
+            str(folder / "scan_point.json"),
+            str(folder / "rendered.h5"),
+            previous,
         )
         wall = time.perf_counter() - start
-        neighbour = str(folder / "start.h5")
         point = json.loads((folder / "scan_point.json").read_text())
-        rows.append({"value": value, "job_s": wall, "point": point, "path": folder})
-        print(f"{backend} {value}: job {wall:.2f} s, solves {point.get('wall_time_s')} s, "
+        rows.append({"value": value, "value_s": wall, "point": point, "path": folder})
+        print(f"{backend} {value}: value {wall:.2f} s, solves {point.get('wall_time_s')} s, "
               f"D {point['log_area_distance']}", flush=True)  # fmt: skip
     return rows
 
@@ -203,17 +206,17 @@ def main() -> None:
             results[backend] = run_scan(bundle, backend, args.threads, args.work)
     for backend, rows in results.items():
         totals[backend] = {
-            "jobs s": sum(row["job_s"] for row in rows),
+            "values s": sum(row["value_s"] for row in rows),
             "solves s": sum(row["point"].get("wall_time_s") or 0.0 for row in rows),
-            "median job s": statistics.median(row["job_s"] for row in rows),
+            "median value s": statistics.median(row["value_s"] for row in rows),
             "best": best_value(rows, spec["judge"]["confidence"]),
         }
-    print("\nvalue | " + " | ".join(f"{b} job s | {b} solves s | {b} D" for b in results))
+    print("\nvalue | " + " | ".join(f"{b} value s | {b} solves s | {b} D" for b in results))
     for i, value in enumerate(spec["chain"]):
         cells = []
         for rows in results.values():
             point = rows[i]["point"]
-            cells += [f"{rows[i]['job_s']:.2f}", str(point.get("wall_time_s")),
+            cells += [f"{rows[i]['value_s']:.2f}", str(point.get("wall_time_s")),
                       str(point["log_area_distance"])]  # fmt: skip
         print(f"{value} | " + " | ".join(cells))
     for backend, total in totals.items():
@@ -227,7 +230,7 @@ def main() -> None:
             and y["point"]["log_area_distance"] is not None
         ]
         print(f"largest |D {a} - D {b}|: {max(diffs) if diffs else None}")
-        jobs = totals[b]["jobs s"] / totals[a]["jobs s"]
+        jobs = totals[b]["values s"] / totals[a]["jobs s"]
         solves = totals[b]["solves s"] / max(totals[a]["solves s"], 1e-9)
         print(f"jobs {b} / {a}: {jobs:.2f}; solves {b} / {a}: {solves:.2f}")
         same = totals[a]["best"]["grid best"] == totals[b]["best"]["grid best"]

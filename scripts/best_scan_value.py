@@ -127,7 +127,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        point_paths=list(sm.input.points),
+        point_paths=list(sm.params.points),
         table_path=sm.output.table,
         best_path=sm.output.best,
         scan_name=sm.wildcards.scan,

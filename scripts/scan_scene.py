@@ -1,9 +1,10 @@
-"""Rule scan_scene: one value of a parameter scan (docs/study.md). The base scene with its
-parameter set to the value, solved over the measured loads, each load starting from the
-neighbouring value's pressure at that load (the value before it in the scan's chain;
-amontons.simulate.scan_start) or else from the previous load, rendered like the microscope
-sees it, and compared with the measured contact under the base scene's registration. Its
-own pressures are the next value's start."""
+"""Rule scan_scene: one sphere's parameter scan (docs/study.md), its values solved in a chain
+in one job. At each value the base scene with its parameter set to the value is solved over
+the measured loads, each load starting from the previous value's pressure at that load
+(amontons.simulate.scan_start) or else from the previous load, rendered like the microscope
+sees it, and compared with the measured contact under the base scene's registration. The
+levelled map, the PSF, the registration and the measured contacts are read once for the
+whole scan; each value writes its result and its rendered fields into its own folder."""
 
 import logging
 import os
@@ -23,40 +24,89 @@ from amontons.simulate.compare import compare_loads, sheet_load_index
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
-from amontons.simulate.scan_start import read_scan_start, write_scan_start
+from amontons.simulate.scan_start import ScanStart
 from amontons.simulate.solve import solve_scene
 from amontons.simulate.surface import afm_indenter, afm_scene, load_levelled_map
 
 log = logging.getLogger(__name__)
 
 
-def main(
-    levelled_path: str,
-    psf_path: str,
-    registration_path: str,
-    fluorescence,
-    neighbour_path: str | None,
-    fields_path: str,
-    point_path: str,
-    start_path: str,
-    scan: dict,
-    base_config: dict,
-    value: float,
-    sphere: str,
-    sphere_record: dict,
-    pixel_nm: float | None,
-    pixel_table: list[str],
-    images: dict,
-    otsu: dict,
-    threads: int,
-    solver_backend: str = "cpu",
-) -> None:
-    config = scene_config_at(base_config, scan["parameter"], value)
-    levelled = load_levelled_map(levelled_path)
-    scene, coverage = afm_scene(scan["scene"], config, sphere, sphere_record, levelled)
+class MeasuredContacts:
+    """The sphere's measured contacts, each load's image read and thresholded the first time
+    a value compares at that load, then kept for the scan's other values."""
+
+    def __init__(self, fluorescence, sheet_mn: list[float], pixel_nm, images: dict, settings):
+        self.files, self.choices = fluorescence_planes(fluorescence, sheet_mn, images)
+        self.fallback_pixel_m = optional_nm_to_m(pixel_nm)
+        self.settings = settings
+        self.found = {}
+
+    def at(self, indices: list[int]) -> list:
+        """The measured contact at each of the sheet's loads ``indices``."""
+        missing = [i for i in indices if i not in self.found]
+        images = read_fluorescence_series(
+            [self.files[i] for i in missing],
+            self.fallback_pixel_m,
+            [self.choices[i] for i in missing],
+        )
+        for i, image in zip(missing, images, strict=True):
+            self.found[i] = image_contact_area(image, self.settings)
+        return [self.found[i] for i in indices]
+
+
+class ScanContext:
+    """What every value of one sphere's scan shares: the levelled map, the sphere, the
+    rendering's optics and the measured contacts with their registration."""
+
+    def __init__(
+        self,
+        levelled_path: str,
+        psf_path: str,
+        registration_path: str,
+        fluorescence,
+        scan: dict,
+        base_config: dict,
+        sphere: str,
+        sphere_record: dict,
+        pixel_nm: float | None,
+        pixel_table: list[str],
+        images: dict,
+        otsu: dict,
+        threads: int,
+        solver_backend: str,
+    ):
+        self.levelled_path = levelled_path
+        self.levelled = load_levelled_map(levelled_path)
+        self.scan = scan
+        self.base_config = base_config
+        self.sphere = sphere
+        self.sphere_record = sphere_record
+        self.settings = OtsuSettings.from_config(otsu)
+        self.pixel_m = image_pixel_m(pixel_nm, pixel_table)
+        self.psf_fwhm_m = read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9
+        self.registration = Registration.from_record(read_json(registration_path))
+        self.sheet_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
+        self.measured = MeasuredContacts(
+            fluorescence, self.sheet_mn, pixel_nm, images, self.settings
+        )
+        self.threads = threads
+        self.solver_backend = solver_backend
+
+
+def solve_value(
+    context: ScanContext, value: float, point_path: str, fields_path: str, start: ScanStart
+) -> ScanStart:
+    """One value of the scan, solved from ``start`` (the previous value's pressures), its
+    result written to ``point_path`` and its rendered fields to ``fields_path``; returns its
+    own pressures, the next value's start."""
+    scan = context.scan
+    config = scene_config_at(context.base_config, scan["parameter"], value)
+    scene, coverage = afm_scene(
+        scan["scene"], config, context.sphere, context.sphere_record, context.levelled
+    )
     covered = coverage.to_record()
     record = {
-        "sphere": sphere,
+        "sphere": context.sphere,
         "scene": scan["scene"],
         "parameter": scan["parameter"],
         "value": value,
@@ -69,67 +119,49 @@ def main(
         # and best_scan_value says so.
         log.warning("%s = %g: the AFM scan holds no load's window", scan["parameter"], value)
         write_load_series(fields_path, [], [], record)
-        write_scan_start(start_path, [], [], None, value)
         # the scan's size and the largest window in it: what best_scan_value says why with
         write_json(point_path, {**record, **covered, "log_area_distance": None,
                                 "outside_window": None, "loads": []})  # fmt: skip
-        return
-    indenter = afm_indenter(levelled, scene, levelled_path)
-    starts = None
-    if neighbour_path is not None:
-        starts, started = read_scan_start(
-            neighbour_path, scene.loads_n, indenter.heights.shape, indenter.spacing_m
-        )
-        log.info("%s = %g: %d of %d loads start from the neighbouring value", scan["parameter"],
+        return ScanStart()
+    indenter = afm_indenter(context.levelled, scene, context.levelled_path)
+    starts, started = start.starts_for(scene.loads_n, indenter.heights.shape, indenter.spacing_m)
+    if start.loads_n:
+        log.info("%s = %g: %d of %d loads start from the previous value", scan["parameter"],
                  value, started, len(scene.loads_n))  # fmt: skip
     try:
         solution = solve_scene(
-            scene, indenter, threads=threads, backend=solver_backend, warm_starts=starts
+            scene,
+            indenter,
+            threads=context.threads,
+            backend=context.solver_backend,
+            warm_starts=starts if start.loads_n else None,
         )
     except FreeBoundaryError as error:
         # A value so soft that the contact outgrows the base scene's window (which holds the
         # measured contact with room to spare) matches the measurement worse than any value
-        # whose contact fits: recorded, never best, and the run goes on.
+        # whose contact fits: recorded, never best, and the scan goes on.
         log.warning("%s = %g: %s", scan["parameter"], value, error)
         write_load_series(fields_path, [], [], {**scene.to_record(), **record})
-        write_scan_start(start_path, [], [], None, value)
         write_json(point_path, {**record, "log_area_distance": None, "outside_window": str(error)})
-        return
-    write_scan_start(
-        start_path,
-        scene.loads_n,
-        [f["pressure"] for f in solution.fields],
-        indenter.spacing_m,
-        value,
-    )
-    settings = OtsuSettings.from_config(otsu)
-    pixel_m = image_pixel_m(pixel_nm, pixel_table)
+        return ScanStart()
     rendered = render_load_series(
         solution.fields,
         scene.pixel_m,
-        pixel_m=pixel_m,
-        psf_fwhm_m=read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9,
+        pixel_m=context.pixel_m,
+        psf_fwhm_m=context.psf_fwhm_m,
         rendering=config["rendering"],
         confinement_floor_pa=config["confinement_floor_mpa"] * 1e6,
-        otsu=settings,
+        otsu=context.settings,
     )
-    sheet_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
-    simulated = [sheet_load_index(sheet_mn, f * 1e3) for f in scene.loads_n]
-    loads_mn = [sheet_mn[i] for i in simulated]
-    files, choices = fluorescence_planes(fluorescence, sheet_mn, images)
-    images = read_fluorescence_series(
-        [files[i] for i in simulated],
-        optional_nm_to_m(pixel_nm),
-        [choices[i] for i in simulated],
-    )
-    measured = [image_contact_area(image, settings) for image in images]
+    simulated = [sheet_load_index(context.sheet_mn, f * 1e3) for f in scene.loads_n]
+    loads_mn = [context.sheet_mn[i] for i in simulated]
     rows = compare_loads(
         [f * 1e-3 for f in loads_mn],
         rendered,
-        measured,
+        context.measured.at(simulated),
         [row["area_um2"] * 1e-12 for row in solution.per_load],
-        Registration.from_record(read_json(registration_path)),
-        pixel_m,
+        context.registration,
+        context.pixel_m,
     )
     used = [row for row in rows if row.measured_found]
     distance = log_area_distance(
@@ -153,7 +185,7 @@ def main(
             **scene.to_record(),
             "parameter": scan["parameter"],
             "value": value,
-            "image_pixel_nm": pixel_m * 1e9,
+            "image_pixel_nm": context.pixel_m * 1e9,
             "window_centre_in_scan_um": [c * 1e6 for c in indenter.centre_in_scan_m],
         },
     )
@@ -176,24 +208,36 @@ def main(
             ],
         },
     )
+    return ScanStart.of(scene.loads_n, [f["pressure"] for f in solution.fields], indenter.spacing_m)
+
+
+def main(context: ScanContext, chain: list[dict]) -> None:
+    """Every value of ``chain`` (amontons.workflow.scenes.Scenes.scan_value_files: value,
+    point and rendered paths, in the order they are solved), each from the one before."""
+    start = ScanStart()
+    for value in chain:
+        start = solve_value(context, float(value["value"]), value["point"], value["rendered"],
+                            start)  # fmt: skip
+
+
+def run(**kwargs) -> None:
+    """The scan job: its context built and its chain solved, with its log."""
+    chain = kwargs.pop("chain")
+    main(ScanContext(**kwargs), chain)
 
 
 if __name__ == "__main__":
     sm = snakemake  # noqa: F821 (injected by Snakemake)
     run_logged(
-        main,
+        run,
         sm.log[0],
         levelled_path=sm.input.levelled,
         psf_path=sm.input.psf,
         registration_path=sm.input.registration,
         fluorescence=sm.input.fluorescence,
-        neighbour_path=sm.input.warm_start[0] if sm.input.warm_start else None,
-        fields_path=sm.output.fields,
-        point_path=sm.output.point,
-        start_path=sm.output.start,
+        chain=sm.params.chain,
         scan=sm.params.scan,
         base_config=sm.params.base,
-        value=float(sm.wildcards.value),
         sphere=sm.wildcards.sphere,
         sphere_record=sm.params.sphere_record,
         pixel_nm=sm.params.pixel_nm,

@@ -565,7 +565,7 @@ def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
     judged = points[~points["contact_leaves_window"]]
     assert len(points) == 3 and len(judged) >= 2 and judged["log_area_distance"].notna().all()
     for value in judged["value"]:
-        point = json.loads((scan / f"{value:g}" / "scan_point.json").read_text())
+        point = json.loads((scan / "values" / f"{value:g}" / "scan_point.json").read_text())
         assert [row["load_mn"] for row in point["loads"]] == pytest.approx([25, 50, 100])
     models = pd.read_csv(project / "results" / SMALL / "PS" / "models.csv")
     cut = models[models["sphere"] == "PS-cutscan"]

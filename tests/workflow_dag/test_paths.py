@@ -10,7 +10,10 @@ def test_a_path_without_wildcard_values_is_the_rules_pattern():
         "results/small/PS/PS-1/scenes/elastic/solve.json"
     )
     assert paths.measured() == "results/small/{material}/{sphere}/measure"
-    assert paths.scan_value("x.json", "PS", "s", "k", "5") == "results/small/PS/s/scans/k/5/x.json"
+    assert paths.scan_value("x.json", "PS", "s", "k", "5") == (
+        "results/small/PS/s/scans/k/values/5/x.json"
+    )
+    assert paths.scan_values("PS", "s", "k") == "results/small/PS/s/scans/k/values"
 
 
 def test_two_runs_share_no_folder():

@@ -63,7 +63,7 @@ def test_a_larger_window_asks_for_more_time_and_memory(make_run):
     wildcards = type("W", (), {"scene": scene, "sphere": sphere})()
 
     def solve_of(wc):
-        return wc.scene, wc.sphere
+        return [(wc.scene, wc.sphere)]
 
     assert bigger.resources.solve_runtime(solve_of)(wildcards) >= run.resources.solve_runtime(
         solve_of

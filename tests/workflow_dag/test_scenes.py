@@ -1,5 +1,6 @@
 """The expansion of scenes, scans and the study into the files the DAG schedules, on the
-shipped small config: only what a scene names, one job per scan value."""
+shipped small config: only what a scene names, one job per sphere and scan that solves its
+values in a chain."""
 
 from pathlib import Path
 from types import SimpleNamespace
@@ -11,7 +12,7 @@ import tifffile
 from amontons.config.scenes import SCAN_COLUMNS
 from amontons.io.tiff import write_image
 from amontons.simulate.scan_grid import scan_values, value_label
-from amontons.workflow.paths import SCAN_START
+from amontons.workflow.paths import RENDERED, SCAN_POINT
 from amontons.workflow.scenes import SCAN_CHAIN_ORDER
 
 
@@ -74,26 +75,25 @@ def test_a_scan_has_one_point_per_value_around_the_sheets_prior(small):
 
 
 def test_a_scans_values_run_as_one_chain_each_from_the_one_before(small):
-    """Every value of a sphere's scan but the first reads the start of the value before it in
-    SCAN_CHAIN_ORDER, so the values form one chain from the largest value down (or the
-    smallest up), and no value reads a start that nothing writes."""
+    """A sphere's scan job solves every value once, in SCAN_CHAIN_ORDER (from the largest
+    value down, or the smallest up), and writes each value's files into a folder of its own
+    inside the job's output folder, where best_scan_value reads the results."""
     scenes = small.scenes
     sphere = next(iter(small.spheres))
     material = small.spheres.material_of(sphere)
     for scan, spec in scenes.scans.items():
+        wildcards = _wildcards(material=material, sphere=sphere, scan=scan)
         chain = scenes.scan_chain(sphere, scan)
         assert sorted(chain, key=float) == sorted(scenes.scan_value_labels(sphere, scan), key=float)
         descending = SCAN_CHAIN_ORDER[spec["parameter"]] < 0
         assert [float(v) for v in chain] == sorted(map(float, chain), reverse=descending)
-        reads = [
-            scenes.scan_neighbour_start(
-                _wildcards(material=material, sphere=sphere, scan=scan, value=value)
-            )
-            for value in chain
-        ]
-        assert reads[0] == []
-        for before, read in zip(chain, reads[1:], strict=False):
-            assert read == [scenes.paths.scan_value(SCAN_START, material, sphere, scan, before)]
+        value_files = scenes.scan_value_files(wildcards)
+        assert [entry["value"] for entry in value_files] == chain
+        folder = scenes.scan_values_folder(wildcards)
+        for entry in value_files:
+            assert entry["point"] == f"{folder}/{entry['value']}/{SCAN_POINT}"
+            assert entry["rendered"] == f"{folder}/{entry['value']}/{RENDERED}"
+        assert sorted(scenes.scan_points(wildcards)) == sorted(e["point"] for e in value_files)
 
 
 def test_without_scans_there_is_no_scan_and_no_study_output(make_run):

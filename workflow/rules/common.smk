@@ -33,9 +33,7 @@ from amontons.workflow.paths import (
     REGISTRATION,
     RENDERED,
     RENDER_TABLE,
-    SCAN_POINT,
     SPHERE_FITS,
-    SCAN_START,
     SCAN_TABLE,
     SCENE_FIT,
     SOLVE,
@@ -44,7 +42,7 @@ from amontons.workflow.paths import (
     ACCURACY_SUMMARY,
     flat_files,
 )
-from amontons.workflow.resources import scan_solve
+from amontons.workflow.resources import scan_solves
 from amontons.workflow.run import WorkflowRun
 from amontons.workflow.spheres import RHEOMETER, names_pattern
 

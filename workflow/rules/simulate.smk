@@ -45,8 +45,8 @@ rule simulate_scene:
     threads: 1
     resources:
         **SOLVE_GPU,
-        mem_mb=solve_mem_mb(lambda wc: (wc.scene, wc.sphere)),
-        runtime=solve_runtime(lambda wc: (wc.scene, wc.sphere)),
+        mem_mb=solve_mem_mb(lambda wc: [(wc.scene, wc.sphere)]),
+        runtime=solve_runtime(lambda wc: [(wc.scene, wc.sphere)]),
     params:
         **SOLVE_BACKEND,
         scene=lambda wc: scene_config(wc.scene),
@@ -96,8 +96,8 @@ rule simulate_synthetic_scene:
     threads: 1
     resources:
         **SOLVE_GPU,
-        mem_mb=solve_mem_mb(lambda wc: (wc.scene, None)),
-        runtime=solve_runtime(lambda wc: (wc.scene, None)),
+        mem_mb=solve_mem_mb(lambda wc: [(wc.scene, None)]),
+        runtime=solve_runtime(lambda wc: [(wc.scene, None)]),
     params:
         **SOLVE_BACKEND,
         scene=lambda wc: scene_config(wc.scene),

@@ -1,7 +1,7 @@
 # The study (docs/study.md): which contact model explains the experiment. Parameter scans of
-# p_Y and k on each sphere's AFM map, each value a job of its own that starts from the value
-# before it (a chain per sphere and scan, one cluster job: profiles/slurm); the best value;
-# the appendix's figures B.8-B.13 and the model-comparison table. Nothing here runs unless
+# p_Y and k on each sphere's AFM map, one job per sphere and scan that solves its values in a
+# chain, each value starting from the one before it (docs/cluster.md); the best value; the
+# appendix's figures B.8-B.13 and the model-comparison table. Nothing here runs unless
 # run_scans lists a scan.
 
 
@@ -12,28 +12,25 @@ rule scan_scene:
         registration=RUN.scenes.scan_base_registration,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
         pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
-        # the value before this one in the scan's chain: its pressures start this value's
-        warm_start=RUN.scenes.scan_neighbour_start,
     output:
-        point=PATHS.scan_value(SCAN_POINT),
-        fields=PATHS.scan_value(RENDERED),
-        start=PATHS.scan_value(SCAN_START),
+        # every value's result and rendered fields, a folder per value
+        values=directory(PATHS.scan_values()),
     log:
-        f"{SCAN_LOGS}/{{value}}/scan_scene.log",
+        f"{SCAN_LOGS}/scan_scene.log",
     benchmark:
-        f"{SCAN_LOGS}/{{value}}/scan_scene.benchmark.tsv"
-    wildcard_constraints:
-        value=r"[0-9][0-9.e+-]*",
+        f"{SCAN_LOGS}/scan_scene.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
     resources:
         **SOLVE_GPU,
-        mem_mb=solve_mem_mb(scan_solve(SCANS)),
-        runtime=solve_runtime(scan_solve(SCANS)),
+        mem_mb=solve_mem_mb(scan_solves(SCANS, RUN.scenes.scan_chain)),
+        runtime=solve_runtime(scan_solves(SCANS, RUN.scenes.scan_chain)),
     params:
         **SOLVE_BACKEND,
         scan=lambda wc: RUN.scenes.scan_params(wc.sphere, wc.scan),
+        # the values in the order they are solved, and where each one's files go
+        chain=RUN.scenes.scan_value_files,
         base=lambda wc: scene_config(SCANS[wc.scan]["scene"]),
         sphere_record=lambda wc: scene_sphere_record(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
@@ -45,7 +42,7 @@ rule scan_scene:
 
 rule best_scan_value:
     input:
-        points=RUN.scenes.scan_points,
+        values=rules.scan_scene.output.values,
     output:
         table=f"{SCAN}/{SCAN_TABLE}",
         best=f"{SCAN}/{BEST}",
@@ -60,6 +57,8 @@ rule best_scan_value:
         mem_mb=measured_mem_mb("best_scan_value"),
         runtime=measured_runtime("best_scan_value"),
     params:
+        # every value's result, in the scan job's folder
+        points=RUN.scenes.scan_points,
         confidence=config["load_area"]["confidence"],
     script:
         "../../scripts/best_scan_value.py"

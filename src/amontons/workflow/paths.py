@@ -16,7 +16,6 @@ MATERIAL = "{material}"
 SPHERE = "{sphere}"
 SCENE = "{scene}"
 SCAN = "{scan}"
-VALUE = "{value}"
 
 # Files that one rule writes and another rule, or a target, reads: named once, here.
 LEVELLED_MAP = "afm_before_levelled.h5"
@@ -35,7 +34,6 @@ COMPARISON = f"{COMPARISON_FIGURE}.csv"
 REGISTRATION = "registration.json"
 SCENE_FIT = "scene_fit.json"
 SCAN_POINT = "scan_point.json"
-SCAN_START = "start.h5"  # a scan value's pressures, the next value's start
 SCAN_TABLE = "scan.csv"
 BEST = "best.json"
 TRUTH = "truth.json"
@@ -115,16 +113,15 @@ class RunPaths:
         """File ``name`` of one sphere's scan (its folder where ``name`` is empty)."""
         return _join(f"{self.results}/{material}/{sphere}/scans/{scan}", name)
 
-    def scan_value(
-        self,
-        name: str,
-        material: str = MATERIAL,
-        sphere: str = SPHERE,
-        scan: str = SCAN,
-        value: str = VALUE,
-    ) -> str:
-        """File ``name`` of one value of a scan."""
-        return f"{self.scan('', material, sphere, scan)}/{value}/{name}"
+    def scan_value(self, name: str, material: str, sphere: str, scan: str, value: str) -> str:
+        """File ``name`` of one value of a scan, in the scan job's folder of values
+        (:meth:`scan_values`)."""
+        return f"{self.scan_values(material, sphere, scan)}/{value}/{name}"
+
+    def scan_values(self, material: str = MATERIAL, sphere: str = SPHERE, scan: str = SCAN):
+        """The folder a scan job writes its values into, one folder per value: the job's
+        output, apart from the scan's judgement beside it."""
+        return self.scan("values", material, sphere, scan)
 
     def scan_logs(self, material: str = MATERIAL, sphere: str = SPHERE, scan: str = SCAN):
         return f"{self.logs}/{material}/{sphere}/scans/{scan}"
@@ -162,8 +159,22 @@ def figure_files(folder: str, name: str) -> list[str]:
     return [f"{folder}/{name}.{ext}" for ext in FIGURE_FORMATS]
 
 
+class FilesInFolder(list):
+    """Files that one job writes inside its output folder (a Snakemake ``directory()``, such
+    as a scan's values): a list of their paths for the script that reads them, and as an
+    input (:func:`flat_files`) the folder, since Snakemake knows no rule for a file inside
+    another rule's output folder."""
+
+    def __init__(self, folder: str, paths: list[str]):
+        super().__init__(paths)
+        self.folder = folder
+
+
 def flat_files(layout) -> list[str]:
-    """Every path in a nested dict/list layout of paths, in order."""
+    """Every path in a nested dict/list layout of paths, in order, as a rule's inputs: the
+    folder of a :class:`FilesInFolder` in its files' place."""
+    if isinstance(layout, FilesInFolder):
+        return [layout.folder]
     if isinstance(layout, dict):
         return [p for value in layout.values() for p in flat_files(value)]
     if isinstance(layout, list):

@@ -15,8 +15,9 @@ from amontons.config import geometry
 from amontons.resources import JobResources, mem_mb_of, runtime_min
 from amontons.workflow.spheres import Spheres
 
-# (scene, sphere or None for a synthetic scene[, scan parameter, scan value]) of a job
-SolveOf = Callable[[object], tuple]
+# A job's solves, one after the other, from its wildcards: each (scene, sphere or None for a
+# synthetic scene[, scan parameter, scan value])
+SolvesOf = Callable[[object], list[tuple]]
 # config solver_backend -> what the solve rules add: their resources and their params
 GPU_BACKENDS = {"cupy": {"gpu": 1}}
 
@@ -112,26 +113,34 @@ class SolveResources:
             "ratio": ratio,
         }
 
-    def predicted(self, solve_of: SolveOf, wildcards) -> tuple[float, float]:
-        """(wall time s, peak memory MB) the timing model predicts for a job's solve."""
-        model, size = self.solve_size(*solve_of(wildcards))
-        return predict(self.timing_model, model, **size)
+    def predicted(self, solves_of: SolvesOf, wildcards) -> tuple[float, float]:
+        """(wall time s, peak memory MB) the timing model predicts for a job's solves, one
+        after the other: their times summed, the largest memory."""
+        each = [
+            predict(self.timing_model, model, **size)
+            for model, size in (self.solve_size(*solve) for solve in solves_of(wildcards))
+        ]
+        return sum(time for time, _ in each), max(memory for _, memory in each)
 
-    def solve_runtime(self, solve_of: SolveOf):
+    def solve_runtime(self, solves_of: SolvesOf):
         """Runtime (min) of a solve job, as a function of its wildcards: the timing model's
         prediction with the resources' safety factor."""
-        return lambda wildcards: runtime_min(self.predicted(solve_of, wildcards)[0])
+        return lambda wildcards: runtime_min(self.predicted(solves_of, wildcards)[0])
 
-    def solve_mem_mb(self, solve_of: SolveOf):
+    def solve_mem_mb(self, solves_of: SolvesOf):
         """Memory (MB) of a solve job, as :meth:`solve_runtime`."""
-        return lambda wildcards: mem_mb_of(self.predicted(solve_of, wildcards)[1])
+        return lambda wildcards: mem_mb_of(self.predicted(solves_of, wildcards)[1])
 
 
-def scan_solve(scans: Mapping) -> SolveOf:
-    """A scan job's solve for the timing model: its scene on its sphere at its value."""
+def scan_solves(scans: Mapping, chain: Callable[[str, str], list[str]]) -> SolvesOf:
+    """A scan job's solves for the timing model: its scene on its sphere at each value of
+    ``chain(sphere, scan)``."""
 
-    def solve_of(wildcards):
+    def solves_of(wildcards):
         scan = scans[wildcards.scan]
-        return scan["scene"], wildcards.sphere, scan["parameter"], wildcards.value
+        return [
+            (scan["scene"], wildcards.sphere, scan["parameter"], value)
+            for value in chain(wildcards.sphere, wildcards.scan)
+        ]
 
-    return solve_of
+    return solves_of

@@ -13,7 +13,7 @@ from amontons.io.pixel_probe import tiff_scan_side_m
 from amontons.simulate.scan_grid import scan_values, value_label
 from amontons.workflow import paths as files
 from amontons.workflow.params import sorted_keys
-from amontons.workflow.paths import RunPaths
+from amontons.workflow.paths import FilesInFolder, RunPaths
 from amontons.workflow.spheres import AFM_BEFORE, Spheres
 
 # What a scan's prior-free range is a multiple of (config scans.<name>.prior_free_range).
@@ -306,23 +306,31 @@ class Scenes:
         return [value_label(v) for v in values]
 
     def scan_chain(self, sphere: str, scan: str) -> list[str]:
-        """A scan's values in the order they run (:data:`SCAN_CHAIN_ORDER`), each starting
-        from the one before (amontons.simulate.scan_start)."""
+        """A scan's values in the order its job solves them (:data:`SCAN_CHAIN_ORDER`), each
+        starting from the one before (amontons.simulate.scan_start)."""
         labels = sorted(self.scan_value_labels(sphere, scan), key=float)
         return labels[::-1] if SCAN_CHAIN_ORDER[self.scans[scan]["parameter"]] < 0 else labels
 
-    def scan_neighbour_start(self, wildcards) -> list[str]:
-        """The start file of the value before this one in its scan's chain; none for the
-        first."""
-        chain = self.scan_chain(wildcards.sphere, wildcards.scan)
-        index = chain.index(wildcards.value)
-        if index == 0:
-            return []
-        where = (wildcards.material, wildcards.sphere, wildcards.scan, chain[index - 1])
-        return [self.paths.scan_value(files.SCAN_START, *where)]
+    def scan_values_folder(self, wildcards) -> str:
+        """The folder a scan job writes every value's files into (its output)."""
+        return self.paths.scan_values(wildcards.material, wildcards.sphere, wildcards.scan)
+
+    def scan_value_files(self, wildcards) -> list[dict]:
+        """A scan job's values in the order it solves them (:meth:`scan_chain`), each with
+        the paths of its result (``point``) and rendered fields (``rendered``)."""
+        where = (wildcards.material, wildcards.sphere, wildcards.scan)
+        return [
+            {
+                "value": value,
+                "point": self.paths.scan_value(files.SCAN_POINT, *where, value),
+                "rendered": self.paths.scan_value(files.RENDERED, *where, value),
+            }
+            for value in self.scan_chain(wildcards.sphere, wildcards.scan)
+        ]
 
     def scan_points(self, wildcards) -> list[str]:
-        """Every value's result of one sphere's scan."""
+        """Every value's result of one sphere's scan, in the scan job's folder
+        (:meth:`scan_values_folder`)."""
         where = (wildcards.material, wildcards.sphere, wildcards.scan)
         return [
             self.paths.scan_value(files.SCAN_POINT, *where, value)
@@ -351,10 +359,13 @@ class Scenes:
         return {
             "best": self.paths.scan(files.BEST, *where),
             "table": self.paths.scan(files.SCAN_TABLE, *where),
-            "rendered": [
-                self.paths.scan_value(files.RENDERED, *where, v)
-                for v in self.scan_value_labels(sphere, scan)
-            ],
+            "rendered": FilesInFolder(
+                self.paths.scan_values(*where),
+                [
+                    self.paths.scan_value(files.RENDERED, *where, v)
+                    for v in self.scan_value_labels(sphere, scan)
+                ],
+            ),
             "registration": self.paths.scene(
                 files.REGISTRATION, material, sphere, self.registration_scene(sphere, scan)
             ),
