@@ -41,3 +41,42 @@ def test_a_wide_map_is_drawn_at_the_panels_resolution_with_its_marks_in_place():
 def test_a_map_no_wider_than_its_panel_is_drawn_as_it_is():
     panel = MapPanel(np.ones((240, 100)), "map", pixel_um=0.5)
     assert at_display_resolution(panel, 0.2, 240) is panel
+
+
+def _drawn_shapes(monkeypatch) -> list[tuple[int, ...]]:
+    """The shape of every image matplotlib is asked to draw from here on."""
+    import matplotlib.axes
+
+    shapes = []
+    imshow = matplotlib.axes.Axes.imshow
+
+    def recording(self, image, *args, **kwargs):
+        shapes.append(np.shape(image))
+        return imshow(self, image, *args, **kwargs)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "imshow", recording)
+    return shapes
+
+
+def test_the_measurement_figures_draw_wide_maps_at_their_panels_pixels(monkeypatch, tmp_path):
+    """Topography (3 in panels, 450 px at 150 dpi), contact areas and scene comparisons
+    (2.4 in, 360 px): a 2048² AFM map and 1568² fluorescence images are drawn as block means
+    no wider than their panel, and a 300² image as it is."""
+    from amontons.plots import plot_contact_separation, plot_scene_comparison, plot_topography
+
+    shapes = _drawn_shapes(monkeypatch)
+    rng = np.random.default_rng(0)
+    afm = rng.normal(size=(2048, 2048))
+    plot_topography(afm, afm, afm, 0.05, "t", [str(tmp_path / "topo.png")])
+    assert shapes == [(409, 409)] * 3  # 2048 // 5: blocks of 5 px
+    shapes.clear()
+    rows, cols = np.indices((1568, 1568))
+    image = rng.normal(size=(1568, 1568))
+    mask = (rows - 800.0) ** 2 + (cols - 700.0) ** 2 < 300.0**2
+    plot_scene_comparison([10.0, 20.0], [image, image[:300, :300]], [mask, mask[:300, :300]],
+                          [mask, None], [0.9, None], [1.0, None], 0.2, "c",
+                          [str(tmp_path / "c.png")])  # fmt: skip
+    plot_contact_separation([10.0], [image], [mask], [0.5], [0.9], [None], 0.2, "s",
+                            [str(tmp_path / "s.png")])  # fmt: skip
+    assert shapes == [(313, 313), (300, 300), (313, 313)]  # 1568 // 5
+    assert all((tmp_path / name).stat().st_size > 0 for name in ("topo.png", "c.png", "s.png"))

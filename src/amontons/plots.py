@@ -14,6 +14,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from amontons.io.files import atomic_path
+from amontons.simulate.grid import block_mean
 
 
 def plot_normalised_load_area(
@@ -134,6 +135,19 @@ def _save(fig, paths: list[str]) -> None:
     plt.close(fig)
 
 
+def display_factor(shape: tuple[int, ...], panel_px: int) -> int:
+    """The block size that brings an image of ``shape`` (px) to no more than ``panel_px``
+    pixels a side (what its panel shows at FIGURE_DPI); 1 where it is no wider."""
+    return max(1, int(np.ceil(max(shape) / panel_px)))
+
+
+def at_display(image: np.ndarray, factor: int) -> np.ndarray:
+    """``image`` as block means of ``factor`` × ``factor`` pixels (a mask as the fraction of
+    each block inside it, outlined at 0.5); itself where ``factor`` is 1. What a panel shows
+    of a map wider than its pixels, while every number is computed at full resolution."""
+    return image if factor == 1 else block_mean(image, factor)
+
+
 def plot_psf_profile(
     r_nm: np.ndarray,
     counts: np.ndarray,
@@ -246,6 +260,12 @@ def plot_unmeasured(reason: str, title: str, paths: list[str]) -> None:
     _save(fig, paths)
 
 
+# The widths (px at FIGURE_DPI) of the map panels below, 3 and 2.4 in: a map is drawn with no
+# more pixels than its panel shows.
+_TOPOGRAPHY_PANEL_PX = round(3.0 * FIGURE_DPI)
+_LOAD_PANEL_PX = round(2.4 * FIGURE_DPI)
+
+
 def plot_topography(
     before_nm: np.ndarray,
     after_nm: np.ndarray,
@@ -257,13 +277,19 @@ def plot_topography(
     """Levelled AFM roughness before and after contact and their difference (appendix
     Fig. B.9), on one colour scale for the two scans."""
     fig, axes = plt.subplots(1, 3, figsize=(9, 3.2), constrained_layout=True)
-    extent = [0, before_nm.shape[1] * pixel_um, 0, before_nm.shape[0] * pixel_um]
+    # the colour scales from the full maps, the panels drawn at the pixels they show
     low, high = np.percentile(before_nm, [1, 99])
+    span = max(float(np.percentile(np.abs(change_nm), 99.9)), 1e-3)
+    factor = display_factor(before_nm.shape, _TOPOGRAPHY_PANEL_PX)
+    before_nm, after_nm, change_nm = (
+        at_display(m, factor) for m in (before_nm, after_nm, change_nm)
+    )
+    pixel_um *= factor
+    extent = [0, before_nm.shape[1] * pixel_um, 0, before_nm.shape[0] * pixel_um]
     for ax, data, label in ((axes[0], before_nm, "before"), (axes[1], after_nm, "after")):
         image = ax.imshow(data, extent=extent, origin="lower", vmin=low, vmax=high, cmap="viridis")
         ax.set_title(f"{label} contact", fontsize=8)
     fig.colorbar(image, ax=axes[:2], label="height (nm)", shrink=0.8)
-    span = max(float(np.percentile(np.abs(change_nm), 99.9)), 1e-3)
     diff = axes[2].imshow(
         change_nm, extent=extent, origin="lower", vmin=-span, vmax=span, cmap="RdBu"
     )
@@ -334,10 +360,12 @@ def plot_contact_separation(
         zip(loads_mn, images, masks, thresholds, separations, flags, strict=True)
     ):
         top, bottom = axes[0, column], axes[1, column]
-        extent = [0, image.shape[1] * pixel_um, 0, image.shape[0] * pixel_um]
-        top.imshow(image, cmap="gray", origin="lower", extent=extent)
+        factor = display_factor(image.shape, _LOAD_PANEL_PX)
+        shown = at_display(image, factor)
+        extent = [0, shown.shape[1] * pixel_um * factor, 0, shown.shape[0] * pixel_um * factor]
+        top.imshow(shown, cmap="gray", origin="lower", extent=extent)
         top.contour(
-            mask.astype(float),
+            at_display(mask.astype(float), factor),
             levels=[0.5],
             colors="lime",
             linewidths=0.5,
@@ -421,12 +449,14 @@ def plot_scene_comparison(
     for ax, load, image, measured, simulated, iou, ratio in zip(
         axes[0], loads_mn, images, measured_masks, simulated_masks, ious, ratios, strict=True
     ):
-        extent = [0, image.shape[1] * pixel_um, 0, image.shape[0] * pixel_um]
-        ax.imshow(image, cmap="gray", origin="lower", extent=extent)
+        factor = display_factor(image.shape, _LOAD_PANEL_PX)
+        shown = at_display(image, factor)
+        extent = [0, shown.shape[1] * pixel_um * factor, 0, shown.shape[0] * pixel_um * factor]
+        ax.imshow(shown, cmap="gray", origin="lower", extent=extent)
         for mask, colour in ((measured, "lime"), (simulated, "magenta")):
             if mask is not None and mask.any():
                 ax.contour(
-                    mask.astype(float),
+                    at_display(mask.astype(float), factor),
                     levels=[0.5],
                     colors=colour,
                     linewidths=0.6,

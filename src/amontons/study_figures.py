@@ -17,7 +17,13 @@ import pandas as pd  # noqa: E402
 
 from amontons.io.fields import read_load_series_settings  # noqa: E402
 from amontons.io.files import write_table  # noqa: E402
-from amontons.plots import FIGURE_DPI, _save, amontons_axes, plot_unmeasured  # noqa: E402
+from amontons.plots import (  # noqa: E402
+    FIGURE_DPI,
+    _save,
+    amontons_axes,
+    display_factor,
+    plot_unmeasured,
+)
 from amontons.simulate.grid import block_mean  # noqa: E402
 
 
@@ -66,8 +72,8 @@ def at_display_resolution(panel: MapPanel, pixel_um: float, panel_px: int) -> Ma
     """``panel`` with its image (and outline) block-averaged to at most ``panel_px`` pixels a
     side, its pixel (µm) and marker moved to the coarser grid; unchanged where it is no wider.
     A block k covers pixels f·k … f·k + f - 1, so a position p lands at (p - (f - 1)/2)/f."""
-    factor = int(np.ceil(max(panel.image.shape) / panel_px))
-    if factor <= 1:
+    factor = display_factor(panel.image.shape, panel_px)
+    if factor == 1:
         return panel
     marker = panel.marker
     if marker is not None:

@@ -55,8 +55,12 @@ def _coordinates(shape, pixel_m):
 
 def sphere_cap(shape, pixel_m, radius_m, apex_xy_m=(0.0, 0.0), apex_height_m=0.0):
     """Heights of a sphere's cap (apex up), m: z0 − R + √(R² − r²)."""
-    x, y = _coordinates(shape, pixel_m)
-    r2 = (x - apex_xy_m[0]) ** 2 + (y - apex_xy_m[1]) ** 2
+    ny, nx = shape
+    x = (np.arange(nx) - (nx - 1) / 2) * pixel_m
+    y = (np.arange(ny) - (ny - 1) / 2) * pixel_m
+    # The squared distances per column and per row, summed by broadcasting: the same floats
+    # as on the two meshgrids (the fit calls this once per residual, on 2048² maps).
+    r2 = ((x - apex_xy_m[0]) ** 2)[None, :] + ((y - apex_xy_m[1]) ** 2)[:, None]
     if np.max(r2) >= radius_m**2:
         raise TopographyError(f"map wider than the sphere of radius {radius_m:.3e} m")
     return apex_height_m - radius_m + np.sqrt(radius_m**2 - r2)
