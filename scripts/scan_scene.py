@@ -8,6 +8,7 @@ whole scan; each value writes its result and its rendered fields into its own fo
 
 import logging
 import os
+from functools import cached_property
 
 if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
@@ -82,15 +83,33 @@ class ScanContext:
         self.sphere = sphere
         self.sphere_record = sphere_record
         self.settings = OtsuSettings.from_config(otsu)
-        self.pixel_m = image_pixel_m(pixel_nm, pixel_table)
-        self.psf_fwhm_m = read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9
-        self.registration = Registration.from_record(read_json(registration_path))
+        self.psf_path = psf_path
+        self.registration_path = registration_path
+        self.pixel_nm = pixel_nm
+        self.pixel_table = pixel_table
         self.sheet_mn = [float(f) for f in sphere_record["loads"]]  # the files are named by these
         self.measured = MeasuredContacts(
             fluorescence, self.sheet_mn, pixel_nm, images, self.settings
         )
         self.threads = threads
         self.solver_backend = solver_backend
+
+    # Read when the first value renders: a scan whose values solve nothing (its windows
+    # outside the AFM scan) has no registration to read, and needs no pixel or PSF.
+    @cached_property
+    def pixel_m(self) -> float:
+        """The fluorescence image's pixel (m)."""
+        return image_pixel_m(self.pixel_nm, self.pixel_table)
+
+    @cached_property
+    def psf_fwhm_m(self) -> float:
+        """The sphere's measured PSF width (m)."""
+        return read_json(self.psf_path)["fwhm_nm"]["estimate"] * 1e-9
+
+    @cached_property
+    def registration(self) -> Registration:
+        """The base scene's registration, every value is compared under."""
+        return Registration.from_record(read_json(self.registration_path))
 
 
 def solve_value(
