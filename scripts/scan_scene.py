@@ -239,10 +239,10 @@ def main(context: ScanContext, chain: list[dict]) -> None:
                             start)  # fmt: skip
 
 
-def run(**kwargs) -> None:
-    """The scan job: its context built and its chain solved, with its log."""
-    chain = kwargs.pop("chain")
-    main(ScanContext(**kwargs), chain)
+def run(chain: list[dict], **context) -> None:
+    """The scan job: its context (:class:`ScanContext`'s arguments) built and its chain
+    solved, inside its log."""
+    main(ScanContext(**context), chain)
 
 
 if __name__ == "__main__":
