@@ -12,6 +12,13 @@ import numpy as np
 
 from amontons.io.files import atomic_path
 
+# How every array is compressed: the byte shuffle, then gzip at level 1 (HDF5's standard
+# filters, which every HDF5 reader has). Against gzip at h5py's default level 4 without the
+# shuffle, on the pipeline's float64 maps: a 2048² levelled AFM map writes in 0.38 s instead
+# of 1.0 s, reads in 0.16 instead of 0.24 s and takes 11.9 instead of 15.6 MB; a scan value's
+# rendered images 0.56 instead of 0.84 s (docs/study.md §5). The values are the same.
+COMPRESSION = {"compression": "gzip", "compression_opts": 1, "shuffle": True}
+
 # Field name → unit, in the order written.
 FIELD_UNITS = {
     "pressure": "Pa",
@@ -51,7 +58,7 @@ def write_load_series(
                     continue
                 data = np.asarray(load_fields[name])
                 data = data.astype(np.uint8) if data.dtype == bool else data
-                dataset = group.create_dataset(name, data=data, compression="gzip")
+                dataset = group.create_dataset(name, data=data, **COMPRESSION)
                 dataset.attrs["unit"] = unit
 
 
@@ -92,7 +99,7 @@ def write_levelled_map(path: str | Path, heights_m: np.ndarray, pixel_m: float, 
     """A levelled AFM map (heights in m, square pixels of ``pixel_m``) with its sphere fit and
     provenance as attributes, atomically."""
     with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
-        dataset = h5.create_dataset("heights", data=np.asarray(heights_m), compression="gzip")
+        dataset = h5.create_dataset("heights", data=np.asarray(heights_m), **COMPRESSION)
         dataset.attrs["unit"] = "m"
         h5.attrs["pixel_m"] = pixel_m
         for key, value in attrs.items():
@@ -117,7 +124,7 @@ def write_named_records(
             for key, value in record.items():
                 group.attrs[key] = _attribute(value)
             for key, data in arrays.get(name, {}).items():
-                group.create_dataset(key, data=np.asarray(data), compression="gzip")
+                group.create_dataset(key, data=np.asarray(data), **COMPRESSION)
 
 
 def read_named_records(path: str | Path) -> tuple[dict[str, dict], dict[str, dict]]:
