@@ -5,7 +5,7 @@ import logging
 from amontons.io.files import write_json
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.scan_lines import line_levelling_mode
-from amontons.measure.topography import measure_topography, write_sphere_fits
+from amontons.measure.topography import measure_topography, read_fit_record, write_sphere_fits
 from amontons.plots import plot_topography
 from amontons.runlog import run_logged
 
@@ -15,6 +15,7 @@ log = logging.getLogger(__name__)
 def main(
     before_path: str,
     after_path: str,
+    before_fit_path: str,
     topography_path: str,
     fits_path: str,
     figure_paths: list[str],
@@ -32,6 +33,8 @@ def main(
         nan_policy=nan_policy,
         channel=channel,
         line_levelling=line_levelling_mode(line_levelling),
+        # level_afm_map's fit of the same before scan: only the after scan is fitted here
+        known_fits=(read_fit_record(before_fit_path, "before"), None),
     )
     flattening = topo.flattening
     log.info(
@@ -65,6 +68,7 @@ if __name__ == "__main__":
         sm.log[0],
         before_path=sm.input.before,
         after_path=sm.input.after,
+        before_fit_path=sm.input.before_fit,
         topography_path=sm.output.topography,
         fits_path=sm.output.fits,
         figure_paths=[sm.output.png, sm.output.pdf],

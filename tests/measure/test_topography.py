@@ -13,11 +13,14 @@ from amontons.io.tiff import read_image, write_image
 from amontons.measure.flattening import unchanged_level
 from amontons.measure.topography import (
     measure_topography,
+    read_fit_record,
     read_sphere_fits,
     sphere_cap,
     square_pixels,
+    write_fit_records,
     write_sphere_fits,
 )
+from amontons.simulate.surface import read_and_fit_afm_map
 
 PIXEL = 32e-9
 
@@ -75,6 +78,30 @@ def test_the_maps_levelled_again_by_the_written_fits_are_the_same_to_the_bit(tmp
         assert np.array_equal(ours.line_offsets, theirs.line_offsets)
     assert np.array_equal(again.change_m, fitted.change_m)
     assert again.to_record() == fitted.to_record()
+
+
+def test_the_levelling_jobs_fit_of_the_before_scan_gives_the_topography_to_the_bit(tmp_path):
+    """measure_topography takes the before scan's fit from level_afm_map's file (the scenes'
+    levelling fits the same map, read the same way) and fits only the after scan: the same
+    topography, every array and the record, as fitting both, scan-line offsets levelled."""
+    _scans(tmp_path, np.random.default_rng(7))
+    image = read_image(tmp_path / "afm_before.tif").data.astype(np.float64)
+    image[60:, :] -= 2e-9  # a scan-line offset that 'auto' levels
+    write_image(tmp_path / "afm_before.tif", image, PIXEL)
+    paths = (tmp_path / "afm_before.tif", tmp_path / "afm_after.tif")
+    levelled, fit = read_and_fit_afm_map(
+        paths[0], fallback_pixel_m=None, nan_policy="fail", channel=None, line_levelling="auto"
+    )
+    assert fit.line_levelling.applied
+    write_fit_records(tmp_path / "before_fit.h5", {"before": fit})
+    known = (read_fit_record(tmp_path / "before_fit.h5", "before"), None)
+    both = measure_topography(*paths, None, nan_policy="fail")
+    given = measure_topography(*paths, None, nan_policy="fail", known_fits=known)
+    assert np.array_equal(given.before.roughness, both.before.roughness)
+    assert np.array_equal(given.after.roughness, both.after.roughness)
+    assert np.array_equal(given.change_m, both.change_m)
+    assert given.to_record() == both.to_record()
+    assert levelled.radius_m == both.before.radius_m
 
 
 def test_nan_pixels_fail_or_are_filled_as_the_config_says(tmp_path):

@@ -120,12 +120,12 @@ def test_a_map_that_is_no_sphere_apex_is_refused_naming_the_file(tmp_path):
     the error names the file and what was expected."""
     from amontons.io.heightmap import write_height_map
     from amontons.io.layout import RawDataError
-    from amontons.simulate.surface import read_and_level_afm_map
+    from amontons.simulate.surface import read_and_fit_afm_map
 
     path = tmp_path / "afm_before.tif"
     write_height_map(path, -_sphere_map(128, 100e-9, 1e-3), 100e-9)
     with pytest.raises(RawDataError, match=r"afm_before\.tif: .*not convex upwards.*sphere's apex"):
-        read_and_level_afm_map(
+        read_and_fit_afm_map(
             path, fallback_pixel_m=None, nan_policy="fail", channel=None, line_levelling="auto"
         )
 

@@ -20,6 +20,7 @@ from amontons.workflow.paths import (
     B12_FIGURE,
     B13_FIGURE,
     MODELS_TABLE,
+    BEFORE_FIT,
     BEST,
     COMPARISON,
     COMPARISON_FIGURE,

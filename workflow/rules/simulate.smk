@@ -9,6 +9,7 @@ rule level_afm_map:
         afm_before=lambda wc: afm_path(wc.sphere, "afm_before"),
     output:
         levelled=f"{MEASURED}/{LEVELLED_MAP}",
+        fit=f"{MEASURED}/{BEFORE_FIT}",
     log:
         f"{SPHERE_LOGS}/level_afm_map.log",
     benchmark:

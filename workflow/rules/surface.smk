@@ -5,6 +5,8 @@ rule measure_topography:
     input:
         before=lambda wc: afm_path(wc.sphere, "afm_before"),
         after=lambda wc: afm_path(wc.sphere, "afm_after"),
+        # the before scan's sphere fit, as level_afm_map found it: not fitted twice
+        before_fit=f"{MEASURED}/{BEFORE_FIT}",
     output:
         topography=f"{MEASURED}/topography.json",
         fits=f"{MEASURED}/{SPHERE_FITS}",

@@ -8,6 +8,7 @@ the height maps are read by amontons.io.heightmap.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -132,8 +133,14 @@ SCANS = ("before", "after")
 def write_sphere_fits(path: str | Path, topography: Topography) -> None:
     """Both scans' sphere fits and scan-line offsets (HDF5, float64 to the bit), so that a
     later step levels the maps again without fitting (:func:`read_sphere_fits`)."""
+    write_fit_records(path, dict(zip(SCANS, (topography.before, topography.after), strict=True)))
+
+
+def write_fit_records(path: str | Path, fits: Mapping[str, FitParameters]) -> None:
+    """Sphere fits by name (``before``, ``after``) with their scan-line offsets (HDF5,
+    float64 to the bit; :func:`read_fit_record`)."""
     records, arrays = {}, {}
-    for name, fit in zip(SCANS, (topography.before, topography.after), strict=True):
+    for name, fit in fits.items():
         lines = fit.line_levelling
         records[name] = {
             "radius_m": fit.radius_m,
@@ -152,27 +159,28 @@ def write_sphere_fits(path: str | Path, topography: Topography) -> None:
 
 def read_sphere_fits(path: str | Path) -> tuple[FitParameters, FitParameters]:
     """The fits :func:`write_sphere_fits` wrote, (before, after)."""
+    before, after = (read_fit_record(path, name) for name in SCANS)
+    return before, after
+
+
+def read_fit_record(path: str | Path, name: str) -> FitParameters:
+    """The fit :func:`write_fit_records` wrote under ``name``."""
     records, arrays = read_named_records(path)
-    fits = []
-    for name in SCANS:
-        r = records[name]
-        lines = LineLevelling(
-            r["line_mode"],
-            bool(r["lines_applied"]),
-            arrays[name]["line_offsets_m"],
-            int(r["stepped_rows"]),
-            bool(r["every_row"]),
-            float(r["step_noise_m"]),
-        )
-        fits.append(
-            FitParameters(
-                float(r["radius_m"]),
-                (float(r["apex_x_m"]), float(r["apex_y_m"])),
-                float(r["apex_height_m"]),
-                lines,
-            )
-        )
-    return fits[0], fits[1]
+    r = records[name]
+    lines = LineLevelling(
+        r["line_mode"],
+        bool(r["lines_applied"]),
+        arrays[name]["line_offsets_m"],
+        int(r["stepped_rows"]),
+        bool(r["every_row"]),
+        float(r["step_noise_m"]),
+    )
+    return FitParameters(
+        float(r["radius_m"]),
+        (float(r["apex_x_m"]), float(r["apex_y_m"])),
+        float(r["apex_height_m"]),
+        lines,
+    )
 
 
 @dataclass(frozen=True)
@@ -259,7 +267,7 @@ def measure_topography(
     nan_policy: str,
     channel: str | None = None,
     line_levelling: str = "auto",
-    known_fits: tuple[FitParameters, FitParameters] | None = None,
+    known_fits: tuple[FitParameters | None, FitParameters | None] | None = None,
 ) -> Topography:
     """Level both scans (sphere fit, scan-line offsets as ``line_levelling`` says: ``auto``,
     ``on``, ``off``) and take their roughness statistics and their difference, the plastic
@@ -267,8 +275,9 @@ def measure_topography(
     Both scans must cover the same field on the same grid (a repeated scan of the same area).
     ``channel`` names the height channel of a vendor file (None: the format's default). Scans
     with non-square pixels are resampled to square ones first (:func:`square_pixels`).
-    ``known_fits``: the scans' fits as :func:`read_sphere_fits` gives them, which a step
-    after this measurement passes instead of fitting again (the same result to the bit)."""
+    ``known_fits``: the scans' fits, (before, after), as :func:`read_sphere_fits` gives
+    them, which a step that has them passes instead of fitting again (the same result to the
+    bit); a None in it is fitted here."""
     files = []
     for path in (before_path, after_path):
         try:
@@ -300,11 +309,12 @@ def measure_topography(
             f"{before.pixel_m * 1e9:.4g} nm)"
         )
     try:
-        if known_fits is None:
-            fits = [level_sphere(m.heights, m.pixel_m, line_levelling=line_levelling) for m in maps]
-        else:
-            pairs = zip(maps, known_fits, strict=True)
-            fits = [sphere_fit_with(m.heights, m.pixel_m, f) for m, f in pairs]
+        fits = [
+            level_sphere(m.heights, m.pixel_m, line_levelling=line_levelling)
+            if known is None
+            else sphere_fit_with(m.heights, m.pixel_m, known)
+            for m, known in zip(maps, known_fits or (None, None), strict=True)
+        ]
     except TopographyError as error:
         raise RawDataError(f"{before.path}, {after.path}: {error}") from error
     difference, difference_lines = _levelled_difference(

@@ -25,7 +25,7 @@ from amontons.contact.surfaces import self_affine, sphere
 from amontons.io.fields import read_levelled_map
 from amontons.io.heightmap import TopographyError, read_height_map
 from amontons.io.layout import RawDataError
-from amontons.measure.topography import level_sphere, sphere_cap, square_pixels
+from amontons.measure.topography import FitParameters, level_sphere, sphere_cap, square_pixels
 from amontons.physics.roughness import roughness_statistics
 from amontons.simulate.scene import Scene, SceneError, scene_in_scan
 
@@ -114,7 +114,13 @@ class LevelledMap:
 def level_afm_map(heights: np.ndarray, pixel_m: float, line_levelling: str = "auto") -> LevelledMap:
     """Level a sphere's AFM map with the topography step's sphere fit and scan-line levelling
     (:func:`amontons.measure.topography.level_sphere`; ``line_levelling`` auto, on or off)."""
-    fit = level_sphere(heights, pixel_m, line_levelling=line_levelling)
+    return levelled_by(
+        heights, pixel_m, level_sphere(heights, pixel_m, line_levelling=line_levelling)
+    )
+
+
+def levelled_by(heights: np.ndarray, pixel_m: float, fit: FitParameters) -> LevelledMap:
+    """The map levelled by its sphere fit: its scan-line offsets removed, the sphere kept."""
     return LevelledMap(
         heights - fit.line_levelling.offsets_m[:, None],
         pixel_m,
@@ -124,25 +130,28 @@ def level_afm_map(heights: np.ndarray, pixel_m: float, line_levelling: str = "au
     )
 
 
-def read_and_level_afm_map(
+def read_and_fit_afm_map(
     path: str | Path,
     *,
     fallback_pixel_m: float | None,
     nan_policy: str,
     channel: str | None,
     line_levelling: str,
-) -> LevelledMap:
-    """Read a sphere's AFM map (amontons.io.heightmap: any supported format, square pixels)
-    and level it; a map that is no sphere's apex raises RawDataError naming the file."""
+) -> tuple[LevelledMap, FitParameters]:
+    """Read a sphere's AFM map (amontons.io.heightmap: any supported format, square pixels),
+    fit its sphere and level it: (the levelled map, the fit), the fit the topography step
+    reads instead of fitting the same map again. A map that is no sphere's apex raises
+    RawDataError naming the file."""
     height_map = square_pixels(
         read_height_map(
             path, fallback_pixel_m=fallback_pixel_m, nan_policy=nan_policy, channel=channel
         )
     )
     try:
-        return level_afm_map(height_map.heights, height_map.pixel_m, line_levelling)
+        fit = level_sphere(height_map.heights, height_map.pixel_m, line_levelling=line_levelling)
     except TopographyError as error:
         raise RawDataError(f"{path}: {error}; expected the AFM map of a sphere's apex") from error
+    return levelled_by(height_map.heights, height_map.pixel_m, fit), fit
 
 
 def load_levelled_map(path: str | Path) -> LevelledMap:

@@ -19,6 +19,7 @@ SCAN = "{scan}"
 
 # Files that one rule writes and another rule, or a target, reads: named once, here.
 LEVELLED_MAP = "afm_before_levelled.h5"
+BEFORE_FIT = "afm_before_fit.h5"  # the levelled map's sphere fit, the topography's before fit
 SPHERE_FITS = "topography_fits.h5"  # both AFM scans' sphere fits, to level them again
 CONTACT_AREA = "contact_area.csv"
 PSF = "psf.json"
