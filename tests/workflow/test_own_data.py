@@ -44,6 +44,7 @@ CASES = {
                                                        "measure/topography.pdf",
                                                        "measure/topography_fits.h5",
                                                        "measure/afm_before_levelled.h5",
+                                                       "measure/afm_before_fit.h5",
                                                        "scenes/"]),
     "PS-norheometer": (["rheometer"], ["measure/friction.csv"]),
 }  # fmt: skip
