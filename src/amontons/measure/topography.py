@@ -159,18 +159,23 @@ def write_fit_records(path: str | Path, fits: Mapping[str, FitParameters]) -> No
 
 def read_sphere_fits(path: str | Path) -> tuple[FitParameters, FitParameters]:
     """The fits :func:`write_sphere_fits` wrote, (before, after)."""
-    before, after = (read_fit_record(path, name) for name in SCANS)
+    records, arrays = read_named_records(path)
+    before, after = (_fit_from(records[name], arrays[name]) for name in SCANS)
     return before, after
 
 
 def read_fit_record(path: str | Path, name: str) -> FitParameters:
     """The fit :func:`write_fit_records` wrote under ``name``."""
     records, arrays = read_named_records(path)
-    r = records[name]
+    return _fit_from(records[name], arrays[name])
+
+
+def _fit_from(r: Mapping, arrays: Mapping) -> FitParameters:
+    """A fit from its record and its arrays as :func:`write_fit_records` wrote them."""
     lines = LineLevelling(
         r["line_mode"],
         bool(r["lines_applied"]),
-        arrays[name]["line_offsets_m"],
+        arrays["line_offsets_m"],
         int(r["stepped_rows"]),
         bool(r["every_row"]),
         float(r["step_noise_m"]),
