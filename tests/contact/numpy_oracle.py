@@ -24,8 +24,11 @@ _EMPTY = np.empty(0, dtype=np.intp)
 _EMPTY_F = np.empty(0, dtype=np.float64)
 # At most this many changed points (clipped + added) are applied to u as point responses.
 SPARSE_MAX = 3
-# Reset the conjugation only when the added points exceed this fraction of the free set.
+# Reset the conjugation only when the added points exceed this fraction of the free set:
+# under the hard wall, and under a bound (the solver's cg_iteration.RESET_FRACTION and
+# BOUNDED_RESET_FRACTION, restated: the oracle does not read the solver's constants).
 RESET_FRACTION = 0.01
+BOUNDED_RESET_FRACTION = 0.1
 
 
 def numpy_polonsky_keer(
@@ -50,6 +53,7 @@ def numpy_polonsky_keer(
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     constraint = HardWall() if constraint is None else constraint
+    reset_fraction = BOUNDED_RESET_FRACTION if constraint.bounded else RESET_FRACTION
     if constraint.bounded and load is not None:
         # the solver imposes the load on the free points (bounded_load.impose_bounded_load);
         # this loop only rescales the whole field, which would push points at the bound
@@ -222,7 +226,7 @@ def numpy_polonsky_keer(
         if ol.size:
             p_new[ol] -= tau * g[ol]
             m[ol] = 1.0
-            if ol.size > RESET_FRACTION * nc:
+            if ol.size > reset_fraction * nc:
                 delta = 0.0
                 resets += 1
             else:

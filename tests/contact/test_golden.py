@@ -1,16 +1,19 @@
 """The solver reproduces its golden record (tests/contact/golden/record.py: elastic periodic
 and padded solves, penetration hardness under load and displacement control, contact
 hardening by the Winkler and the appendix's routes, volume-conserving increments, load series
-and a scan; the solves of 26f01d4, before the rebuild of issue 38).
+and a scan; the solves of 26f01d4, before the rebuild of issue 38, with the bounded ones
+re-made when the bounded reset rule changed on 2026-11-28).
 
 On any machine, each case holds the record to its route's tolerances (golden/compare.py says
 each bound and why): the same contact set, fields within a stated fraction of their peak,
 iterations within a stated count, a converged residual. It is held to two records: the one
 made on the machine named in golden.machine.json, and one made on another kind of machine
 (earlier-machine.npz, the developers' machine until 2026-11-26), whose round-off differs from
-the first in every one of the 16 cases, so that the tolerances are tried against a real other CPU
-on every run. On a machine of the record's kind (same CPU features and library versions),
-the record must also hold to the last bit.
+the first in every case, so that the tolerances are tried against a real other CPU on every
+run; the six cases the bounded reset rule changed on 2026-11-28 are not in the earlier
+record yet (compare.NOT_ON_THE_EARLIER_MACHINE says why), and their test against it skips
+saying so. On a machine of the record's kind (same CPU features and library versions), the
+record must also hold to the last bit.
 
 The cases are solved by record.py in a process of its own, without FFTW wisdom and with
 FFTW_ESTIMATE plans, so that neither this process's plans nor a wisdom file on the machine
@@ -77,12 +80,23 @@ def test_the_record_holds_every_case_with_a_route():
     assert source.count(": lambda: solve") == len(names)
     assert sorted(compare.CASE_ROUTES) == names
     assert set(compare.CASE_ROUTES.values()) <= set(compare.ROUTES)
-    assert sorted(_arrays(EARLIER)) == sorted(_arrays(STORED))
+    not_earlier = set(compare.NOT_ON_THE_EARLIER_MACHINE)
+    assert not_earlier <= set(names)
+    earlier_cases = {key.split("/")[0] for key in _arrays(EARLIER)}
+    assert earlier_cases == set(names) - not_earlier
+    assert sorted(_arrays(EARLIER)) == sorted(
+        key for key in _arrays(STORED) if key.split("/")[0] in earlier_cases
+    )
 
 
 @pytest.mark.parametrize("record", [STORED, EARLIER], ids=["record", "earlier_machine"])
 @pytest.mark.parametrize("name", _case_names())
 def test_case_holds_the_record_on_any_machine(name, record, computed):
+    if record == EARLIER and name in compare.NOT_ON_THE_EARLIER_MACHINE:
+        pytest.skip(
+            f"{name}: changed by the bounded reset rule of 2026-11-28, not yet recorded on "
+            "another kind of machine (compare.NOT_ON_THE_EARLIER_MACHINE)"
+        )
     got = {k: v for k, v in computed.items() if k.split("/")[0] == name}
     failures = compare.cross_machine_failures(got, _arrays(record, name), compare.CASE_ROUTES[name])
     assert not failures, failures

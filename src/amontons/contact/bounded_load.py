@@ -9,7 +9,9 @@ keep their pressure and the free ones share what is left by one common factor
   convolution ``u = K*p`` follows every step. It is the reference the tests compare with,
   and the fallback of the other version in the cases it does not take.
 * :class:`BoundedLoadSweep`, the default: the step in the fused ``kernels.update`` sweep and
-  the rescale in ``kernels.rescale_free``, keeping ``u = K*p`` without a convolution. The
+  the rescale in ``kernels.rescale_free``, keeping ``u = K*p`` without a convolution where
+  few points change (``K*t`` brought from the spectrum then, its inverse transform skipped
+  where ``u`` is taken afresh anyway). The
   rescale multiplies the free part of the pressure by ``s`` and leaves the bound part
   ``p_b``, so ``K*p`` becomes ``s·K*p - (s - 1)·K*p_b``; ``v = K*p_b`` is carried from step
   to step by point responses of the few points that join or leave the bound. It is dropped,
@@ -196,7 +198,9 @@ class BoundedLoadSweep:
     applied as point responses; more, and ``u`` is convolved afresh.
     """
 
-    def __init__(self, ks, base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf):
+    def __init__(
+        self, ks, base_op, shape, p_max, target, sparse_max, sparse_ok, conv, buf, finish_r=None
+    ):
         n = p_max.size
         self.ks = ks
         self.base_op = base_op
@@ -210,6 +214,9 @@ class BoundedLoadSweep:
         self.spare_mask = ks.empty(n, np.uint8)
         self.v = None  # K*p_b (m), None while it is not known
         self._v_buf = self._bound_buf = None  # allocated on first use
+        # r = K*t left in the spectrum (the caller's split convolution): finish_r(r) takes
+        # its inverse, only for a step that follows u by its linear part; None: r is whole
+        self.finish_r = finish_r
         self.green = None
 
     def forget_bound_displacement(self):
@@ -235,18 +242,22 @@ class BoundedLoadSweep:
         q = self.spare
         violators, vidx, vg = found
         ks = self.ks
+        # with r in the spectrum, u is left as it was (K*p); it follows the step's linear
+        # part below only where the step is followed without a convolution
+        followed = self.finish_r is None
         total, pen, at_bound, complete = ks.update(
             p, q, u, r, t, h, m, self.p_max, True, 1.0, d, tau, violators,
-            idx_buf, val_buf, counts, True, True, vidx, vg, self.sparse_max,
+            idx_buf, val_buf, counts, True, followed, vidx, vg, self.sparse_max,
         )  # fmt: skip
         rest = self.target - at_bound
         free_sum = total - at_bound
         if rest < 0.0 or (rest > 0.0 and not free_sum > 0.0):
-            return self._numpy_step(p, u, r, t, h, m, d, tau)
+            return self._numpy_step(p, u, r, t, h, m, d, tau, followed)
         changed = int(counts.sum())
         # records complete: no chunk was swept without them (kernels.update)
         sparse = changed <= self.sparse_max and complete
         if sparse:
+            followed = followed or self._follow_linear_part(u, r, tau)
             idx, vals = ks.changed_points(counts, idx_buf, val_buf)
             self._add_responses(u, idx, vals)
             self._follow_bound(p, q, idx)
@@ -278,7 +289,9 @@ class BoundedLoadSweep:
             free_sum = total - at_bound
             if rest < 0.0 or not free_sum > 0.0:
                 # every free point clipped (the deficit goes to the next points to touch), or
-                # the bound's round-off above the load (the excess comes off the bound)
+                # the bound's round-off above the load (the excess comes off the bound); the
+                # step's linear u orders the candidates
+                followed = followed or self._follow_linear_part(u, r, tau)
                 left, joined = self._restart_free_set(q, u, h, m, m_new, t)
                 sparse = False
                 self.v = None
@@ -292,10 +305,18 @@ class BoundedLoadSweep:
         self.spare, self.spare_mask = p, m
         return q, m_new, left, joined, pen, how, reset
 
-    def _numpy_step(self, p, u, r, t, h, m, d, tau):
+    def _follow_linear_part(self, u, r, tau):
+        """``u -= τ K*t``, ``r = K*t`` first brought to real space (the inverse its split
+        convolution skipped). Returns True: ``u`` has followed."""
+        self.finish_r(r)
+        self.ks.subtract_scaled(u, r, tau)
+        return True
+
+    def _numpy_step(self, p, u, r, t, h, m, d, tau, followed):
         """The step that must be shortened: :func:`bounded_load_step` from the old state
         (``update`` left ``p``, ``m`` and ``t`` as they were), then ``u = K*p``."""
-        u += tau * r  # back to K*p to round-off (it gives the gap of the joining points)
+        if followed:
+            u += tau * r  # back to K*p to round-off (it gives the gap of the joining points)
         left, joined, pen, _ = self.ks.on_host(
             bounded_load_step, p, u, h, m, t, self.p_max, d, tau, self.target, writes=(0, 3, 4)
         )

@@ -12,7 +12,7 @@ Two departures from the paper (docs/models.md §2.2; measured in benchmarks/READ
 is given zero sum over ``Ic`` under load control, so ``Σ r t`` is the quadratic form alone
 and can be taken from the spectrum (Parseval); and the conjugation is reset to steepest
 descent only when the points added in one iteration exceed ``RESET_FRACTION`` of the free
-set. The fixed point is Polonsky & Keer's.
+set (``BOUNDED_RESET_FRACTION`` under a bound). The fixed point is Polonsky & Keer's.
 
 :class:`CGIteration` owns the control flow: stall detection (:class:`.stall.StallMonitor`),
 the full-contact singularity of periodic displacement control, restarts when no descent
@@ -38,7 +38,8 @@ step): with no changed point no convolution at all, with at most ``SPARSE_MAX_PE
 ``SPARSE_MAX_PADDED`` of them their point responses are added
 (:func:`.kernels.add_point_responses`); otherwise, and at least every ``refresh``
 iterations and before convergence is declared, ``u = K*p`` is taken afresh and the inverse
-transform of ``K*t`` is skipped.
+transform of ``K*t`` is skipped. The bounded load step (:class:`.bounded_load.BoundedLoadSweep`)
+skips it alike: it asks for the inverse only for a step it follows without a convolution.
 
 Load control rescales ``p`` (and so ``u``) to the target force every iteration at no cost:
 the stored pressure ``P`` and displacement ``U`` carry one common scale ``sigma`` (true
@@ -64,6 +65,12 @@ from .stall import StallMonitor
 # Reset the conjugation to steepest descent only when the points added to the free set in
 # one iteration exceed this fraction of it (module docstring; 0 = the original PK rule).
 RESET_FRACTION = 0.01
+# The same under a bound (penetration hardness): where the bound binds, a few hundred points
+# join the free set every iteration (rising from 0 at the contact's edge, falling from the
+# bound inside it) while as many leave, so the 1 % rule ran steepest descent in most
+# iterations; 10 % keeps the conjugation through them (docs/models.md §2.2; measured by
+# benchmarks/bench_scan_warm_start.py --bounded-reset-fractions).
+BOUNDED_RESET_FRACTION = 0.1
 # Most changed points (clipped + added) applied to u as point responses instead of a full
 # convolution, periodic and padded: about where the points' responses cost a convolution
 # less its inverse (benchmarks/bench_point_responses.py; benchmarks/README.md, "Fewer
@@ -124,7 +131,8 @@ class CGIteration:
         self.ks, self.xp = ks, ks.xp
         self.tol, self.max_iter = options.tol, options.max_iter
         self.refresh, self.raise_on_failure = options.refresh, options.raise_on_failure
-        self.reset_fraction = RESET_FRACTION  # read per solve (bench_convergence.py sets it)
+        # read per solve (bench_convergence.py sets it)
+        self.reset_fraction = BOUNDED_RESET_FRACTION if constraint.bounded else RESET_FRACTION
         self.constraint, self.pixel_area, self.h_scale = constraint, pixel_area, h_scale
         self.load, self.load_control = load, load is not None
         self.shape, self.n = heights.shape, heights.size
@@ -202,16 +210,21 @@ class CGIteration:
         self.u, self.r = self.buf(), self.buf()
         # the convolution r = K*t taken in halves (operator.forward, .multiply_energy,
         # .inverse): an iteration that takes u = K*p afresh then skips the inverse, half an
-        # FFT pair. A Winkler term needs r in real space (step_dots); the bounded load step
-        # updates u itself
+        # FFT pair. A Winkler term needs r in real space (step_dots); the numpy bounded load
+        # step updates u itself, the fused one (the sweep) asks for the inverse when it
+        # follows u by the step's linear part
+        with_sweep = self.bounded_load and options.bounded_load_sweep and not self.winkler
         self.split = (
-            getattr(self.base_op, "splits", False) and not self.winkler and not self.bounded_load
+            getattr(self.base_op, "splits", False)
+            and not self.winkler
+            and (with_sweep or not self.bounded_load)
         )
         self.sweep = None
-        if self.bounded_load and options.bounded_load_sweep and not self.winkler:
+        if with_sweep:
             self.sweep = BoundedLoadSweep(
                 ks, self.base_op, self.shape, self.p_max, self.target, self.sparse_max,
                 self.sparse_ok, self.conv, self.buf,
+                self._finish_r if self.split else None,
             )  # fmt: skip
 
     def _set_buffers(self):
@@ -474,6 +487,13 @@ class CGIteration:
             self.updates["point responses" if changes else "linear"] += 1
             self._follow_u_incrementally(changes, tau, sigma_old)
             self.since_fresh += 1
+
+    def _finish_r(self, r):
+        """``r = K*t`` brought to real space from the spectrum the split convolution left
+        (its inverse, counted: the forward is then no longer a forward only)."""
+        self.base_op.inverse(r.reshape(self.shape))
+        self.forward_only -= 1
+        self.calls += 1
 
     def _follow_u_incrementally(self, changes, tau, sigma_old):
         """``u -= τ/σ K*t`` (the inverse the split step skipped), then ``u += K*c / σ`` for

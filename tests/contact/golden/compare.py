@@ -12,6 +12,12 @@ bounds below (:data:`ROUTES`).
 
 What a rebuild must show is exact identity on one machine: same_bits.py re-makes the record
 from a base commit and compares it with the working tree's, in the same place.
+
+On 2026-11-28 the bounded iteration's conjugation reset changed (docs/models.md §2.2), an
+intended change of the numbers: golden.npz was re-recorded then, on the machine
+golden.machine.json names (a 2-core AMD EPYC with AVX2, another kind than either machine
+above). The cases it changed (:data:`NOT_ON_THE_EARLIER_MACHINE`) hold the same contact sets
+as before and fields within 1.5e-8 of their peak (the solves' tolerance is 1e-8).
 """
 
 from __future__ import annotations
@@ -101,6 +107,19 @@ CASE_ROUTES = {
     "scan_hardness": "cg",
 }
 
+
+# The cases the bounded reset rule of 2026-11-28 changed beyond the cross-machine bounds:
+# earlier-machine.npz held the old iteration's solves of them and no longer holds them.
+# Until a machine of another kind records them (record.py --out there, then their arrays
+# added to earlier-machine.npz), they are held on other CPUs to golden.npz alone.
+NOT_ON_THE_EARLIER_MACHINE = (
+    "hardening_appendix_load",
+    "hardness_bounded_displacement",
+    "hardness_bounded_load",
+    "hardness_bounded_periodic",
+    "hardness_volume_displacement",
+    "scan_hardness",
+)
 
 FIELDS = ("pressure", "gap", "plastic_displacement")
 

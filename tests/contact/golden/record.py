@@ -2,8 +2,9 @@
 must reproduce, to the last bit on the machine that recorded them and to stated tolerances on
 any other (tests/contact/test_golden.py; the tolerances and why: compare.py).
 
-The solves are 26f01d4's, before the rebuild of issue 38; re-recorded from that commit's code
-on the machine named in golden.machine.json (same_bits.py --base 26f01d4 --keep). Run from
+The solves were 26f01d4's, before the rebuild of issue 38, until the bounded iteration's
+reset rule changed on 2026-11-28 (docs/models.md §2.2); since then they are that change's,
+recorded on the machine named in golden.machine.json (compare.py says what moved). Run from
 the repository root to re-record (only when a change of the numbers is intended, and say so
 in the commit):
 
