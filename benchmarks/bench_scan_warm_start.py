@@ -7,7 +7,11 @@ load series solved
 * ``independent``: from nothing, each load from the previous one (the pipeline until
   2026-11-28);
 * ``descending`` / ``ascending``: each load from the neighbouring value's pressure at the
-  same load (:mod:`amontons.simulate.scan_start`), the values in that order;
+  same load (:mod:`amontons.simulate.scan_start`), the values in that order, the first from
+  nothing;
+* ``pipeline``: as the scan job runs it: the values in its chain's order
+  (``SCAN_CHAIN_ORDER``), and the first from the sphere's elastic solve where the chain
+  starts at the elastic end (``Scenes.scan_seed_scene``: p_Y from its largest value down);
 
 against one elastic load series of the same sphere (its run's elastic scene), solved first
 and timed in the same process. Prints per value and order the CG iterations and wall time,
@@ -16,6 +20,7 @@ areas against the independent solves (relative): the warm start may move a conve
 solution only within the solver's tolerance.
 
     python benchmarks/bench_scan_warm_start.py --configfile config/config.yaml --sphere PS
+    python benchmarks/bench_scan_warm_start.py --sphere PTFE --bounded-reset-fractions 0.01 0.1 1
 
 Needs the run's raw data and levelled maps (``make reproduce`` or the run of
 ``--configfile``). One thread, as a scan job runs; medians of ``--repeats`` solves.
@@ -34,15 +39,16 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from amontons.contact import FreeBoundaryError
+from amontons.contact import FreeBoundaryError, cg_iteration
 from amontons.simulate.scan import scene_config_at
+from amontons.simulate.scan_start import ScanStart
 from amontons.simulate.solve import solve_scene
 from amontons.simulate.surface import afm_indenter, afm_scene, load_levelled_map
 from amontons.workflow.paths import LEVELLED_MAP
 from amontons.workflow.run import WorkflowRun
 
 REPO = Path(__file__).resolve().parents[1]
-ORDERS = ("independent", "descending", "ascending")
+ORDERS = ("independent", "descending", "ascending", "pipeline")
 
 
 def sphere_scene(run, name: str, config: dict, sphere: str, levelled, levelled_path: str):
@@ -62,25 +68,59 @@ def timed_series(scene, indenter, starts=None):
     return solution, iterations, time.perf_counter() - t0
 
 
-def scan_order(run, scan: str, sphere: str, levelled, path: str, order: str) -> list[dict]:
-    """Every value of the scan solved in ``order``: value, iterations, wall s, areas (µm²)."""
+def solved_start(solution, scene, indenter) -> ScanStart:
+    """A solve's pressures as a start (none where it solved nothing)."""
+    if solution is None:
+        return ScanStart()
+    pressures = [f["pressure"] for f in solution.fields]
+    return ScanStart.of(scene.loads_n, pressures, indenter.spacing_m, indenter.centre_in_scan_m)
+
+
+def scan_order(run, scan, sphere, levelled, path, order, seed: ScanStart) -> list[dict]:
+    """Every value of the scan solved in ``order``: value, iterations, wall s, areas (µm²).
+    ``seed``: the sphere's elastic solve, the first value's start in the ``pipeline`` order
+    where the pipeline starts it so."""
     spec = run.scenes.scans[scan]
     base = run.scenes.config(spec["scene"])
     values = [float(v) for v in run.scenes.scan_value_labels(sphere, scan)]
     if order == "descending":
         values = values[::-1]
-    rows, previous = [], None
+    start = ScanStart()
+    if order == "pipeline":
+        values = [float(v) for v in run.scenes.scan_chain(sphere, scan)]
+        if run.scenes.scan_seed_scene(sphere, scan) is not None:
+            start = seed
+    rows = []
     for value in values:
         config = scene_config_at(base, spec["parameter"], value)
         scene, indenter = sphere_scene(run, spec["scene"], config, sphere, levelled, path)
-        starts = None
-        if order != "independent" and previous is not None:
-            starts = [f["pressure"] for f in previous.fields]
+        starts, _ = start.starts_for(
+            scene.loads_n, indenter.heights.shape, indenter.spacing_m, indenter.centre_in_scan_m
+        )
+        if not start.loads_n:
+            starts = None
         solution, iterations, wall = timed_series(scene, indenter, starts)
         areas = [] if solution is None else [row["area_um2"] for row in solution.per_load]
         rows.append({"value": value, "iterations": iterations, "wall_s": wall, "areas": areas})
-        previous = solution
+        if order != "independent":
+            start = solved_start(solution, scene, indenter)
     return sorted(rows, key=lambda row: row["value"])
+
+
+def reset_fractions(run, sphere, levelled, path, seed, fractions) -> None:
+    """The p_Y scan's values solved independently under each bounded reset fraction: the
+    measurement that chose BOUNDED_RESET_FRACTION (docs/models.md §2.2)."""
+    default = cg_iteration.BOUNDED_RESET_FRACTION
+    try:
+        for fraction in fractions:
+            cg_iteration.BOUNDED_RESET_FRACTION = fraction
+            rows = scan_order(run, "p_y", sphere, levelled, path, "independent", seed)
+            counts = ", ".join(f"{r['value']:.4g}: {r['iterations']}" for r in rows)
+            total = sum(r["iterations"] for r in rows)
+            wall = sum(r["wall_s"] for r in rows)
+            print(f"bounded reset fraction {fraction:g}: {total} it, {wall:.2f} s ({counts})")
+    finally:
+        cg_iteration.BOUNDED_RESET_FRACTION = default
 
 
 def main() -> None:
@@ -90,6 +130,15 @@ def main() -> None:
     parser.add_argument("--scans", nargs="+", default=["p_y", "k"])
     parser.add_argument("--orders", nargs="+", default=list(ORDERS), choices=ORDERS)
     parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument(
+        "--bounded-reset-fractions",
+        nargs="+",
+        type=float,
+        default=[],
+        help="instead of the orders: the p_Y scan's independent values under each of these "
+        "conjugation reset fractions of the bounded iteration (cg_iteration."
+        "BOUNDED_RESET_FRACTION), CG iterations per value",
+    )
     args = parser.parse_args()
     config = yaml.safe_load(args.configfile.read_text())
     run = WorkflowRun.from_config(config, REPO / "workflow", str(args.configfile))
@@ -107,14 +156,26 @@ def main() -> None:
         run, elastic_name, run.scenes.config(elastic_name), args.sphere, levelled, path
     )
     # the first solve of each grid plans its transforms (FFTW wisdom): not timed
-    _, elastic_iterations, _ = timed_series(*elastic)
+    elastic_solution, elastic_iterations, _ = timed_series(*elastic)
+    seed_name = run.scenes.sphere_elastic_scene(args.sphere) or elastic_name
+    if seed_name != elastic_name:
+        print(f"# the scans' seed is scene {seed_name}, not {elastic_name}: solved apart")
+        seeded = sphere_scene(
+            run, seed_name, run.scenes.config(seed_name), args.sphere, levelled, path
+        )
+        seed = solved_start(timed_series(*seeded)[0], seeded[0], seeded[1])
+    else:
+        seed = solved_start(elastic_solution, *elastic)
     walls = [timed_series(*elastic)[2] for _ in range(max(args.repeats, 3))]
     elastic_wall = statistics.median(walls)
     print(f"elastic series ({elastic_name}): {elastic_iterations} iterations, {elastic_wall:.2f} s")
+    if args.bounded_reset_fractions:
+        reset_fractions(run, args.sphere, levelled, path, seed, args.bounded_reset_fractions)
+        return
     for scan in args.scans:
         results = {}
         for order in args.orders:
-            repeats = [scan_order(run, scan, args.sphere, levelled, path, order)
+            repeats = [scan_order(run, scan, args.sphere, levelled, path, order, seed)
                        for _ in range(args.repeats)]  # fmt: skip
             results[order] = repeats[0]
             wall = statistics.median(sum(r["wall_s"] for r in rows) for rows in repeats)

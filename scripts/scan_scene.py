@@ -155,7 +155,9 @@ def solve_value(
                                 "outside_window": None, "loads": []})  # fmt: skip
         return ScanStart()
     indenter = context.indenter(scene)
-    starts, started = start.starts_for(scene.loads_n, indenter.heights.shape, indenter.spacing_m)
+    starts, started = start.starts_for(
+        scene.loads_n, indenter.heights.shape, indenter.spacing_m, indenter.centre_in_scan_m
+    )
     if start.loads_n:
         log.info("%s = %g: %d of %d loads start from the previous value", scan["parameter"],
                  value, started, len(scene.loads_n))  # fmt: skip
@@ -239,22 +241,38 @@ def solve_value(
             ],
         },
     )
-    return ScanStart.of(scene.loads_n, [f["pressure"] for f in solution.fields], indenter.spacing_m)
+    return ScanStart.of(
+        scene.loads_n,
+        [f["pressure"] for f in solution.fields],
+        indenter.spacing_m,
+        indenter.centre_in_scan_m,
+    )
 
 
-def main(context: ScanContext, chain: list[dict]) -> None:
+def first_start(seed: list[str]) -> ScanStart:
+    """The chain's first value's start: the sphere's elastic scene's pressures, where the run
+    has them (``seed``, amontons.workflow.scenes.Scenes.scan_seed_fields), else none."""
+    if not seed:
+        log.info("no elastic scene of this sphere: the first value starts from nothing")
+        return ScanStart()
+    log.info("the first value starts from the elastic scene's pressures (%s)", seed[0])
+    return ScanStart.from_scene_fields(seed[0])
+
+
+def main(context: ScanContext, chain: list[dict], seed: list[str]) -> None:
     """Every value of ``chain`` (amontons.workflow.scenes.Scenes.scan_value_files: value,
-    point and rendered paths, in the order they are solved), each from the one before."""
-    start = ScanStart()
+    point and rendered paths, in the order they are solved), each from the one before, the
+    first from the elastic scene's fields ``seed`` (none or one path)."""
+    start = first_start(seed)
     for value in chain:
         start = solve_value(context, float(value["value"]), value["point"], value["rendered"],
                             start)  # fmt: skip
 
 
-def run(chain: list[dict], **context) -> None:
+def run(chain: list[dict], seed: list[str], **context) -> None:
     """The scan job: its context (:class:`ScanContext`'s arguments) built and its chain
     solved, inside its log."""
-    main(ScanContext(**context), chain)
+    main(ScanContext(**context), chain, seed)
 
 
 if __name__ == "__main__":
@@ -267,6 +285,7 @@ if __name__ == "__main__":
         registration_path=sm.input.registration,
         fluorescence=sm.input.fluorescence,
         chain=sm.params.chain,
+        seed=list(sm.input.seed),
         scan=sm.params.scan,
         base_config=sm.params.base,
         sphere=sm.wildcards.sphere,

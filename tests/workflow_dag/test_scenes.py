@@ -12,7 +12,7 @@ import tifffile
 from amontons.config.scenes import SCAN_COLUMNS
 from amontons.io.tiff import write_image
 from amontons.simulate.scan_grid import scan_values, value_label
-from amontons.workflow.paths import RENDERED, SCAN_POINT
+from amontons.workflow.paths import FIELDS, RENDERED, SCAN_POINT
 from amontons.workflow.scenes import SCAN_CHAIN_ORDER
 
 
@@ -94,6 +94,40 @@ def test_a_scans_values_run_as_one_chain_each_from_the_one_before(small):
             assert entry["point"] == f"{folder}/{entry['value']}/{SCAN_POINT}"
             assert entry["rendered"] == f"{folder}/{entry['value']}/{RENDERED}"
         assert sorted(scenes.scan_points(wildcards)) == sorted(e["point"] for e in value_files)
+
+
+def test_a_chain_from_the_elastic_end_starts_from_the_spheres_elastic_solve(small):
+    """A scan whose chain starts at its largest value, where the model tends to the elastic
+    contact, reads the sphere's elastic scene's fields (its first value's start); one that
+    starts at the other end reads nothing more. The elastic scene's comparison registers the
+    sphere, and the scan's own registration waits for it: the seed adds no wait."""
+    scenes = small.scenes
+    sphere = next(iter(small.spheres))
+    material = small.spheres.material_of(sphere)
+    elastic = [s for s in scenes.runnable(sphere) if scenes.scenes[s]["model"] == "elastic"]
+    assert elastic and scenes.sphere_registration_scene(sphere) == elastic[0]
+    for scan, spec in scenes.scans.items():
+        wildcards = _wildcards(material=material, sphere=sphere, scan=scan)
+        seed = scenes.scan_seed_fields(wildcards)
+        if SCAN_CHAIN_ORDER[spec["parameter"]] < 0:
+            assert seed == [small.paths.scene(FIELDS, material, sphere, elastic[0])]
+        else:
+            assert seed == []
+
+
+def test_a_sphere_without_an_elastic_scene_starts_its_scans_from_nothing(make_run):
+    def drop_elastic(config):
+        scenes = config["scenes"]
+        config["run_scenes"] = [
+            s
+            for s in config["run_scenes"]
+            if (scenes[s]["model"], scenes[s]["surface"]) != ("elastic", "afm_before")
+        ]
+
+    run = make_run(edit=drop_elastic)
+    sphere = next(iter(run.spheres))
+    for scan in run.scenes.scans:
+        assert run.scenes.scan_seed_scene(sphere, scan) is None
 
 
 def test_without_scans_there_is_no_scan_and_no_study_output(make_run):

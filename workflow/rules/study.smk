@@ -10,6 +10,8 @@ rule scan_scene:
         levelled=rules.level_afm_map.output.levelled,
         psf=rules.measure_psf.output.psf,
         registration=RUN.scenes.scan_base_registration,
+        # the sphere's elastic solve: the chain's first value starts from its pressures
+        seed=RUN.scenes.scan_seed_fields,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
         pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
     output:

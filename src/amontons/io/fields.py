@@ -80,6 +80,16 @@ def read_load_series(path: str | Path) -> tuple[list[dict], list[dict], dict]:
     return fields, per_load, settings
 
 
+def read_load_series_field(path: str | Path, name: str) -> tuple[list[np.ndarray], list[dict]]:
+    """One field of every load of a file of write_load_series (its arrays, as stored) and
+    the loads' diagnostics, without reading the other fields."""
+    with h5py.File(path, "r") as h5:
+        groups = sorted(h5, key=lambda group: int(group.split("_")[1]))
+        arrays = [h5[group][name][()] for group in groups]
+        per_load = [{k: _decoded(v) for k, v in h5[group].attrs.items()} for group in groups]
+    return arrays, per_load
+
+
 def read_load_series_settings(path: str | Path) -> dict:
     """The settings of a file of write_load_series alone, without reading its fields."""
     with h5py.File(path, "r") as h5:

@@ -311,6 +311,28 @@ class Scenes:
         labels = sorted(self.scan_value_labels(sphere, scan), key=float)
         return labels[::-1] if SCAN_CHAIN_ORDER[self.scans[scan]["parameter"]] < 0 else labels
 
+    def scan_seed_scene(self, sphere: str, scan: str) -> str | None:
+        """The scene whose pressures start a scan's first value (amontons.simulate.scan_start):
+        where the chain starts at the scan's elastic end (the largest value), the sphere's
+        first running elastic scene on its map; None where it starts at the other end or the
+        sphere runs no elastic scene. The elastic scene's comparison registers the sphere,
+        which the scan waits for already: its fields cost the scan no wait."""
+        if SCAN_CHAIN_ORDER[self.scans[scan]["parameter"]] > 0:
+            return None
+        return self.sphere_elastic_scene(sphere)
+
+    def sphere_elastic_scene(self, sphere: str) -> str | None:
+        """The sphere's first running elastic scene on its map, or None."""
+        elastic = [s for s in self.runnable(sphere) if self.scenes[s]["model"] == "elastic"]
+        return elastic[0] if elastic else None
+
+    def scan_seed_fields(self, wildcards) -> list[str]:
+        """The fields file of :meth:`scan_seed_scene` (a scan job's input), or nothing."""
+        scene = self.scan_seed_scene(wildcards.sphere, wildcards.scan)
+        if scene is None:
+            return []
+        return [self.paths.scene(files.FIELDS, wildcards.material, wildcards.sphere, scene)]
+
     def scan_values_folder(self, wildcards) -> str:
         """The folder a scan job writes every value's files into (its output)."""
         return self.paths.scan_values(wildcards.material, wildcards.sphere, wildcards.scan)
