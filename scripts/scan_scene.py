@@ -1,10 +1,11 @@
 """Rule scan_scene: one sphere's parameter scan (docs/study.md), its values solved in a chain
 in one job. At each value the base scene with its parameter set to the value is solved over
 the measured loads, each load starting from the previous value's pressure at that load
-(amontons.simulate.scan_start) or else from the previous load, rendered like the microscope
-sees it, and compared with the measured contact under the base scene's registration. The
-levelled map, the PSF, the registration and the measured contacts are read once for the
-whole scan; each value writes its result and its rendered fields into its own folder."""
+(amontons.simulate.scan_start; the p_Y chain's first value from the sphere's elastic scene's)
+or else from the previous load, rendered like the microscope sees it, and compared with the
+measured contact under the base scene's registration. The levelled map, the PSF, the
+registration and the measured contacts are read once for the whole scan; each value writes
+its result and its rendered fields into its own folder."""
 
 import logging
 import os
