@@ -160,8 +160,9 @@ def solve_value(
         scene.loads_n, indenter.heights.shape, indenter.spacing_m, indenter.centre_in_scan_m
     )
     if start.loads_n:
-        log.info("%s = %g: %d of %d loads start from the previous value", scan["parameter"],
-                 value, started, len(scene.loads_n))  # fmt: skip
+        log.info("%s = %g: %d of %d loads start from the neighbour's pressures (the value "
+                 "before, or the elastic scene for the first)", scan["parameter"], value,
+                 started, len(scene.loads_n))  # fmt: skip
     try:
         solution = solve_scene(
             scene,
