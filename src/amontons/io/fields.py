@@ -66,7 +66,7 @@ def read_load_series(path: str | Path) -> tuple[list[dict], list[dict], dict]:
     """(fields per load, diagnostics per load, settings) as written by write_load_series."""
     settings = read_load_series_settings(path)
     with h5py.File(path, "r") as h5:
-        groups = sorted(h5, key=lambda name: int(name.split("_")[1]))
+        groups = _load_groups(h5)
         fields, per_load = [], []
         for name in groups:
             group = h5[name]
@@ -80,14 +80,22 @@ def read_load_series(path: str | Path) -> tuple[list[dict], list[dict], dict]:
     return fields, per_load, settings
 
 
-def read_load_series_field(path: str | Path, name: str) -> tuple[list[np.ndarray], list[dict]]:
-    """One field of every load of a file of write_load_series (its arrays, as stored) and
-    the loads' diagnostics, without reading the other fields."""
+def read_load_series_field(
+    path: str | Path, name: str
+) -> tuple[list[np.ndarray], list[dict], dict]:
+    """One field of every load of a file of write_load_series (its arrays, as stored), the
+    loads' diagnostics and the settings, in one read and without the other fields."""
     with h5py.File(path, "r") as h5:
-        groups = sorted(h5, key=lambda group: int(group.split("_")[1]))
+        groups = _load_groups(h5)
         arrays = [h5[group][name][()] for group in groups]
         per_load = [{k: _decoded(v) for k, v in h5[group].attrs.items()} for group in groups]
-    return arrays, per_load
+        settings = {key: _decoded(value) for key, value in h5.attrs.items()}
+    return arrays, per_load, settings
+
+
+def _load_groups(h5) -> list[str]:
+    """The load groups of a file of write_load_series, in load order (``load_<i>``)."""
+    return sorted(h5, key=lambda name: int(name.split("_")[1]))
 
 
 def read_load_series_settings(path: str | Path) -> dict:

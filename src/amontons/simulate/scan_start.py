@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from amontons.io.fields import read_load_series_field, read_load_series_settings
+from amontons.io.fields import read_load_series_field
 
 log = logging.getLogger(__name__)
 
@@ -76,10 +76,9 @@ class ScanStart:
         """The pressures of a scene's solve (its fields file, rule simulate_scene: pressure
         per load in Pa, the loads in mN, the window's pixel in nm and centre in µm); empty
         where it solved no load (its window outside the AFM scan)."""
-        pressures, per_load = read_load_series_field(path, "pressure")
+        pressures, per_load, settings = read_load_series_field(path, "pressure")
         if not pressures:
             return cls()
-        settings = read_load_series_settings(path)
         return cls.of(
             [row["load_mn"] * 1e-3 for row in per_load],
             pressures,
