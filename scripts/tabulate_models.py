@@ -13,8 +13,8 @@ import pandas as pd
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
 from amontons.simulate.compare import largest_compared
-from amontons.simulate.fits import model_table_rows
 from amontons.simulate.scan_record import estimate_columns
+from amontons.simulate.tables import model_table_rows
 
 log = logging.getLogger(__name__)
 

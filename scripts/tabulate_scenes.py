@@ -7,7 +7,7 @@ import pandas as pd
 
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
-from amontons.simulate.fits import scene_table_rows
+from amontons.simulate.tables import scene_table_rows
 
 log = logging.getLogger(__name__)
 

@@ -1,7 +1,7 @@
 """The study's answer in one table (docs/study.md §6): per sphere, the measured load-area
 exponent, each contact model's exponent and area ratio, the scans' estimates of k and p_Y with
 their intervals, and which models give the measured exponent. Read from the model tables
-(``models.csv``, amontons.simulate.fits.model_table_rows) and written as ``verdict.csv``; the
+(``models.csv``, amontons.simulate.tables.model_table_rows) and written as ``verdict.csv``; the
 report's first page (``report_page``) and ``summary.md`` (``summary_markdown``) show it.
 
 Exponents are dimensionless; k is in MPa/nm and p_Y in MPa; area ratios are simulated over

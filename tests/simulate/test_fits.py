@@ -4,13 +4,8 @@ of the AFM scan (docs/simulate.md, "Fits and tables")."""
 import numpy as np
 import pytest
 
-from amontons.simulate.fits import (
-    MIN_FIT_LOADS,
-    left_out_note,
-    model_table_rows,
-    scene_area_fits,
-    scene_table_rows,
-)
+from amontons.simulate.fits import MIN_FIT_LOADS, scene_area_fits
+from amontons.simulate.tables import left_out_note, model_table_rows, scene_table_rows
 
 MEASURED = {"exponent": {"estimate": 0.8, "ci_low": 0.78, "ci_high": 0.82}}
 OUTSIDE = [{"load_mn": 200.0, "window_um": 55.1}, {"load_mn": 300.0, "window_um": 63.3}]
