@@ -14,13 +14,19 @@ load series solved
   starts at the elastic end (``Scenes.scan_seed_scene``: p_Y from its largest value down);
 
 against one elastic load series of the same sphere (its run's elastic scene), solved first
-and timed in the same process. Prints per value and order the CG iterations and wall time,
-each order's total over the elastic series', and the largest change of a value's contact
-areas against the independent solves (relative): the warm start may move a converged
-solution only within the solver's tolerance.
+and timed in the same process just before each repeat of a scan. Prints per value and order
+the CG iterations and wall time, each order's total over the elastic series' (the median of
+the repeats' ratios), and the largest change of a value's contact areas against the
+independent solves (relative): the warm start may move a converged solution only within
+the solver's tolerance.
 
     python benchmarks/bench_scan_warm_start.py --configfile config/config.yaml --sphere PS
     python benchmarks/bench_scan_warm_start.py --sphere PTFE --bounded-reset-fractions 0.01 0.1 1
+    python benchmarks/bench_scan_warm_start.py --sphere PTFE --start-predictors neighbour coarse
+
+``--start-predictors``: the p_Y chain as the job runs it, each value's loads started by one
+of :data:`PREDICTORS` instead (the starts tried for the values where the bound binds,
+docs/study.md §1).
 
 Needs the run's raw data and levelled maps (``make reproduce`` or the run of
 ``--configfile``). One thread, as a scan job runs; medians of ``--repeats`` solves.
@@ -29,6 +35,7 @@ Needs the run's raw data and levelled maps (``make reproduce`` or the run of
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import datetime
 import os
 import platform
@@ -49,6 +56,11 @@ from amontons.workflow.run import WorkflowRun
 
 REPO = Path(__file__).resolve().parents[1]
 ORDERS = ("independent", "descending", "ascending", "pipeline")
+# a p_Y value's start from the chain so far: the neighbour's pressures (the pipeline); their
+# extrapolation in log p_Y from the two previous values; the value solved first on a grid
+# twice as coarse (from the neighbour's coarse solve) and repeated onto the solver grid; the
+# neighbour's pressures plus the coarse grid's change between the two values
+PREDICTORS = ("neighbour", "secant", "coarse", "coarse-corrected")
 
 
 def sphere_scene(run, name: str, config: dict, sphere: str, levelled, levelled_path: str):
@@ -123,6 +135,68 @@ def reset_fractions(run, sphere, levelled, path, seed, fractions) -> None:
         cg_iteration.BOUNDED_RESET_FRACTION = default
 
 
+def coarse_indenter(indenter):
+    """The indenter block-averaged 2×2 onto a grid of twice its pixel (an odd side loses its
+    last row and column)."""
+    n = indenter.heights.shape[0] // 2
+    heights = indenter.heights[: 2 * n, : 2 * n].reshape(n, 2, n, 2).mean(axis=(1, 3))
+    return dataclasses.replace(
+        indenter, heights=heights - heights.max(), spacing_m=2 * indenter.spacing_m
+    )
+
+
+def fine_of(coarse: np.ndarray) -> np.ndarray:
+    """A coarse grid's pressures repeated onto the solver grid (each value on 2×2 points)."""
+    return np.kron(coarse, np.ones((2, 2)))
+
+
+def predicted_starts(predictor, value, chain, coarse_now) -> list[np.ndarray]:
+    """The loads' starts of p_Y ``value`` by ``predictor`` from ``chain``: (p_Y, pressures,
+    coarse pressures) of the values solved so far, the elastic solve first (p_Y inf)."""
+    (_, fine, coarse) = chain[-1]
+    if predictor == "coarse":
+        return [fine_of(c) for c in coarse_now]
+    if predictor == "coarse-corrected":
+        return [np.clip(f + fine_of(c - o), 0.0, None)
+                for f, c, o in zip(fine, coarse_now, coarse, strict=True)]  # fmt: skip
+    if predictor == "secant" and len(chain) >= 3:
+        (v2, before, _), (v1, _, _) = chain[-2], chain[-1]
+        step = (np.log(value) - np.log(v1)) / (np.log(v1) - np.log(v2))
+        return [np.clip(f + step * (f - b), 0.0, None)
+                for f, b in zip(fine, before, strict=True)]  # fmt: skip
+    return [f.copy() for f in fine]
+
+
+def start_predictors(run, sphere, levelled, path, elastic, predictors) -> None:
+    """The p_Y chain (the job's order, the elastic solve first) under each predictor of the
+    loads' starts: CG iterations per value, and the wall time with the coarse solves'."""
+    spec = run.scenes.scans["p_y"]
+    base = run.scenes.config(spec["scene"])
+    values = [float(v) for v in run.scenes.scan_chain(sphere, "p_y")]
+    solution = timed_series(*elastic)[0]
+    coarse = timed_series(elastic[0], coarse_indenter(elastic[1]))[0]
+    first = (np.inf, [f["pressure"] for f in solution.fields],
+             [f["pressure"] for f in coarse.fields])  # fmt: skip
+    for predictor in predictors:
+        chain, rows, wall = [first], [], 0.0
+        for value in values:
+            config = scene_config_at(base, spec["parameter"], value)
+            scene, indenter = sphere_scene(run, spec["scene"], config, sphere, levelled, path)
+            coarse_now = chain[-1][2]
+            if predictor.startswith("coarse"):
+                solved, _, coarse_wall = timed_series(
+                    scene, coarse_indenter(indenter), [c.copy() for c in chain[-1][2]]
+                )
+                coarse_now, wall = [f["pressure"] for f in solved.fields], wall + coarse_wall
+            starts = predicted_starts(predictor, value, chain, coarse_now)
+            solved, iterations, fine_wall = timed_series(scene, indenter, starts)
+            chain.append((value, [f["pressure"] for f in solved.fields], coarse_now))
+            rows.append(f"{value:.4g}: {iterations}")
+            wall += fine_wall
+        total = sum(int(row.split(": ")[1]) for row in rows)
+        print(f"p_y start {predictor}: {total} it, {wall:.2f} s ({', '.join(rows)})")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--configfile", type=Path, default=REPO / "config" / "config.yaml")
@@ -138,6 +212,14 @@ def main() -> None:
         help="instead of the orders: the p_Y scan's independent values under each of these "
         "conjugation reset fractions of the bounded iteration (cg_iteration."
         "BOUNDED_RESET_FRACTION), CG iterations per value",
+    )
+    parser.add_argument(
+        "--start-predictors",
+        nargs="+",
+        default=[],
+        choices=PREDICTORS,
+        help="instead of the orders: the p_Y chain with each value's loads started by each of "
+        "these predictors, CG iterations per value",
     )
     args = parser.parse_args()
     config = yaml.safe_load(args.configfile.read_text())
@@ -172,18 +254,31 @@ def main() -> None:
     if args.bounded_reset_fractions:
         reset_fractions(run, args.sphere, levelled, path, seed, args.bounded_reset_fractions)
         return
+    if args.start_predictors:
+        seeded = elastic if seed_name == elastic_name else None
+        if seeded is None:
+            seeded = sphere_scene(
+                run, seed_name, run.scenes.config(seed_name), args.sphere, levelled, path
+            )
+        start_predictors(run, args.sphere, levelled, path, seeded, args.start_predictors)
+        return
     for scan in args.scans:
         results = {}
         for order in args.orders:
-            repeats = [scan_order(run, scan, args.sphere, levelled, path, order, seed)
-                       for _ in range(args.repeats)]  # fmt: skip
+            # each round times an elastic series just before the scan: the machine's speed
+            # drifts by tens of per cent between minutes, so the ratio is taken per round
+            rounds = [(timed_series(*elastic)[2],
+                       scan_order(run, scan, args.sphere, levelled, path, order, seed))
+                      for _ in range(args.repeats)]  # fmt: skip
+            repeats = [rows for _, rows in rounds]
             results[order] = repeats[0]
-            wall = statistics.median(sum(r["wall_s"] for r in rows) for rows in repeats)
+            walls = [sum(r["wall_s"] for r in rows) for rows in repeats]
+            ratio = statistics.median(w / b for w, (b, _) in zip(walls, rounds, strict=True))
             iterations = sum(r["iterations"] for r in repeats[0])
             print(
-                f"{scan} {order}: {iterations} iterations, {wall:.2f} s, "
-                f"{wall / elastic_wall:.2f}× the elastic series, "
-                f"{iterations / elastic_iterations:.2f}× its iterations"
+                f"{scan} {order}: {iterations} iterations, {statistics.median(walls):.2f} s, "
+                f"{ratio:.2f}× the elastic series timed before it (median of "
+                f"{args.repeats} rounds), {iterations / elastic_iterations:.2f}× its iterations"
             )
             for row in repeats[0]:
                 print(f"    {row['value']:10.4g}: {row['iterations']:5d} it, {row['wall_s']:.2f} s")
