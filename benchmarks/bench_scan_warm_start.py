@@ -167,18 +167,18 @@ def predicted_starts(predictor, value, chain, coarse_now) -> list[np.ndarray]:
     return [f.copy() for f in fine]
 
 
-def start_predictors(run, sphere, levelled, path, elastic, predictors) -> None:
-    """The p_Y chain (the job's order, the elastic solve first) under each predictor of the
-    loads' starts: CG iterations per value, and the wall time with the coarse solves'."""
+def start_predictors(run, sphere, levelled, path, seeded, solution, predictors) -> None:
+    """The p_Y chain (the job's order, from ``solution``, the elastic scene and indenter
+    ``seeded``'s solve) under each predictor of the loads' starts: CG iterations per value,
+    and the wall time with the coarse solves'."""
     spec = run.scenes.scans["p_y"]
     base = run.scenes.config(spec["scene"])
     values = [float(v) for v in run.scenes.scan_chain(sphere, "p_y")]
-    solution = timed_series(*elastic)[0]
-    coarse = timed_series(elastic[0], coarse_indenter(elastic[1]))[0]
+    coarse = timed_series(seeded[0], coarse_indenter(seeded[1]))[0]
     first = (np.inf, [f["pressure"] for f in solution.fields],
              [f["pressure"] for f in coarse.fields])  # fmt: skip
     for predictor in predictors:
-        chain, rows, wall = [first], [], 0.0
+        chain, counts, wall = [first], [], 0.0
         for value in values:
             config = scene_config_at(base, spec["parameter"], value)
             scene, indenter = sphere_scene(run, spec["scene"], config, sphere, levelled, path)
@@ -191,10 +191,11 @@ def start_predictors(run, sphere, levelled, path, elastic, predictors) -> None:
             starts = predicted_starts(predictor, value, chain, coarse_now)
             solved, iterations, fine_wall = timed_series(scene, indenter, starts)
             chain.append((value, [f["pressure"] for f in solved.fields], coarse_now))
-            rows.append(f"{value:.4g}: {iterations}")
+            counts.append((value, iterations))
             wall += fine_wall
-        total = sum(int(row.split(": ")[1]) for row in rows)
-        print(f"p_y start {predictor}: {total} it, {wall:.2f} s ({', '.join(rows)})")
+        total = sum(iterations for _, iterations in counts)
+        listed = ", ".join(f"{value:.4g}: {iterations}" for value, iterations in counts)
+        print(f"p_y start {predictor}: {total} it, {wall:.2f} s ({listed})")
 
 
 def main() -> None:
@@ -240,14 +241,14 @@ def main() -> None:
     # the first solve of each grid plans its transforms (FFTW wisdom): not timed
     elastic_solution, elastic_iterations, _ = timed_series(*elastic)
     seed_name = run.scenes.sphere_elastic_scene(args.sphere) or elastic_name
+    seeded, seed_solution = elastic, elastic_solution
     if seed_name != elastic_name:
         print(f"# the scans' seed is scene {seed_name}, not {elastic_name}: solved apart")
         seeded = sphere_scene(
             run, seed_name, run.scenes.config(seed_name), args.sphere, levelled, path
         )
-        seed = solved_start(timed_series(*seeded)[0], seeded[0], seeded[1])
-    else:
-        seed = solved_start(elastic_solution, *elastic)
+        seed_solution = timed_series(*seeded)[0]
+    seed = solved_start(seed_solution, *seeded)
     walls = [timed_series(*elastic)[2] for _ in range(max(args.repeats, 3))]
     elastic_wall = statistics.median(walls)
     print(f"elastic series ({elastic_name}): {elastic_iterations} iterations, {elastic_wall:.2f} s")
@@ -255,12 +256,9 @@ def main() -> None:
         reset_fractions(run, args.sphere, levelled, path, seed, args.bounded_reset_fractions)
         return
     if args.start_predictors:
-        seeded = elastic if seed_name == elastic_name else None
-        if seeded is None:
-            seeded = sphere_scene(
-                run, seed_name, run.scenes.config(seed_name), args.sphere, levelled, path
-            )
-        start_predictors(run, args.sphere, levelled, path, seeded, args.start_predictors)
+        start_predictors(
+            run, args.sphere, levelled, path, seeded, seed_solution, args.start_predictors
+        )
         return
     for scan in args.scans:
         results = {}

@@ -64,13 +64,12 @@ def write_load_series(
 
 def read_load_series(path: str | Path) -> tuple[list[dict], list[dict], dict]:
     """(fields per load, diagnostics per load, settings) as written by write_load_series."""
-    settings = read_load_series_settings(path)
     with h5py.File(path, "r") as h5:
-        groups = _load_groups(h5)
+        settings = _attributes(h5)
         fields, per_load = [], []
-        for name in groups:
+        for name in _load_groups(h5):
             group = h5[name]
-            per_load.append({key: _decoded(value) for key, value in group.attrs.items()})
+            per_load.append(_attributes(group))
             fields.append(
                 {
                     key: group[key][()].astype(bool) if key == "contact" else group[key][()]
@@ -88,8 +87,8 @@ def read_load_series_field(
     with h5py.File(path, "r") as h5:
         groups = _load_groups(h5)
         arrays = [h5[group][name][()] for group in groups]
-        per_load = [{k: _decoded(v) for k, v in h5[group].attrs.items()} for group in groups]
-        settings = {key: _decoded(value) for key, value in h5.attrs.items()}
+        per_load = [_attributes(h5[group]) for group in groups]
+        settings = _attributes(h5)
     return arrays, per_load, settings
 
 
@@ -101,7 +100,12 @@ def _load_groups(h5) -> list[str]:
 def read_load_series_settings(path: str | Path) -> dict:
     """The settings of a file of write_load_series alone, without reading its fields."""
     with h5py.File(path, "r") as h5:
-        return {key: _decoded(value) for key, value in h5.attrs.items()}
+        return _attributes(h5)
+
+
+def _attributes(node) -> dict:
+    """The attributes of a file or group of write_load_series, decoded."""
+    return {key: _decoded(value) for key, value in node.attrs.items()}
 
 
 def _decoded(value):
