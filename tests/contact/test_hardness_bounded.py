@@ -27,6 +27,7 @@ from amontons.contact import (
     solve_load_series,
 )
 from amontons.contact.api import solve_with_options
+from amontons.contact.bounded_load import impose_bounded_load
 from amontons.contact.options import solve_options
 from amontons.contact.surfaces import self_affine, sphere
 
@@ -264,3 +265,41 @@ def test_a_start_above_the_bound_is_clipped_after_the_load_rescale(sphere_case):
     assert warm.pressure.max() <= p_y
     np.testing.assert_array_equal(warm.contact, cold.contact)
     np.testing.assert_allclose(warm.pressure, cold.pressure, rtol=0, atol=1e-6 * p_y)
+
+
+@pytest.mark.parametrize("deficit_points", [0.4, 3.5, 40.0, 5000.0])
+def test_a_deficit_fills_the_points_next_to_touch_in_gap_order(deficit_points):
+    """Every loaded point at the bound and load missing: impose_bounded_load gives the
+    deficit to the unloaded points with the smallest u - h, each up to its p_max, ties in
+    index order (what raising the approach until they touch does). Gaps on a coarse grid of
+    values so that ties are many; p_max per pixel between 1 and 2 Pa; deficits from under a
+    point to more than every point can take (then all are filled). The result is that of a
+    full stable sort, to the bit: the fill orders only the points it can need."""
+    rng = np.random.default_rng(3)
+    n = 4096
+    p_max = 1.0 + rng.random(n)
+    gap = np.round(rng.random(n), 2)  # 101 distinct values: ties everywhere
+    h = np.zeros(n)
+    p = np.zeros(n)
+    loaded = rng.random(n) < 0.1
+    p[loaded] = p_max[loaded]
+    deficit = deficit_points * float(p_max.mean())
+    target = float(p.sum()) + deficit
+    got = p.copy()
+    _, restarted = impose_bounded_load(
+        got, np.zeros(n, np.uint8), np.zeros(n), p_max, target, gap.copy(), h
+    )
+    # the rule, with every unloaded point sorted, for the deficit as the function finds it
+    deficit = target - float(p.sum(where=p >= p_max))
+    want = p.copy()
+    cand = np.flatnonzero(~loaded)
+    order = cand[np.argsort(gap[cand], kind="stable")]
+    room = np.cumsum(p_max[order])
+    k = int(np.searchsorted(room, deficit)) + 1
+    want[order[:k]] = p_max[order[:k]]
+    if k <= room.size:
+        want[order[k - 1]] -= room[k - 1] - deficit
+    assert restarted
+    np.testing.assert_array_equal(got, want)
+    if k <= room.size:
+        assert got.sum() == pytest.approx(target, rel=1e-12)  # the load is met

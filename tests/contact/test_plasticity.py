@@ -11,6 +11,7 @@ from amontons.contact import (
     ConvergenceError,
     FreeBoundaryError,
     PenetrationHardness,
+    api,
     solve,
     solve_load_series,
 )
@@ -278,6 +279,25 @@ def test_load_beyond_the_window_at_the_hardness_is_a_window_too_small():
         solve(h, dx, E_STAR, load=load, plasticity=PenetrationHardness(p_y))
     with pytest.raises(ContactInputError, match="needs more than the whole window"):
         solve(h, dx, E_STAR, load=load, plasticity=PenetrationHardness(p_y), periodic=True)
+
+
+def test_series_with_a_load_beyond_the_window_is_refused_before_any_step(monkeypatch):
+    """A series whose loads pass what the window at the hardness can carry is refused before
+    its first step is solved: that step would be refused anyway, and the steps below it
+    would be solved for nothing (a p_Y scan's softest values). The error is the one that
+    step raises, and names the first load beyond the window (step 2 of 3 here)."""
+    h, dx = rough_sphere(n=32)
+    p_y = 1e5
+    capacity = p_y * h.size * dx**2
+    loads = [0.1 * capacity, 1.5 * capacity, 2.0 * capacity]
+
+    def solved(*args, **kwargs):
+        raise AssertionError("a step was solved")
+
+    monkeypatch.setattr(api, "run_route", solved)
+    with pytest.raises(FreeBoundaryError, match="needs more than the whole window") as info:
+        solve_load_series(h, dx, E_STAR, loads, plasticity=PenetrationHardness(p_y))
+    assert "load step 2 of 3" in "".join(getattr(info.value, "__notes__", []))
 
 
 def test_load_controlled_appendix_schemes_reach_their_load():

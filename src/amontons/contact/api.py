@@ -38,7 +38,7 @@ from .options import (
 )
 from .pools import solve_pools
 from .result import ContactResult, SolveInfo
-from .routes import run_route
+from .routes import check_capacity, run_route
 
 
 def solve(
@@ -265,7 +265,8 @@ def solve_load_series(
     ------
     ContactInputError, ConvergenceError, FreeBoundaryError
         As in :func:`solve`; an error raised by a step carries a note (``__notes__``) naming
-        the step and its load.
+        the step and its load. A load that the whole window at the hardness could not carry
+        (penetration hardness) is refused before any step is solved.
     """
     h, spacing, e_star, opts = _checked_problem(
         heights,
@@ -292,6 +293,7 @@ def solve_load_series(
         coarse_to_fine=coarse_to_fine,
         warm_start=starts is not None,
     )
+    _check_series_capacity(h, spacing, opts, arr)
     plastic = None if opts.law is None else np.zeros(h.shape)
     results = []
     prev = None
@@ -314,6 +316,19 @@ def solve_load_series(
             results.append(res)
             prev = res
     return results
+
+
+def _check_series_capacity(h, spacing, opts, loads) -> None:
+    """Refuse a series with a load (N) the window at the hardness cannot carry before any
+    step is solved (routes.check_capacity): its step would refuse it anyway, after the steps
+    below it were solved for nothing (a p_Y scan's softest values; docs/study.md §1). The
+    error names the first such step, as that step's own error does."""
+    for i, w in enumerate(loads):
+        try:
+            check_capacity(opts.law, h, spacing**2, float(w), opts.periodic)
+        except ContactError as err:
+            err.add_note(f"load step {i + 1} of {loads.size} (W = {w:.6e} N)")
+            raise
 
 
 def solve_scan(heights, spacing, e_star, loads: Sequence[float], laws: Sequence, **options):

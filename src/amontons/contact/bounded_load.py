@@ -149,13 +149,30 @@ def _fill_next_points(p, p_max, deficit, u, h):
     ``u - h - d`` (so smallest ``u - h``) first, each up to its ``p_max``
     (impose_bounded_load)."""
     cand = np.flatnonzero((p <= 0.0) & (p_max > 0.0))
-    order = cand[np.argsort(u[cand] - h[cand], kind="stable")]
+    key = u[cand] - h[cand]
+    # the points needed cannot outnumber deficit / (smallest p_max): order only that many
+    # (sorting every unloaded point took 12 ms a call, 18 calls in PS's p_Y chain)
+    order = cand[_stable_order_head(key, int(deficit / float(p_max[cand].min())) + 2)]
     room = np.cumsum(p_max[order])
     k = int(np.searchsorted(room, deficit)) + 1  # points needed
+    if k > room.size and order.size < cand.size:  # round-off: one more than bounded
+        order = cand[np.argsort(key, kind="stable")]
+        room = np.cumsum(p_max[order])
+        k = int(np.searchsorted(room, deficit)) + 1
     take = order[:k]
     p[take] = p_max[take]
     # the last one takes what is left (its room minus the overshoot)
     p[take[-1]] -= room[k - 1] - deficit if k <= room.size else 0.0
+
+
+def _stable_order_head(key, count):
+    """The first ``count`` or more indices of ``argsort(key, kind="stable")``, the same
+    (every key up to the ``count``-th smallest, ties in index order), without sorting the
+    rest."""
+    if count >= key.size:
+        return np.argsort(key, kind="stable")
+    head = np.flatnonzero(key <= np.partition(key, count - 1)[count - 1])
+    return head[np.argsort(key[head], kind="stable")]
 
 
 def _release_bound_points(p, p_max, excess, u, h):
