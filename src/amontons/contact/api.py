@@ -309,7 +309,7 @@ def solve_load_series(
                 )
             except ContactError as err:
                 # the error describes the solve; the caller also needs to know which step
-                err.add_note(f"load step {i + 1} of {arr.size} (W = {w:.6e} N)")
+                err.add_note(_step_note(i, arr))
                 raise
             if opts.law is not None:
                 plastic = res.plastic_displacement
@@ -327,8 +327,13 @@ def _check_series_capacity(h, spacing, opts, loads) -> None:
         try:
             check_capacity(opts.law, h, spacing**2, float(w), opts.periodic)
         except ContactError as err:
-            err.add_note(f"load step {i + 1} of {loads.size} (W = {w:.6e} N)")
+            err.add_note(_step_note(i, loads))
             raise
+
+
+def _step_note(i: int, loads) -> str:
+    """The note an error of a series' step ``i`` (from 0) carries: the step and its load (N)."""
+    return f"load step {i + 1} of {loads.size} (W = {loads[i]:.6e} N)"
 
 
 def solve_scan(heights, spacing, e_star, loads: Sequence[float], laws: Sequence, **options):

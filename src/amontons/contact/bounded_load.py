@@ -151,14 +151,14 @@ def _fill_next_points(p, p_max, deficit, u, h):
     cand = np.flatnonzero((p <= 0.0) & (p_max > 0.0))
     key = u[cand] - h[cand]
     # the points needed cannot outnumber deficit / (smallest p_max): order only that many
-    # (sorting every unloaded point took 12 ms a call, 18 calls in PS's p_Y chain)
-    order = cand[_stable_order_head(key, int(deficit / float(p_max[cand].min())) + 2)]
-    room = np.cumsum(p_max[order])
-    k = int(np.searchsorted(room, deficit)) + 1  # points needed
-    if k > room.size and order.size < cand.size:  # round-off: one more than bounded
-        order = cand[np.argsort(key, kind="stable")]
+    # (sorting every unloaded point took 12 ms a call, 18 calls in PS's p_Y chain), and
+    # every point where the round-off of the sums needs more
+    for count in (int(deficit / float(p_max[cand].min())) + 2, cand.size):
+        order = cand[_stable_order_head(key, count)]
         room = np.cumsum(p_max[order])
-        k = int(np.searchsorted(room, deficit)) + 1
+        k = int(np.searchsorted(room, deficit)) + 1  # points needed
+        if k <= room.size or order.size == cand.size:
+            break
     take = order[:k]
     p[take] = p_max[take]
     # the last one takes what is left (its room minus the overshoot)
