@@ -21,7 +21,7 @@ def main(pairs: dict, solves: dict, fits: dict, table_path: str, figure_paths: l
         exponents = {}
         for geometry, scene in (("flat periodic", flat), ("curved", curved)):
             rows = read_json(solves[scene])["loads"]
-            exponent = read_json(fits[scene])["solver_area"]["exponent"]
+            exponent = read_json(fits[scene])[scene]["solver_area"]["exponent"]
             exponents[geometry] = exponent["estimate"]
             loads = np.array([r["load_mn"] for r in rows])
             areas = np.array([r["area_um2"] for r in rows])

@@ -14,20 +14,15 @@ log = logging.getLogger(__name__)
 
 def main(
     measured_fits: list[str],
-    layout: dict[str, dict[str, str]],
+    layout: dict[str, str],
     table_path: str,
     models: dict,
 ) -> None:
-    """``layout``: sphere → scene → its fit, for the spheres whose data run a scene;
-    ``measured_fits``: those spheres' measured load-area fits, in the same order."""
+    """``layout``: sphere → its scenes' fits (scene_fits.json), for the spheres whose data run
+    a scene; ``measured_fits``: those spheres' measured load-area fits, in the same order."""
     rows = []
     for sphere, measured in zip(layout, measured_fits, strict=True):
-        rows += scene_table_rows(
-            sphere,
-            read_json(measured),
-            {scene: read_json(path) for scene, path in layout[sphere].items()},
-            models,
-        )
+        rows += scene_table_rows(sphere, read_json(measured), read_json(layout[sphere]), models)
     table = pd.DataFrame(rows)
     log.info("\n%s", table.to_string(index=False))
     write_table(table_path, table)

@@ -72,7 +72,7 @@ PSF_DEPENDENT = {
     "scenes/elastic/render.csv",
     "scenes/elastic/comparison.csv",
     "scenes/elastic/registration.json",
-    "scenes/elastic/scene_fit.json",
+    "scenes/scene_fits.json",
 }
 # The stand-in PSF of the sphere without a bead image: another FWHM than the bead gives, so
 # that its renderings differ from the complete sphere's and show where the PSF came from.
@@ -440,6 +440,12 @@ def _scene_record(project, sphere, name):
     return json.loads(path.read_text()) if name.endswith(".json") else pd.read_csv(path)
 
 
+def _elastic_fit(project, sphere):
+    """The elastic scene's load-area fit, from its sphere's fits file."""
+    path = project / "results" / SMALL / "PS" / sphere / "scenes" / "scene_fits.json"
+    return json.loads(path.read_text())["elastic"]
+
+
 def test_a_scan_smaller_than_the_contact_simulates_the_loads_it_holds(lab_run):
     """The cut scan holds the three smaller loads' windows: the scene simulates those, lists
     200 and 300 mN as outside_scan with the window each needs (larger than the scan holds),
@@ -457,7 +463,7 @@ def test_a_scan_smaller_than_the_contact_simulates_the_loads_it_holds(lab_run):
     assert comparison["status"].tolist() == ["compared"] * 3 + ["outside_scan"] * 2
     outside = comparison[comparison["status"] == "outside_scan"]
     assert outside["iou"].isna().all() and outside["measured_area_um2"].gt(0).all()
-    fit = _scene_record(project, "PS-cutscan", "scene_fit.json")
+    fit = _elastic_fit(project, "PS-cutscan")
     assert fit["loads_mn"] == pytest.approx([25, 50, 100], rel=1e-6)
     assert fit["not_fitted"] is None
     assert fit["rendered_area"]["exponent"]["estimate"] > 0
@@ -512,7 +518,7 @@ def test_a_scan_that_holds_no_load_gets_a_record_and_no_failed_job(lab_run):
     assert [row["load_mn"] for row in solve["outside_scan"]] == [25, 50, 100, 200, 300]
     comparison = _scene_record(project, "PS-noload", "comparison.csv")
     assert set(comparison["status"]) == {"outside_scan"} and len(comparison) == 5
-    fit = _scene_record(project, "PS-noload", "scene_fit.json")
+    fit = _elastic_fit(project, "PS-noload")
     assert fit["solver_area"] is None and "0 loads simulated" in fit["not_fitted"]
     scenes = pd.read_csv(project / "results" / SMALL / "PS" / "scenes.csv")
     row = scenes[(scenes["sphere"] == "PS-noload") & (scenes["scene"] == "elastic")].iloc[0]

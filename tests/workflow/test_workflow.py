@@ -176,7 +176,7 @@ def test_slurm_dry_run_gives_every_job_measured_resources_that_grow_with_the_gri
     # scan among them) on their own
     assert "Group job figures" in stdout and "Group job measurements" in stdout
     grouped = re.findall(r"^    rule (\w+):", stdout, re.M)
-    assert "fit_scene" in grouped
+    assert "fit_sphere_scenes" in grouped
     assert not {"simulate_scene", "scan_scene"} & set(grouped)
     for rule, wildcards, resources in jobs:
         assert int(resources["mem_mb"]) >= 500 and int(resources["runtime"]) >= 2, (rule, wildcards)
@@ -335,7 +335,7 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
         "measure_psf": "2",
         "render_scene": "6",
         "compare_scene": "6",
-        "fit_scene": "6",
+        "fit_sphere_scenes": "2",
         "tabulate_scenes": "2",
         "scan_scene": "4",
         **study,
@@ -355,7 +355,7 @@ def test_rerun_is_a_no_op_and_a_setting_reruns_only_its_jobs(small_run):
         "simulate_scene": "2",
         "render_scene": "2",
         "compare_scene": "2",
-        "fit_scene": "2",
+        "fit_sphere_scenes": "2",
         "tabulate_scenes": "2",
         "scan_scene": "2",
         **study,
@@ -591,21 +591,21 @@ def _scene_jobs(project, target, **changes):
 
 
 def test_an_elastic_scene_without_optics_schedules_no_psf_rendering_or_plastic_job(project):
-    target = "results/small/PS/PS/scenes/probe/scene_fit.json"
+    target = "results/small/PS/PS/scenes/scene_fits.json"
     jobs, _ = _scene_jobs(project, target)
     assert set(jobs) == {
         "generate_virtual_experiment_with_flim",
         "level_afm_map",
         "simulate_scene",
-        "fit_scene",
+        "fit_sphere_scenes",
     }
 
 
 def test_switching_a_scene_to_the_microscope_adds_exactly_its_psf_and_rendering_jobs(project):
     target = "results/small/PS/PS/scenes/probe/comparison.csv"
-    without, _ = _scene_jobs(project, "results/small/PS/PS/scenes/probe/scene_fit.json")
+    without, _ = _scene_jobs(project, "results/small/PS/PS/scenes/scene_fits.json")
     fit_with, _ = _scene_jobs(
-        project, "results/small/PS/PS/scenes/probe/scene_fit.json", optics="microscope"
+        project, "results/small/PS/PS/scenes/scene_fits.json", optics="microscope"
     )
     compare_with, _ = _scene_jobs(project, target, optics="microscope")
     added = {rule: n for rule, n in (fit_with | compare_with).items() if rule not in without}
@@ -623,7 +623,7 @@ def test_a_synthetic_scene_reads_nothing_of_the_experiment(project):
     }
     jobs, stdout = _scene_jobs(
         project,
-        "results/small/synthetic/scenes/probe/scene_fit.json",
+        "results/small/synthetic/scenes/probe/scene_fits.json",
         surface="synthetic",
         geometry="flat_periodic",
         side_px=128,

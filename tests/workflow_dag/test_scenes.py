@@ -27,28 +27,27 @@ def test_only_microscope_scenes_deliver_a_comparison(small):
     assert with_optics and without
     sphere = next(iter(small.spheres))
     material = small.spheres.material_of(sphere)
-    assert len(scenes.sphere_scene_outputs(material, sphere, without[0])) == 1
+    assert scenes.sphere_scene_outputs(material, sphere, without[0]) == []
     outputs = scenes.sphere_scene_outputs(material, sphere, with_optics[0])
     names = sorted(path.rsplit("/", 1)[1] for path in outputs)
-    assert names == [
-        "comparison.csv",
-        "comparison.pdf",
-        "comparison.png",
-        "registration.json",
-        "scene_fit.json",
-    ]
+    assert names == ["comparison.csv", "comparison.pdf", "comparison.png", "registration.json"]
 
 
-def test_a_scenes_fit_reads_its_render_only_with_optics(small):
+def test_a_spheres_scenes_are_fitted_in_one_file_reading_renders_only_with_optics(small):
+    """One fits file per sphere, beside its scenes' folders, delivered with them; each scene
+    reads its solve and, with optics only, its rendered areas."""
     scenes = small.scenes
     sphere = next(iter(small.spheres))
-    for name in scenes.afm_scenes():
-        wildcards = _wildcards(
-            material=small.spheres.material_of(sphere), sphere=sphere, scene=name
-        )
-        inputs = scenes.fit_inputs(wildcards)
-        assert inputs["solve"].endswith(f"/scenes/{name}/solve.json")
+    material = small.spheres.material_of(sphere)
+    layout = scenes.fit_layout(material, sphere)
+    assert list(layout) == scenes.runnable(sphere) and len(layout) > 1
+    for name, inputs in layout.items():
+        assert inputs["solve"].endswith(f"/{sphere}/scenes/{name}/solve.json")
         assert ("render" in inputs) == scenes.has_optics(name)
+    fits = scenes.fits_file(material, sphere)
+    assert fits.endswith(f"/{material}/{sphere}/scenes/scene_fits.json")
+    assert fits in scenes.outputs([material])
+    assert scenes.table_layout(material)[sphere] == fits
 
 
 def test_greenwood_tripp_is_the_one_model_without_fields(small):

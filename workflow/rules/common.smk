@@ -36,7 +36,7 @@ from amontons.workflow.paths import (
     RENDER_TABLE,
     SPHERE_FITS,
     SCAN_TABLE,
-    SCENE_FIT,
+    SCENE_FITS,
     SOLVE,
     TRUTH,
     ACCURACY_FIELDS,
@@ -77,6 +77,8 @@ MATERIAL = PATHS.material()
 MATERIAL_LOGS = PATHS.material_logs()
 SCENE = PATHS.scene()
 SCENE_LOGS = PATHS.scene_logs()
+SPHERE_SCENES = PATHS.sphere_scenes()
+SPHERE_SCENES_LOGS = PATHS.sphere_scenes_logs()
 SYNTHETIC_SCENE = PATHS.synthetic_scene()
 SYNTHETIC_SCENE_LOGS = PATHS.synthetic_scene_logs()
 SCAN = PATHS.scan()

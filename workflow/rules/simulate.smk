@@ -176,32 +176,36 @@ rule compare_scene:
         "../../scripts/compare_scene.py"
 
 
-rule fit_scene:
+# A sphere's scenes are fitted in one job: each fit takes milliseconds, a job's start and
+# imports seconds (docs/study.md §5). A changed scene re-runs its sphere's fits, which only
+# the sphere's tables and figures read.
+rule fit_sphere_scenes:
     input:
-        unpack(RUN.scenes.fit_inputs),
+        lambda wc: flat_files(RUN.scenes.fit_layout(wc.material, wc.sphere)),
     output:
-        fit=f"{SCENE}/{SCENE_FIT}",
+        fits=f"{SPHERE_SCENES}/{SCENE_FITS}",
     log:
-        f"{SCENE_LOGS}/fit_scene.log",
+        f"{SPHERE_SCENES_LOGS}/fit_sphere_scenes.log",
     benchmark:
-        f"{SCENE_LOGS}/fit_scene.benchmark.tsv"
+        f"{SPHERE_SCENES_LOGS}/fit_sphere_scenes.benchmark.tsv"
     conda:
         "../envs/amontons.yaml"
     threads: 1
     resources:
-        mem_mb=measured_mem_mb("fit_scene"),
-        runtime=measured_runtime("fit_scene"),
+        mem_mb=measured_mem_mb("fit_sphere_scenes"),
+        runtime=measured_runtime("fit_sphere_scenes"),
     params:
+        layout=lambda wc: RUN.scenes.fit_layout(wc.material, wc.sphere),
         confidence=config["load_area"]["confidence"],
     script:
-        "../../scripts/fit_scene.py"
+        "../../scripts/fit_scenes.py"
 
 
 rule fit_synthetic_scene:
     input:
         solve=rules.simulate_synthetic_scene.output.solve,
     output:
-        fit=f"{SYNTHETIC_SCENE}/{SCENE_FIT}",
+        fits=f"{SYNTHETIC_SCENE}/{SCENE_FITS}",
     log:
         f"{SYNTHETIC_SCENE_LOGS}/fit_scene.log",
     benchmark:
@@ -213,9 +217,10 @@ rule fit_synthetic_scene:
         mem_mb=measured_mem_mb("fit_synthetic_scene"),
         runtime=measured_runtime("fit_synthetic_scene"),
     params:
+        layout=lambda wc: RUN.scenes.synthetic_fit_layout(wc.scene),
         confidence=config["load_area"]["confidence"],
     script:
-        "../../scripts/fit_scene.py"
+        "../../scripts/fit_scenes.py"
 
 
 rule tabulate_scenes:

@@ -245,7 +245,7 @@ rule plot_model_curves:
 rule plot_curvature_study:
     input:
         solves=list(RUN.study.curvature_files(SOLVE).values()),
-        fits=list(RUN.study.curvature_files(SCENE_FIT).values()),
+        fits=list(RUN.study.curvature_files(SCENE_FITS).values()),
     output:
         table=f"{STUDY_RESULTS}/{B10_FIGURE}.csv",
         png=report(
@@ -268,7 +268,7 @@ rule plot_curvature_study:
     params:
         pairs=CURVATURE_PAIRS,
         solves=RUN.study.curvature_files(SOLVE),
-        fits=RUN.study.curvature_files(SCENE_FIT),
+        fits=RUN.study.curvature_files(SCENE_FITS),
     script:
         "../../scripts/plot_curvature_study.py"
 

@@ -1,5 +1,5 @@
 """The per-material tables of scenes and models against the measured exponent, from the
-scenes' fits (:mod:`.fits`, scene_fit.json) and the scans' best values (best.json)
+scenes' fits (:mod:`.fits`, scene_fits.json) and the scans' best values (best.json)
 (docs/simulate.md, "Fits and tables"; docs/study.md §3).
 
 Apart from :mod:`.fits` so that a table job, which fits nothing, does not import the fitting
@@ -95,8 +95,9 @@ def model_table_rows(
     parameter and each scan's best value, with its load-area exponent and interval beside the
     measured one, its parameter, and the area ratio and IoU at the largest load.
 
-    ``scenes``: name → {"fit": scene_fit.json, "largest": the comparison's row of the largest
-    load compared or None (no optics, or no load in the scan), "solve": solve.json};
+    ``scenes``: name → {"fit": its entry of scene_fits.json, "largest": the comparison's row
+    of the largest load compared or None (no optics, or no load in the scan), "solve":
+    solve.json};
     ``scan_bests``: scan name → best.json."""
     measured = measured_fit["exponent"]
     rows = []

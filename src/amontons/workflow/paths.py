@@ -33,7 +33,8 @@ RENDER_TABLE = "render.csv"
 COMPARISON_FIGURE = "comparison"  # its table is COMPARISON
 COMPARISON = f"{COMPARISON_FIGURE}.csv"
 REGISTRATION = "registration.json"
-SCENE_FIT = "scene_fit.json"
+# The scenes' load-area fits (scene name → fit): one file per sphere, one per synthetic scene.
+SCENE_FITS = "scene_fits.json"
 SCAN_POINT = "scan_point.json"
 SCAN_TABLE = "scan.csv"
 BEST = "best.json"
@@ -100,6 +101,14 @@ class RunPaths:
 
     def scene_logs(self, material: str = MATERIAL, sphere: str = SPHERE, scene: str = SCENE):
         return f"{self.logs}/{material}/{sphere}/scenes/{scene}"
+
+    def sphere_scenes(self, name: str = "", material: str = MATERIAL, sphere: str = SPHERE):
+        """File ``name`` of all of one sphere's scenes together, beside their folders (the
+        folder of the scenes where ``name`` is empty)."""
+        return _join(f"{self.results}/{material}/{sphere}/scenes", name)
+
+    def sphere_scenes_logs(self, material: str = MATERIAL, sphere: str = SPHERE) -> str:
+        return f"{self.logs}/{material}/{sphere}/scenes"
 
     def synthetic_scene(self, name: str = "", scene: str = SCENE) -> str:
         """File ``name`` of a scene on a synthetic surface (run once, for no sphere)."""

@@ -214,49 +214,63 @@ class Scenes:
         return lines
 
     def sphere_scene_outputs(self, material: str, sphere: str, scene: str) -> list[str]:
-        """What a scene of one sphere delivers: its fit and, with optics, its comparison."""
-        out = [self.paths.scene(files.SCENE_FIT, material, sphere, scene)]
-        if self.has_optics(scene):
-            folder = self.paths.scene("", material, sphere, scene)
-            out += files.figure_files(folder, files.COMPARISON_FIGURE)
-            out.append(f"{folder}/{files.REGISTRATION}")
-        return out
+        """What a scene of one sphere delivers beside the sphere's fits (:meth:`fits_file`):
+        with optics, its comparison; without, nothing more."""
+        if not self.has_optics(scene):
+            return []
+        folder = self.paths.scene("", material, sphere, scene)
+        return [
+            *files.figure_files(folder, files.COMPARISON_FIGURE),
+            f"{folder}/{files.REGISTRATION}",
+        ]
+
+    def fits_file(self, material: str, sphere: str) -> str:
+        """The load-area fits of every scene of one sphere, in one file (scene → fit)."""
+        return self.paths.sphere_scenes(files.SCENE_FITS, material, sphere)
 
     def outputs(self, materials) -> list[str]:
-        """Every AFM scene of every sphere of ``materials`` and each material's scene table."""
+        """Every AFM scene of every sphere of ``materials``, each sphere's fits and each
+        material's scene table."""
         out = []
         for material in materials:
             for sphere in self.spheres.of(material):
-                for scene in self.runnable(sphere):
+                scenes = self.runnable(sphere)
+                for scene in scenes:
                     out += self.sphere_scene_outputs(material, sphere, scene)
+                if scenes:
+                    out.append(self.fits_file(material, sphere))
             if self.table_layout(material):
                 out.append(f"{self.paths.material(material)}/scenes.csv")
         return out
 
     def synthetic_outputs(self) -> list[str]:
         return [
-            self.paths.synthetic_scene(files.SCENE_FIT, s) for s in self.names(surface="synthetic")
+            self.paths.synthetic_scene(files.SCENE_FITS, s) for s in self.names(surface="synthetic")
         ]
 
-    def fit_inputs(self, wildcards) -> dict[str, str]:
-        """A scene's solve and, with optics, its rendered areas."""
-        where = (wildcards.material, wildcards.sphere, wildcards.scene)
-        inputs = {"solve": self.paths.scene(files.SOLVE, *where)}
-        if self.has_optics(wildcards.scene):
-            inputs["render"] = self.paths.scene(files.RENDER_TABLE, *where)
-        return inputs
+    def fit_layout(self, material: str, sphere: str) -> dict[str, dict[str, str]]:
+        """What one sphere's fits read, scene by scene: its solve and, with optics, its
+        rendered areas."""
+        layout = {}
+        for scene in self.runnable(sphere):
+            where = (material, sphere, scene)
+            layout[scene] = {"solve": self.paths.scene(files.SOLVE, *where)}
+            if self.has_optics(scene):
+                layout[scene]["render"] = self.paths.scene(files.RENDER_TABLE, *where)
+        return layout
 
-    def table_layout(self, material: str) -> dict[str, dict[str, str]]:
-        """The scene table's inputs: each AFM scene's fit of each sphere of ``material`` that
-        runs it (sphere → scene → path)."""
-        layout = {
-            sphere: {
-                scene: self.paths.scene(files.SCENE_FIT, material, sphere, scene)
-                for scene in self.runnable(sphere)
-            }
+    def synthetic_fit_layout(self, scene: str) -> dict[str, dict[str, str]]:
+        """What a synthetic scene's fit reads: its solve (a synthetic scene has no optics)."""
+        return {scene: {"solve": self.paths.synthetic_scene(files.SOLVE, scene)}}
+
+    def table_layout(self, material: str) -> dict[str, str]:
+        """The scene table's inputs: the fits of each sphere of ``material`` that runs a
+        scene (sphere → its fits file)."""
+        return {
+            sphere: self.fits_file(material, sphere)
             for sphere in self.spheres.of(material)
+            if self.runnable(sphere)
         }
-        return {sphere: fits for sphere, fits in layout.items() if fits}
 
     # scans
 

@@ -54,13 +54,14 @@ class Study:
             "k_scan": self.k_scan(wildcards),
         }
 
-    def _scene_files(self, material: str, sphere: str, scene: str, with_fit: bool) -> dict:
+    def _scene_files(self, material: str, sphere: str, scene: str, compared: bool) -> dict:
+        """A scene's solve and, with optics, its comparison (``compared``) or its rendered
+        areas."""
         where = (material, sphere, scene)
-        found = {"fit": self.paths.scene(files.SCENE_FIT, *where)} if with_fit else {}
-        found["solve"] = self.paths.scene(files.SOLVE, *where)
+        found = {"solve": self.paths.scene(files.SOLVE, *where)}
         if self.scenes.has_optics(scene):
-            name = files.COMPARISON if with_fit else files.RENDER_TABLE
-            found["comparison" if with_fit else "render"] = self.paths.scene(name, *where)
+            name = files.COMPARISON if compared else files.RENDER_TABLE
+            found["comparison" if compared else "render"] = self.paths.scene(name, *where)
         return found
 
     def _best_values(self, material: str, sphere: str) -> dict[str, str]:
@@ -72,24 +73,28 @@ class Study:
         """Fig. B.12's inputs: each AFM scene's areas and each scan's best value."""
         where = (wildcards.material, wildcards.sphere)
         scenes = {
-            scene: self._scene_files(*where, scene, with_fit=False)
+            scene: self._scene_files(*where, scene, compared=False)
             for scene in self.scenes.runnable(wildcards.sphere)
         }
         return {"scenes": scenes, "scans": self._best_values(*where)}
 
     def model_table_layout(self, material: str) -> dict:
-        """The model table's inputs per sphere: measured fit, scenes, scans' best values."""
+        """The model table's inputs per sphere: measured fit, each scene's solve and
+        comparison with, where it runs a scene, the scenes' fits, and the scans' best values."""
         return {
-            sphere: {
-                "measured": self.paths.measured(files.LOAD_AREA_FIT, material, sphere),
-                "scenes": {
-                    scene: self._scene_files(material, sphere, scene, with_fit=True)
-                    for scene in self.scenes.runnable(sphere)
-                },
-                "scans": self._best_values(material, sphere),
-            }
-            for sphere in self.scanned(material)
+            sphere: self._model_table_files(material, sphere) for sphere in self.scanned(material)
         }
+
+    def _model_table_files(self, material: str, sphere: str) -> dict:
+        scenes = self.scenes.runnable(sphere)
+        found = {"measured": self.paths.measured(files.LOAD_AREA_FIT, material, sphere)}
+        if scenes:
+            found["fits"] = self.scenes.fits_file(material, sphere)
+        found["scenes"] = {
+            scene: self._scene_files(material, sphere, scene, compared=True) for scene in scenes
+        }
+        found["scans"] = self._best_values(material, sphere)
+        return found
 
     def scanned(self, material: str) -> list[str]:
         """The spheres of ``material`` whose scans run (the model table's rows)."""

@@ -1,5 +1,8 @@
-"""Rule fit_scene: a scene's load-area power law, from the solver's area and (with optics)
-from the rendered Otsu area."""
+"""Rules fit_sphere_scenes and fit_synthetic_scene: each scene's load-area power law, from the
+solver's area and (with optics) from the rendered Otsu area, into one file (scene → fit).
+
+A sphere's scenes are fitted in one job: a fit takes milliseconds, the job's imports
+(statsmodels, pandas) seconds (docs/study.md §5)."""
 
 import logging
 
@@ -12,7 +15,8 @@ from amontons.simulate.fits import scene_area_fits
 log = logging.getLogger(__name__)
 
 
-def main(solve_path: str, render_path: str | None, fit_path: str, confidence: float) -> None:
+def scene_fit(solve_path: str, render_path: str | None, confidence: float) -> dict:
+    """One scene's fits from its solve record and, with optics, its render table."""
     solve = read_json(solve_path)
     loads = solve["loads"]
     rendered = None
@@ -30,7 +34,16 @@ def main(solve_path: str, render_path: str | None, fit_path: str, confidence: fl
     else:
         exponent = record["solver_area"]["exponent"]["estimate"]
         log.info("%s: solver-area exponent %.4f", solve_path, exponent)
-    write_json(fit_path, record)
+    return record
+
+
+def main(layout: dict[str, dict[str, str]], fits_path: str, confidence: float) -> None:
+    """``layout``: scene → {"solve": solve.json, "render": render.csv (with optics)}."""
+    fits = {
+        scene: scene_fit(files["solve"], files.get("render"), confidence)
+        for scene, files in layout.items()
+    }
+    write_json(fits_path, fits)
 
 
 if __name__ == "__main__":
@@ -38,8 +51,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        solve_path=sm.input.solve,
-        render_path=sm.input.get("render"),
-        fit_path=sm.output.fit,
+        layout=sm.params.layout,
+        fits_path=sm.output.fits,
         confidence=sm.params.confidence,
     )
