@@ -4,7 +4,12 @@
 Each process is a job's: a fresh interpreter that imports scripts/fit_scenes.py and fits its
 scenes from a run's solve.json and render.csv files. A fit takes milliseconds; the rest is
 the process's start and its imports (statsmodels, pandas), which the per-scene jobs pay once
-a scene and the per-sphere jobs once a sphere (docs/study.md §5).
+a scene and the per-sphere jobs once a sphere (docs/study.md §5). The per-scene side runs the
+same script with one scene a process: what the rule it replaced imported and fitted.
+Snakemake's own start of each job is not included. The two sides alternate, per-scene first.
+
+It reads a run made with rule fit_sphere_scenes: the spheres' scene_fits.json name their
+scenes. The confidence is 0.95, config/config.yaml's load_area.confidence.
 
     python benchmarks/bench_fit_jobs.py --results results/full --repeats 3
 """

@@ -178,7 +178,7 @@ rule compare_scene:
 
 # A sphere's scenes are fitted in one job: each fit takes milliseconds, a job's start and
 # imports seconds (docs/study.md §5). A changed scene re-runs its sphere's fits, which only
-# the sphere's tables and figures read.
+# its material's scene and model tables read (and they read every scene of the material).
 rule fit_sphere_scenes:
     input:
         lambda wc: flat_files(RUN.scenes.fit_layout(wc.material, wc.sphere)),

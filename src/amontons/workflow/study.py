@@ -79,8 +79,9 @@ class Study:
         return {"scenes": scenes, "scans": self._best_values(*where)}
 
     def model_table_layout(self, material: str) -> dict:
-        """The model table's inputs per sphere: measured fit, each scene's solve and
-        comparison with, where it runs a scene, the scenes' fits, and the scans' best values."""
+        """The model table's inputs per sphere: its measured fit, its scenes' fits file
+        (where it runs a scene), each scene's solve and, with optics, comparison, and its
+        scans' best values."""
         return {
             sphere: self._model_table_files(material, sphere) for sphere in self.scanned(material)
         }
