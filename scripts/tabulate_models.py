@@ -46,7 +46,7 @@ def with_estimate(row: dict, best: dict | None) -> dict:
 def sphere_rows(sphere: str, files: dict, models: dict) -> list[dict]:
     """The model-table rows of one sphere: its scenes, then its scans' best values."""
     measured = read_json(files["measured"])
-    fits = read_json(files["fits"]) if "fits" in files else {}
+    fits = read_json(files["fits"])
     scenes = {
         name: {
             "fit": fits[name],

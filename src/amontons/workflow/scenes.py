@@ -248,16 +248,17 @@ class Scenes:
             self.paths.synthetic_scene(files.SCENE_FITS, s) for s in self.names(surface="synthetic")
         ]
 
+    def area_files(self, material: str, sphere: str, scene: str) -> dict[str, str]:
+        """A scene's areas per load: its solve and, with optics, its rendered areas."""
+        where = (material, sphere, scene)
+        found = {"solve": self.paths.scene(files.SOLVE, *where)}
+        if self.has_optics(scene):
+            found["render"] = self.paths.scene(files.RENDER_TABLE, *where)
+        return found
+
     def fit_layout(self, material: str, sphere: str) -> dict[str, dict[str, str]]:
-        """What one sphere's fits read, scene by scene: its solve and, with optics, its
-        rendered areas."""
-        layout = {}
-        for scene in self.runnable(sphere):
-            where = (material, sphere, scene)
-            layout[scene] = {"solve": self.paths.scene(files.SOLVE, *where)}
-            if self.has_optics(scene):
-                layout[scene]["render"] = self.paths.scene(files.RENDER_TABLE, *where)
-        return layout
+        """What one sphere's fits read: each scene's :meth:`area_files`."""
+        return {scene: self.area_files(material, sphere, scene) for scene in self.runnable(sphere)}
 
     def synthetic_fit_layout(self, scene: str) -> dict[str, dict[str, str]]:
         """What a synthetic scene's fit reads: its solve (a synthetic scene has no optics)."""

@@ -54,14 +54,12 @@ class Study:
             "k_scan": self.k_scan(wildcards),
         }
 
-    def _scene_files(self, material: str, sphere: str, scene: str, compared: bool) -> dict:
-        """A scene's solve and, with optics, its comparison (``compared``) or its rendered
-        areas."""
+    def _compared_files(self, material: str, sphere: str, scene: str) -> dict:
+        """A scene's solve and, with optics, its comparison."""
         where = (material, sphere, scene)
         found = {"solve": self.paths.scene(files.SOLVE, *where)}
         if self.scenes.has_optics(scene):
-            name = files.COMPARISON if compared else files.RENDER_TABLE
-            found["comparison" if compared else "render"] = self.paths.scene(name, *where)
+            found["comparison"] = self.paths.scene(files.COMPARISON, *where)
         return found
 
     def _best_values(self, material: str, sphere: str) -> dict[str, str]:
@@ -73,29 +71,27 @@ class Study:
         """Fig. B.12's inputs: each AFM scene's areas and each scan's best value."""
         where = (wildcards.material, wildcards.sphere)
         scenes = {
-            scene: self._scene_files(*where, scene, compared=False)
+            scene: self.scenes.area_files(*where, scene)
             for scene in self.scenes.runnable(wildcards.sphere)
         }
         return {"scenes": scenes, "scans": self._best_values(*where)}
 
     def model_table_layout(self, material: str) -> dict:
-        """The model table's inputs per sphere: its measured fit, its scenes' fits file
-        (where it runs a scene), each scene's solve and, with optics, comparison, and its
-        scans' best values."""
+        """The model table's inputs per sphere: its measured fit, its scenes' fits file (a
+        scanned sphere runs its microscope scenes), each scene's solve and, with optics,
+        comparison, and its scans' best values."""
         return {
-            sphere: self._model_table_files(material, sphere) for sphere in self.scanned(material)
+            sphere: {
+                "measured": self.paths.measured(files.LOAD_AREA_FIT, material, sphere),
+                "fits": self.scenes.fits_file(material, sphere),
+                "scenes": {
+                    scene: self._compared_files(material, sphere, scene)
+                    for scene in self.scenes.runnable(sphere)
+                },
+                "scans": self._best_values(material, sphere),
+            }
+            for sphere in self.scanned(material)
         }
-
-    def _model_table_files(self, material: str, sphere: str) -> dict:
-        scenes = self.scenes.runnable(sphere)
-        found = {"measured": self.paths.measured(files.LOAD_AREA_FIT, material, sphere)}
-        if scenes:
-            found["fits"] = self.scenes.fits_file(material, sphere)
-        found["scenes"] = {
-            scene: self._scene_files(material, sphere, scene, compared=True) for scene in scenes
-        }
-        found["scans"] = self._best_values(material, sphere)
-        return found
 
     def scanned(self, material: str) -> list[str]:
         """The spheres of ``material`` whose scans run (the model table's rows)."""
