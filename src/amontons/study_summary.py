@@ -187,10 +187,10 @@ def parameter_text(row: Mapping, parameter: str) -> str:
     if not _present(estimate):
         return NOT_DECIDED_SOURCE if _not_decided(row, SCAN_MODELS[parameter]) else "not scanned"
     low, high = (_cell(row[f"{stem}_{end}"]) for end in ("low", "high"))
-    return (
-        f"{significant(estimate)} ({interval_text(low, high)}); grid's best "
-        f"{significant(row[f'{stem}_grid_best'])}"
-    )
+    grid = f"grid's best {significant(row[f'{stem}_grid_best'])}"
+    if low is None or high is None:  # the interval reaches the scan's end: a bound
+        return f"{interval_text(low, high)} (bound); {grid}"
+    return f"{significant(estimate)} ({interval_text(low, high)}); {grid}"
 
 
 def verdict_text(row: Mapping) -> str:
@@ -372,13 +372,20 @@ def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
             "--forcerun best_scan_value)"
         )
     symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
-    low, high = best["scatter_interval"]
+    low, high = best["interval"]
     edge = "; the grid's best is at the scan's end" if best["at_scan_edge"] else ""
+    grid = f"grid's best {significant(best['grid_best'])}{edge}"
+    if low is None or high is None:  # the interval reaches the scan's end: a bound
+        value = f"{interval_text(low, high)} ({best['confidence']:.0%} bound; {grid})"
+    else:
+        value = (
+            f"{significant(best['estimate'])} ({best['confidence']:.0%} interval "
+            f"{interval_text(low, high)}; {grid})"
+        )
     return Headline(
         f"{sphere}: {symbol} of {MODELS[_model_of(best['parameter'])]} ({unit})",
-        f"{significant(best['estimate'])} ({best['confidence']:.0%} interval "
-        f"{interval_text(low, high)}; grid's best {significant(best['grid_best'])}{edge})",
-        f"`{path}`: estimate, scatter_interval, grid_best",
+        value,
+        f"`{path}`: estimate, interval, grid_best",
     )
 
 

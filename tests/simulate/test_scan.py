@@ -6,8 +6,22 @@ import numpy as np
 import pytest
 
 from amontons.simulate.scan import log_area_distance, scene_config_at
-from amontons.simulate.scan_best import ScanPoint, best_scan_value, log_area_scatter
+from amontons.simulate.scan_best import ScanPoint, best_scan_value
+from amontons.simulate.scan_criterion import Criterion, ModelError, log_area_scatter
 from amontons.simulate.scan_grid import ScanError, scan_values
+
+LOADS_MN = (25.0, 50.0, 100.0, 200.0, 300.0)
+
+
+def _scatter_only(scatter_sd, n_loads=5):
+    """The criterion of the scans before the model's error was counted: the measured scatter
+    alone, taken as known (χ²(1) quantile). χ² = n D² / s² exactly."""
+    return Criterion(LOADS_MN[:n_loads], scatter_sd, ModelError.none(n_loads), quantile="chi2")
+
+
+def _point(value, residual, iou=0.9, ratio=1.0, n_loads=5):
+    """A value whose rendered areas are off by the same factor exp(residual) at every load."""
+    return ScanPoint(value, abs(residual), iou, ratio, (residual,) * n_loads)
 
 
 def test_log_scan_spans_the_range_with_equal_ratios():
@@ -55,14 +69,14 @@ def test_log_area_scatter_of_an_exact_power_law_is_zero_and_grows_with_noise():
 def _points(values, true_value, slope=0.3):
     """A model whose areas are off by a factor (v/v0)^slope at every load: D = slope |ln v/v0|."""
     return [
-        ScanPoint(v, slope * abs(math.log(v / true_value)), 0.9, (v / true_value) ** slope)
+        _point(v, slope * math.log(v / true_value), 0.9, (v / true_value) ** slope)
         for v in values
     ]
 
 
 def test_best_value_is_the_grid_point_nearest_the_truth_in_log():
     values = scan_values(5.0, [0.2, 4.0], 7)  # 1, 1.648, 2.714, 4.472, 7.368, 12.14, 20
-    best = best_scan_value(_points(values, 5.0), scatter_sd=0.02, n_loads=5, confidence=0.95)
+    best = best_scan_value(_points(values, 5.0), _scatter_only(0.02), 0.95)
     assert best.value == 4.472
     assert (best.resolution_low, best.resolution_high) == (2.714, 7.368)
     assert not best.at_scan_edge
@@ -83,7 +97,7 @@ def test_a_scatter_wider_than_the_misfit_widens_the_interval_beyond_the_neighbou
     follows χ² linearly between grid points, which overstates χ² between them and so lands
     inside the exact bounds, by less than one grid step (a factor 1.648)."""
     values = scan_values(5.0, [0.2, 4.0], 7)
-    best = best_scan_value(_points(values, 5.0), scatter_sd=0.3, n_loads=5, confidence=0.95)
+    best = best_scan_value(_points(values, 5.0), _scatter_only(0.3), 0.95)
     half = 0.3 * math.sqrt(3.841459 / 0.45)
     exact = (5 * math.exp(-half), 5 * math.exp(half))
     assert exact[0] < best.scatter_low < 2.714 and 7.368 < best.scatter_high < exact[1]
@@ -93,21 +107,21 @@ def test_a_scatter_wider_than_the_misfit_widens_the_interval_beyond_the_neighbou
 def test_a_flat_criterion_leaves_the_interval_open_and_ties_go_to_the_better_overlap():
     values = [1000.0, 2000.0, 4000.0, 8000.0]
     points = [
-        ScanPoint(v, 0.05, iou, 1.0) for v, iou in zip(values, [0.8, 0.9, 0.85, 0.8], strict=True)
+        _point(v, 0.05, iou) for v, iou in zip(values, [0.8, 0.9, 0.85, 0.8], strict=True)
     ]
-    best = best_scan_value(points, scatter_sd=0.05, n_loads=5, confidence=0.95)
+    best = best_scan_value(points, _scatter_only(0.05), 0.95)
     assert best.value == 2000.0  # the IoU tie-break
     assert best.scatter_low is None and best.scatter_high is None
 
 
 def test_best_at_the_scan_end_is_flagged():
     values = [1.0, 2.0, 4.0, 8.0]
-    best = best_scan_value(_points(values, 20.0), scatter_sd=0.02, n_loads=5, confidence=0.95)
+    best = best_scan_value(_points(values, 20.0), _scatter_only(0.02), 0.95)
     assert best.value == 8.0 and best.at_scan_edge and best.resolution_high is None
 
 
 def test_values_whose_contact_leaves_the_window_are_never_best():
-    points = [ScanPoint(1.0, math.inf, 0.0, math.inf)] + _points([2.0, 4.0, 8.0], 4.0)
-    assert best_scan_value(points, 0.02, 5, 0.95).value == 4.0
+    points = [ScanPoint.outside_window(1.0, 5)] + _points([2.0, 4.0, 8.0], 4.0)
+    assert best_scan_value(points, _scatter_only(0.02), 0.95).value == 4.0
     with pytest.raises(ScanError, match="no scanned value"):
-        best_scan_value([ScanPoint(1.0, math.inf, 0.0, math.inf)] * 3, 0.02, 5, 0.95)
+        best_scan_value([ScanPoint.outside_window(1.0, 5)] * 3, _scatter_only(0.02), 0.95)

@@ -743,9 +743,9 @@ def test_k_scan_recovers_the_true_k_of_the_rough_sphere_within_one_scan_step(sma
     best = scan_best(small_run, "PS", "k")
     truth = truth_of(small_run, "PS")["hardening_k_mpa_per_nm"]
     step = np.log(best["values"][1] / best["values"][0])
-    print("PS k scan:", best["best"], best["scatter_interval"], "truth", truth)
+    print("PS k scan:", best["best"], best["interval"], "truth", truth)
     assert abs(np.log(best["best"] / truth)) <= step * (1 + 1e-9)
-    low, high = best["scatter_interval"]
+    low, high = best["interval"]
     assert (low is None or low <= truth) and (high is None or truth <= high)
     assert not best["at_scan_edge"]
 
@@ -756,8 +756,8 @@ def test_k_of_glass_is_left_open_where_no_k_changes_its_contact(small_run):
     bound k from above: the scatter interval is open there and holds the truth."""
     best = scan_best(small_run, "glass", "k")
     truth = truth_of(small_run, "glass")["hardening_k_mpa_per_nm"]
-    print("glass k scan:", best["best"], best["scatter_interval"])
-    low, high = best["scatter_interval"]
+    print("glass k scan:", best["best"], best["interval"])
+    low, high = best["interval"]
     assert high is None
     assert low is None or low <= truth
 

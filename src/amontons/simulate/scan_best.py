@@ -1,26 +1,20 @@
 """The judgement of a parameter scan (docs/study.md §1): the best of its values under the
-criterion D of :mod:`amontons.simulate.scan`, and the brackets about it.
+criterion of :mod:`amontons.simulate.scan_criterion` (χ² of the log-area residuals, counting
+the measured scatter and the model's error), the estimate and its interval.
 
-Brackets, two of them:
-
-* the scan's resolution: the grid neighbours of the best value (one scan step each side);
-* the measured areas' scatter: the values whose χ² = n D² / s² lies within the
-  ``confidence`` quantile of χ²(1 dof) above its minimum. ``s`` is the residual standard
-  deviation of the measured log areas about their own power-law fit (what a perfect model
-  would still miss by), inflated by the Birge ratio sqrt(χ²_min / (n - 1)) where the best
-  value misses by more than that (the model, not the measurement, then sets the scatter),
-  so that a misfit does not shrink the interval. Near the best value χ² is the parabola
-  in ln v through the best value and its two neighbours (its vertex is the ``refined``
-  best value); beyond the neighbours it is interpolated linearly in ln v between grid
-  points. Where the interval reaches the end of the scan, that side is open (``None``): the
-  data do not bound the parameter there (glass: no value of k within the scan changes its
-  contact).
-
-The scan's **estimate** is the refined value: the interval is the one about the parabola's
-vertex, so it always holds the estimate. The grid's best value need not lie inside it: χ² at
-the grid point lies above the vertex's by the parabola's rise over the grid step, which can
-exceed the χ² quantile (docs/study.md §4: PS's k). The grid's best is what was solved and
-rendered, so the figures and the model table show the model at it, named as the grid's best.
+* **The interval**: the values whose χ² lies within the criterion's quantile (F(1, n − 2))
+  above its minimum. Near the best solved value χ² is the parabola in ln v through it and its
+  two solved neighbours (its vertex is the ``refined`` value, the scan's **estimate**);
+  beyond them it is interpolated linearly in ln v between solved values. Read off solved
+  values only where they lie close about it: the scan job refines the grid there
+  (:mod:`amontons.simulate.scan_refine`) and :func:`interval_resolution` says how close
+  they lie. Where the interval reaches the end of the scan, that side is open (``None``):
+  the data bound the parameter on one side only, and the record states a bound.
+* **The grid's best**: the coarse grid's value of least χ² (the figures and the model table
+  show the model there, and name it so). It need not lie inside the interval, which belongs
+  to the estimate.
+* **The resolution bracket**: the grid's best value's neighbours on the coarse grid (one
+  scan step each side).
 """
 
 from __future__ import annotations
@@ -29,47 +23,53 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
+from amontons.simulate.scan_criterion import MIN_LOADS, SD_FLOOR, Criterion, TooFewLoads
 from amontons.simulate.scan_grid import ScanError
 from amontons.simulate.scan_record import NOT_DECIDED
 
-__all__ = ["ScanBest", "ScanPoint", "best_scan_value", "log_area_scatter", "not_decided_record"]
+__all__ = [
+    "ScanBest",
+    "ScanPoint",
+    "best_scan_value",
+    "best_targets",
+    "interval_resolution",
+    "interval_width_ln",
+    "not_decided_record",
+    "too_few_loads_record",
+]
 
-# Relative difference in D below which two values count as equally good (tie-break: IoU).
+# Relative difference in χ² below which two values count as equally good (tie-break: IoU).
 TIE = 1e-9
-
-
-def log_area_scatter(loads: Sequence[float], areas: Sequence[float]) -> float:
-    """s: residual standard deviation of ln A about the straight line fitted to ln A against
-    ln F (n - 2 degrees of freedom; at least 3 loads)."""
-    x = np.log(np.asarray(loads, dtype=float))
-    y = np.log(np.asarray(areas, dtype=float))
-    if x.size < 3:
-        raise ScanError(f"{x.size} measured loads; the scatter needs at least 3")
-    residuals = y - np.polyval(np.polyfit(x, y, 1), x)
-    return float(np.sqrt(np.sum(residuals**2) / (x.size - 2)))
 
 
 @dataclass(frozen=True)
 class ScanPoint:
-    """One scanned value: its log-area distance D, the IoU and the area ratio at the largest
-    load (simulated / measured Otsu area)."""
+    """One solved value: its log-area distance D, the IoU and the area ratio at the largest
+    load (simulated / measured Otsu area), and its residuals ln A_sim − ln A_meas at the
+    criterion's loads (inf where the contact left the window)."""
 
     value: float
     distance: float
     iou_largest: float
     area_ratio_largest: float
+    residuals: tuple[float, ...]
+
+    @classmethod
+    def outside_window(cls, value: float, n_loads: int) -> ScanPoint:
+        """A value whose contact left the solver window: never best."""
+        return cls(value, float("inf"), 0.0, float("inf"), (float("inf"),) * n_loads)
 
 
 @dataclass(frozen=True)
 class ScanBest:
-    """The best value, its two brackets (``None``: open at the scan's end) and the
-    criterion's numbers."""
+    """The estimate with its interval (``None``: open at the scan's end), the grid's best
+    and the criterion's numbers."""
 
     value: float
     refined: float
     distance: float
+    chi2_min: float
     resolution_low: float | None
     resolution_high: float | None
     scatter_low: float | None
@@ -78,6 +78,7 @@ class ScanBest:
     scatter_sd_used: float
     n_loads: int
     confidence: float
+    rise: float
     at_scan_edge: bool
 
     def to_record(self) -> dict:
@@ -86,39 +87,43 @@ class ScanBest:
         ``grid_best`` and under its former name ``best``."""
         return {
             "estimate": self.refined,
-            "scatter_interval": [self.scatter_low, self.scatter_high],
+            "interval": [self.scatter_low, self.scatter_high],
             "grid_best": self.value,
             "best": self.value,
             "resolution_bracket": [self.resolution_low, self.resolution_high],
             "distance": self.distance,
+            "chi2_min": self.chi2_min,
+            "chi2_rise": self.rise,
             "measured_log_area_sd": self.scatter_sd,
             "log_area_sd_used": self.scatter_sd_used,
             "n_loads": self.n_loads,
             "confidence": self.confidence,
             "at_scan_edge": self.at_scan_edge,
-            "criterion": "least root-mean-square distance of ln(rendered Otsu area) from "
-            "ln(measured Otsu area) over the loads; tie-break: IoU at the largest load",
+            "criterion": "chi2 of the residuals ln(rendered Otsu area) - bias - ln(measured "
+            "Otsu area) over the loads, under C = s^2 I + offset_sd^2 11' + slope_sd^2 "
+            "(x - mean x)(x - mean x)', x = ln F (model_error); tie-break: IoU at the largest "
+            "load",
             "estimate_definition": "the vertex in ln(value) of the parabola of chi2 through the "
-            "grid's best value and its two neighbours (the grid's best where it lies at the "
-            "scan's end or the three points are not convex); it lies inside scatter_interval",
-            "grid_best_definition": "the scanned value with the least distance (also `best`); "
+            "solved value of least chi2 and its two solved neighbours (that value itself where "
+            "it lies at the scan's end or the three are not convex); it lies inside interval",
+            "grid_best_definition": "the coarse grid's value of least chi2 (also `best`); "
             "distance, iou_largest, area_ratio_largest, best_loads and best_rendered_fit are "
-            "its, and it may lie outside scatter_interval, which belongs to the estimate",
-            "scatter_interval_definition": "values with n D^2 / s^2 within the chi2(1) "
-            "quantile at `confidence` of its minimum; s the residual sd of the measured ln "
-            "areas about their power-law fit, inflated by the Birge ratio where the grid's best "
-            "value misses by more (log_area_sd_used); a parabola in ln(value) through the grid's "
-            "best value and its neighbours (vertex: estimate), linear beyond; null: open at the "
-            "scan's end",
+            "its, and it may lie outside interval, which belongs to the estimate",
+            "interval_definition": "values whose chi2 lies within chi2_rise (the F(1, n - 2) "
+            "quantile at `confidence`) of its minimum; s the residual sd of the measured ln "
+            "areas about their power-law fit, inflated by the Birge ratio where the best value "
+            "misses by more than s and the model error allow (log_area_sd_used); a parabola in "
+            "ln(value) near the estimate, linear between solved values beyond; null: open at "
+            "the scan's end (a bound)",
         }
 
 
-def _best_index(points: Sequence[ScanPoint]) -> int:
-    distances = np.array([p.distance for p in points])
-    best = float(np.min(distances))
+def _best_index(chi2: np.ndarray, points: Sequence[ScanPoint], among: Sequence[int]) -> int:
+    """The index of least χ² among ``among`` (ties: the larger IoU at the largest load)."""
+    best = float(np.min(chi2[list(among)]))
     if not np.isfinite(best):
         raise ScanError("no scanned value gives a contact at every load")
-    tied = [i for i, d in enumerate(distances) if d <= best * (1 + TIE) + 1e-15]
+    tied = [i for i in among if chi2[i] <= best * (1 + TIE) + 1e-15]
     return max(tied, key=lambda i: points[i].iou_largest)
 
 
@@ -148,7 +153,7 @@ def _parabola(x, chi2, best: int):
     return (a, -b / (2 * a)) if a > 0 else None
 
 
-def _scatter_interval(x, chi2, best: int, rise: float):
+def _profile_interval(x, chi2, best: int, rise: float):
     """(low, high, refined): the interval where χ² lies within ``rise`` of its minimum."""
     parabola = _parabola(x, chi2, best)
     if parabola is None:
@@ -172,36 +177,107 @@ def _scatter_interval(x, chi2, best: int, rise: float):
     return low, high, float(np.exp(np.clip(x0, x[best - 1], x[best + 1])))
 
 
+def _neighbours(values: np.ndarray, target: float) -> tuple[float | None, float | None]:
+    """The solved values either side of ``target`` (a solved value is its own neighbour)."""
+    below = values[values <= target]
+    above = values[values >= target]
+    return (
+        float(below.max()) if below.size else None,
+        float(above.min()) if above.size else None,
+    )
+
+
+def chi2_of_points(
+    points: Sequence[ScanPoint], criterion: Criterion
+) -> tuple[np.ndarray, float, int]:
+    """(χ² of every point, in the order of ``points``; the random part it was taken with,
+    Birge-inflated at the best point; the index of least χ²)."""
+    floor = max(criterion.scatter_sd, SD_FLOOR)
+    first = np.array([criterion.chi2(p.residuals, floor) for p in points])
+    best = _best_index(first, points, range(len(points)))
+    sd = criterion.random_sd_used(points[best].residuals)
+    return np.array([criterion.chi2(p.residuals, sd) for p in points]), sd, best
+
+
 def best_scan_value(
-    points: Sequence[ScanPoint], scatter_sd: float, n_loads: int, confidence: float
+    points: Sequence[ScanPoint],
+    criterion: Criterion,
+    confidence: float,
+    grid: Sequence[float] | None = None,
 ) -> ScanBest:
-    """The best of ``points`` (sorted by value) under the criterion of this module, with its
-    resolution and scatter brackets."""
+    """The estimate of ``points`` (every solved value, any order) under ``criterion``, its
+    interval at ``confidence``, and the best of the coarse ``grid``'s values (None: every
+    point is the grid's)."""
     points = sorted(points, key=lambda p: p.value)
     values = np.array([p.value for p in points])
-    best = _best_index(points)
-    distances = np.array([p.distance for p in points])
-    # A perfect model still misses each ln area by s (floor 1e-6); a model that misses by
-    # more sets the scatter itself (Birge ratio; n - 1 degrees of freedom for one parameter).
-    sd = max(scatter_sd, 1e-6, distances[best] * np.sqrt(n_loads / max(n_loads - 1, 1)))
-    chi2 = n_loads * distances**2 / sd**2
-    low, high, refined = _scatter_interval(
-        np.log(values), chi2, best, stats.chi2.ppf(confidence, 1)
-    )
+    chi2, sd, best = chi2_of_points(points, criterion)
+    rise = criterion.rise(confidence)
+    low, high, refined = _profile_interval(np.log(values), chi2, best, rise)
+    coarse = None if grid is None else {float(g) for g in grid}
+    on_grid = [i for i, v in enumerate(values) if coarse is None or float(v) in coarse]
+    grid_best = _best_index(chi2, points, on_grid)
+    # the scan's resolution: the grid's best value's neighbours on the coarse grid
+    position = on_grid.index(grid_best)
+    below = float(values[on_grid[position - 1]]) if position > 0 else None
+    above = float(values[on_grid[position + 1]]) if position < len(on_grid) - 1 else None
     return ScanBest(
-        value=float(values[best]),
+        value=float(values[grid_best]),
         refined=refined,
-        distance=float(points[best].distance),
-        resolution_low=float(values[best - 1]) if best > 0 else None,
-        resolution_high=float(values[best + 1]) if best < len(values) - 1 else None,
+        distance=float(points[grid_best].distance),
+        chi2_min=float(chi2[best]),
+        resolution_low=below,
+        resolution_high=above,
         scatter_low=low,
         scatter_high=high,
-        scatter_sd=float(scatter_sd),
+        scatter_sd=float(criterion.scatter_sd),
         scatter_sd_used=float(sd),
-        n_loads=int(n_loads),
+        n_loads=criterion.n,
         confidence=float(confidence),
-        at_scan_edge=best in (0, len(values) - 1),
+        rise=rise,
+        at_scan_edge=grid_best in (on_grid[0], on_grid[-1]),
     )
+
+
+def interval_width_ln(best: ScanBest, values: Sequence[float]) -> float:
+    """The interval's width in ln v; where an end is open, up to the scan's end on that
+    side."""
+    low = best.scatter_low if best.scatter_low is not None else min(values)
+    high = best.scatter_high if best.scatter_high is not None else max(values)
+    return float(np.log(high / low)) if high > low else 0.0
+
+
+def interval_resolution(values: Sequence[float], best: ScanBest) -> dict[str, dict]:
+    """The solved ``values`` about the estimate and each closed end of its interval, and
+    their spacing in ln v: what the interpolation between solved values could move each of
+    them by at most."""
+    solved = np.sort(np.asarray(values, dtype=float))
+    out = {}
+    for name, target in best_targets(best).items():
+        below, above = _neighbours(solved, target)
+        spacing = None if below is None or above is None else float(np.log(above / below))
+        out[name] = {"value": target, "solved_neighbours": [below, above], "spacing_ln": spacing}
+    return out
+
+
+def best_targets(best: ScanBest) -> dict[str, float]:
+    """The values a scan's answer is read at: its estimate and its interval's closed ends."""
+    targets = {"estimate": best.refined, "low": best.scatter_low, "high": best.scatter_high}
+    return {name: value for name, value in targets.items() if value is not None}
+
+
+def too_few_loads_record(record: Mapping, error: TooFewLoads, values: Sequence[float]) -> dict:
+    """best.json of a scan whose measured loads are too few to judge (``record``: one value's
+    scan_point.json): not decided, with the loads it holds and the loads the criterion needs."""
+    return {
+        "sphere": record["sphere"],
+        "scene": record["scene"],
+        "parameter": record["parameter"],
+        "values": list(values),
+        NOT_DECIDED: f"too few loads to judge: {error}",
+        "measured_loads_mn": error.loads_mn,
+        "loads_needed": MIN_LOADS,
+        "outside_scan": record["outside_scan"],
+    }
 
 
 def not_decided_record(points: Sequence[Mapping]) -> dict:

@@ -25,7 +25,7 @@ def estimate_columns(best: Mapping | None) -> dict:
     interval's ends are ``None`` where it is open at the scan's end."""
     if best is None or not is_decided(best):
         return {"estimate": None, "estimate_low": None, "estimate_high": None}
-    low, high = best["scatter_interval"]
+    low, high = best["interval"]
     return {"estimate": best["estimate"], "estimate_low": low, "estimate_high": high}
 
 
@@ -36,35 +36,52 @@ def significant(value: float, digits: int = 3) -> str:
 
 
 def interval_text(low: float | None, high: float | None) -> str:
-    """A scan's interval as '4.61–6.13'; with an end the scan does not bound, '2170 to open',
-    and with neither, 'open both ways'."""
+    """A scan's interval as '4.61–6.13'; with an end the scan does not bound, '≥ 2170' or
+    '≤ 214' (a bound), and with neither, 'not bounded by the scan'."""
     if low is None and high is None:
-        return "open both ways"
-    ends = ["open" if end is None else significant(end) for end in (low, high)]
-    return (" to " if None in (low, high) else "–").join(ends)
+        return "not bounded by the scan"
+    if high is None:
+        return f"≥ {significant(low)}"
+    if low is None:
+        return f"≤ {significant(high)}"
+    return f"{significant(low)}–{significant(high)}"
+
+
+def _is_bound(best: Mapping) -> bool:
+    return None in best["interval"]
 
 
 def estimate_text(best: Mapping) -> str:
-    """A best.json record as figures and tables state it: the parameter's estimate, its
-    interval at its confidence, and the grid's best named as such ('k = 5.31 MPa/nm (95%
-    interval 4.61–6.13; grid's best 4.47)')."""
+    """A best.json record as figures and tables state it: the parameter's estimate with its
+    interval at its confidence, or, where the interval reaches the scan's end, the bound the
+    data set; and the grid's best named as such ('k = 5.31 MPa/nm (95% interval 4.61–6.13;
+    grid's best 4.47)', 'k ≥ 2170 MPa/nm (95% bound, open at the scan's end; grid's best
+    40000)')."""
     symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
-    low, high = best["scatter_interval"]
+    low, high = best["interval"]
+    grid = f"grid's best {significant(best['grid_best'])}"
+    if _is_bound(best):
+        return (
+            f"{symbol} {interval_text(low, high)} {unit} ({best['confidence']:.0%} bound, open "
+            f"at the scan's end; {grid})"
+        )
     return (
         f"{symbol} = {significant(best['estimate'])} {unit} ({best['confidence']:.0%} interval "
-        f"{interval_text(low, high)}; grid's best {significant(best['grid_best'])})"
+        f"{interval_text(low, high)}; {grid})"
     )
 
 
 def grid_best_text(best: Mapping) -> str:
     """The grid's best value of a best.json record, for a figure that shows the model there,
-    with the estimate beside it ("the grid's best k = 4.47 MPa/nm (estimate 5.31, 95%
-    interval 4.61–6.13)")."""
+    with the estimate and its interval, or the bound, beside it ("the grid's best k = 4.47
+    MPa/nm (estimate 5.31, 95% interval 4.61–6.13)")."""
     symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
-    low, high = best["scatter_interval"]
+    low, high = best["interval"]
+    grid = f"the grid's best {symbol} = {significant(best['grid_best'])} {unit}"
+    if _is_bound(best):
+        return f"{grid} ({best['confidence']:.0%} bound {symbol} {interval_text(low, high)})"
     return (
-        f"the grid's best {symbol} = {significant(best['grid_best'])} {unit} (estimate "
-        f"{significant(best['estimate'])}, {best['confidence']:.0%} interval "
+        f"{grid} (estimate {significant(best['estimate'])}, {best['confidence']:.0%} interval "
         f"{interval_text(low, high)})"
     )
 

@@ -127,7 +127,7 @@ def model_table_rows(
         if NOT_DECIDED in best:
             rows.append(_not_decided_row(sphere, name, best, models, measured))
             continue
-        low, high = best["scatter_interval"]
+        low, high = best["interval"]
         rows.append(
             {
                 "sphere": sphere,
