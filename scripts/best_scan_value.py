@@ -10,12 +10,16 @@ from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_json, write_table
 from amontons.runlog import run_logged
 from amontons.simulate.scan_best import (
-    ScanPoint,
     best_scan_value,
-    log_area_scatter,
+    interval_resolution,
+    measured_rows,
     not_decided_record,
+    point_from_record,
+    too_few_loads_record,
 )
+from amontons.simulate.scan_criterion import Criterion, ModelError, TooFewLoads
 from amontons.simulate.scan_grid import ScanError
+from amontons.simulate.scan_record import NOT_DECIDED
 
 log = logging.getLogger(__name__)
 
@@ -43,11 +47,35 @@ def write_not_decided(records: list[dict], table_path: str, best_path: str, scan
     write_json(best_path, best)
 
 
-def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str, confidence):
-    records = sorted((read_json(p) for p in point_paths), key=lambda r: r["value"])
-    if all(r.get("loads") == [] for r in records):  # the scan held no load (scan_scene)
-        write_not_decided(records, table_path, best_path, scan_name)
+def criterion_of(record: dict, model_error: dict | None) -> Criterion:
+    """The criterion of a solved value's measured loads (every solved value has the same),
+    with the model's error where the scan job measured it."""
+    rows = measured_rows(record)
+    error = (
+        ModelError.from_record(model_error)
+        if model_error is not None and model_error.get("estimated")
+        else None
+    )
+    return Criterion.of_measured(
+        [row["load_mn"] for row in rows], [row["measured_area_um2"] for row in rows], error
+    )
+
+
+def main(
+    point_paths: list[str],
+    refinement_path: str,
+    table_path: str,
+    best_path: str,
+    scan_name: str,
+    confidence: float,
+):
+    grid = sorted((read_json(p) for p in point_paths), key=lambda r: r["value"])
+    if all(r.get("loads") == [] for r in grid):  # the scan held no load (scan_scene)
+        write_not_decided(grid, table_path, best_path, scan_name)
         return
+    judgement = read_json(refinement_path)
+    refined = [read_json(p) for p in judgement["refined_points"]]
+    records = sorted(grid + refined, key=lambda r: r["value"])
     solved = [r for r in records if r["outside_window"] is None]
     if not solved:
         raise ScanError(
@@ -55,17 +83,19 @@ def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str
             "the contact leaves the base scene's window; expected a range_factor whose values "
             "give contacts that fit (or a larger window_factor)"
         )
-    measured = [row for row in solved[0]["loads"] if row["measured_contact_found"]]
-    scatter = log_area_scatter(
-        [row["load_mn"] for row in measured], [row["measured_area_um2"] for row in measured]
-    )
-    points = [
-        ScanPoint(r["value"], r["log_area_distance"], r["iou_largest"], r["area_ratio_largest"])
-        if r["outside_window"] is None
-        else ScanPoint(r["value"], float("inf"), 0.0, float("inf"))
-        for r in records
-    ]
-    best = best_scan_value(points, scatter, len(measured), confidence)
+    try:
+        criterion = criterion_of(solved[0], judgement.get("model_error"))
+    except TooFewLoads as error:
+        best = {
+            "scan": scan_name,
+            **too_few_loads_record(solved[0], error, [r["value"] for r in grid]),
+        }
+        log.warning("%s: not decided: %s", scan_name, best[NOT_DECIDED])
+        write_table(table_path, pd.DataFrame(scan_rows(grid, None)))
+        write_json(best_path, best)
+        return
+    points = [point_from_record(r, criterion.n) for r in records]
+    best = best_scan_value(points, criterion, confidence, [r["value"] for r in grid])
     log.info(
         "%s: %s = %g, interval %s; grid's best %g (D = %.4f; scan bracket %s)",
         scan_name,
@@ -76,27 +106,10 @@ def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str
         best.distance,
         [best.resolution_low, best.resolution_high],
     )
-    rows = []
-    for record in records:
-        outside = record["outside_window"] is not None
-        largest = {} if outside else record["loads"][-1]
-        rows.append(
-            {
-                "value": record["value"],
-                "log_area_distance": record["log_area_distance"],
-                "iou_largest": record.get("iou_largest"),
-                "area_ratio_largest": record.get("area_ratio_largest"),
-                "simulated_area_largest_um2": largest.get("simulated_area_um2"),
-                "measured_area_largest_um2": largest.get("measured_area_um2"),
-                "best": record["value"] == best.value,
-                "contact_leaves_window": outside,
-                "wall_time_s": record.get("wall_time_s"),
-            }
-        )
-    write_table(table_path, pd.DataFrame(rows))
-    chosen = next(r for r in records if r["value"] == best.value)["loads"]
-    loads = [row["load_mn"] for row in chosen]
-    rendered = [row["simulated_area_um2"] for row in chosen]
+    write_table(table_path, pd.DataFrame(scan_rows(records, best.value, refined)))
+    chosen = next(r for r in grid if r["value"] == best.value)
+    loads = [row["load_mn"] for row in chosen["loads"]]
+    rendered = [row["simulated_area_um2"] for row in chosen["loads"]]
     write_json(
         best_path,
         {
@@ -104,16 +117,20 @@ def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str
             "scan": scan_name,
             "scene": records[0]["scene"],
             "parameter": records[0]["parameter"],
-            "values": [r["value"] for r in records],
+            "values": [r["value"] for r in grid],
+            "refined_values": [r["value"] for r in refined],
             "outside_scan": records[0]["outside_scan"],
             **best.to_record(),
-            "iou_largest": next(r["iou_largest"] for r in records if r["value"] == best.value),
-            "area_ratio_largest": next(
-                r["area_ratio_largest"] for r in records if r["value"] == best.value
-            ),
+            "criterion_loads_mn": list(criterion.loads_mn),
+            "model_error": judgement.get("model_error")
+            or {"estimated": False, "why": "the scan job measured none"},
+            "refinement": judgement.get("refinement"),
+            "interval_resolution": interval_resolution([p.value for p in points], best),
+            "iou_largest": chosen["iou_largest"],
+            "area_ratio_largest": chosen["area_ratio_largest"],
             "best_loads": [
                 {k: row[k] for k in ("load_mn", "simulated_area_um2", "solver_area_um2")}
-                for row in chosen
+                for row in chosen["loads"]
             ],
             "best_rendered_fit": fit_power_law(
                 loads, rendered, x_ref=loads[0], confidence=confidence
@@ -122,12 +139,38 @@ def main(point_paths: list[str], table_path: str, best_path: str, scan_name: str
     )
 
 
+def scan_rows(records: list[dict], best_value: float | None, refined=()) -> list[dict]:
+    """scan.csv: one row per solved value (the grid's, then refinement's, by value), the
+    grid's best marked."""
+    refined_values = {r["value"] for r in refined}
+    rows = []
+    for record in records:
+        outside = record["outside_window"] is not None
+        largest = {} if outside or not record["loads"] else record["loads"][-1]
+        rows.append(
+            {
+                "value": record["value"],
+                "refined": record["value"] in refined_values,
+                "log_area_distance": record["log_area_distance"],
+                "iou_largest": record.get("iou_largest"),
+                "area_ratio_largest": record.get("area_ratio_largest"),
+                "simulated_area_largest_um2": largest.get("simulated_area_um2"),
+                "measured_area_largest_um2": largest.get("measured_area_um2"),
+                "best": record["value"] == best_value,
+                "contact_leaves_window": outside,
+                "wall_time_s": record.get("wall_time_s"),
+            }
+        )
+    return rows
+
+
 if __name__ == "__main__":
     sm = snakemake  # noqa: F821 (injected by Snakemake)
     run_logged(
         main,
         sm.log[0],
         point_paths=list(sm.params.points),
+        refinement_path=sm.input.refinement,
         table_path=sm.output.table,
         best_path=sm.output.best,
         scan_name=sm.wildcards.scan,

@@ -14,7 +14,12 @@ from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area
 from amontons.runlog import run_logged
 from amontons.simulate.register import Registration, warp_to_measured
-from amontons.simulate.scan_record import estimate_text, is_decided
+from amontons.simulate.scan_record import (
+    estimate_text,
+    held_no_load,
+    is_decided,
+    not_decided_note,
+)
 from amontons.study_figures import MapPanel, crop_box, plot_map_grid
 
 log = logging.getLogger(__name__)
@@ -40,11 +45,12 @@ def main(
     records, estimates = [], []
     for name, scan in scans.items():
         best = read_json(scan["best"])
-        decided = is_decided(best)  # else no value was solved: nothing rendered
+        decided = is_decided(best)
+        rendered_any = not held_no_load(best)  # else no value was solved: nothing rendered
         table = pd.read_csv(scan["table"]).set_index("value")
-        # a scan not decided solved nothing: its base scene has no registration to warp by
-        base = read_json(scan["registration"]) if decided else None
-        registration = Registration.from_record(base) if decided else None
+        # a scan that solved nothing has no registration to warp by
+        base = read_json(scan["registration"]) if rendered_any else None
+        registration = Registration.from_record(base) if rendered_any else None
         panels = []
         for path in scan["rendered"]:
             fields, per_load, attrs = read_load_series(path)
@@ -58,13 +64,13 @@ def main(
                 "iou_largest": row["iou_largest"],
                 "area_ratio_largest": row["area_ratio_largest"],
                 "best": decided and value == best["grid_best"],
-                "contact_leaves_window": decided and not fields,
+                "contact_leaves_window": rendered_any and not fields,
                 "load_mn": loads_mn[-1],
             }
             records.append(record)
             if not fields:
                 blank = np.zeros_like(measured.data[box], dtype=float)
-                note = "contact leaves window" if decided else "not decided"
+                note = "contact leaves window" if rendered_any else "not decided"
                 panels.append(MapPanel(blank, f"{value:g}\n{note}"))
                 continue
             image = warp_to_measured(
@@ -82,7 +88,9 @@ def main(
         rows.append(panels)
         symbol = {"p_y_mpa": "p_Y (MPa)", "k_mpa_per_nm": "k (MPa/nm)"}[best["parameter"]]
         labels.append(f"{best['scene']}\n{symbol}")
-        estimate = estimate_text(best) if decided else f"{name} not decided (no load in the scan)"
+        estimate = (
+            estimate_text(best) if decided else f"{name} not decided ({not_decided_note(best)})"
+        )
         log.info("%s: %s", name, estimate if decided else best["not_decided"])
         estimates.append(estimate)
     write_table(table_path, pd.DataFrame(records))

@@ -8,14 +8,17 @@ registration and the measured contacts are read once for the whole scan; each va
 its result and its rendered fields into its own folder."""
 
 import logging
+import math
 import os
+from dataclasses import dataclass, replace
 from functools import cached_property
+from pathlib import Path
 
 if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
-from amontons.contact import FreeBoundaryError
+from amontons.contact import ContactError, FreeBoundaryError
 from amontons.io.fields import write_load_series
 from amontons.io.files import read_json, write_json
 from amontons.io.rawdata import fluorescence_planes, read_fluorescence_series
@@ -23,9 +26,14 @@ from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area, image_pixel_m
 from amontons.runlog import run_logged
 from amontons.simulate.compare import compare_loads, sheet_load_index
+from amontons.simulate.model_error import model_error_of, richardson_log_bias
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
+from amontons.simulate.scan_best import measured_rows, point_from_record
+from amontons.simulate.scan_criterion import Criterion, TooFewLoads
+from amontons.simulate.scan_grid import ScanError, value_label
+from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.scan_start import ScanStart
 from amontons.simulate.solve import solve_scene
 from amontons.simulate.surface import Indenter, afm_indenter, afm_scene, load_levelled_map
@@ -125,12 +133,28 @@ class ScanContext:
         return self._indenters[key]
 
 
+@dataclass
+class Solved:
+    """One value solved: its result (scan_point.json), the next value's start, and where its
+    contact fit the window, its scene and solution (what the model's error is measured on)."""
+
+    record: dict
+    start: ScanStart
+    scene: object = None
+    solution: object = None
+
+    @property
+    def distance(self) -> float:
+        d = self.record.get("log_area_distance")
+        return float("inf") if d is None else d
+
+
 def solve_value(
     context: ScanContext, value: float, point_path: str, fields_path: str, start: ScanStart
-) -> ScanStart:
+) -> Solved:
     """One value of the scan, solved from ``start`` (the previous value's pressures), its
-    result written to ``point_path`` and its rendered fields to ``fields_path``; returns its
-    own pressures, the next value's start."""
+    result written to ``point_path`` and its rendered fields to ``fields_path``; returns it
+    with its own pressures, the next value's start."""
     scan = context.scan
     config = scene_config_at(context.base_config, scan["parameter"], value)
     scene, coverage = afm_scene(
@@ -152,9 +176,15 @@ def solve_value(
         log.warning("%s = %g: the AFM scan holds no load's window", scan["parameter"], value)
         write_load_series(fields_path, [], [], record)
         # the scan's size and the largest window in it: what best_scan_value says why with
-        write_json(point_path, {**record, **covered, "log_area_distance": None,
-                                "outside_window": None, "loads": []})  # fmt: skip
-        return ScanStart()
+        record = {
+            **record,
+            **covered,
+            "log_area_distance": None,
+            "outside_window": None,
+            "loads": [],
+        }
+        write_json(point_path, record)
+        return Solved(record, ScanStart())
     indenter = context.indenter(scene)
     starts, started = start.starts_for(
         scene.loads_n, indenter.heights.shape, indenter.spacing_m, indenter.centre_in_scan_m
@@ -177,8 +207,9 @@ def solve_value(
         # whose contact fits: recorded, never best, and the scan goes on.
         log.warning("%s = %g: %s", scan["parameter"], value, error)
         write_load_series(fields_path, [], [], {**scene.to_record(), **record})
-        write_json(point_path, {**record, "log_area_distance": None, "outside_window": str(error)})
-        return ScanStart()
+        record = {**record, "log_area_distance": None, "outside_window": str(error)}
+        write_json(point_path, record)
+        return Solved(record, ScanStart())
     rendered = render_load_series(
         solution.fields,
         scene.pixel_m,
@@ -224,30 +255,179 @@ def solve_value(
             "window_centre_in_scan_um": [c * 1e6 for c in indenter.centre_in_scan_m],
         },
     )
-    write_json(
-        point_path,
-        {
-            **record,
-            "log_area_distance": distance,
-            "outside_window": None,
-            "loads_used": len(used),
-            "iou_largest": rows[-1].iou,
-            "area_ratio_largest": rows[-1].area_ratio,
-            "wall_time_s": solution.wall_time_s,
-            "loads": [
-                {
-                    **row.to_record(),
-                    **{k: info[k] for k in ("iterations", "outer_iterations", "convolutions")},
-                }
-                for row, info in zip(rows, solution.per_load, strict=True)
-            ],
-        },
-    )
-    return ScanStart.of(
+    record = {
+        **record,
+        "log_area_distance": distance,
+        "outside_window": None,
+        "loads_used": len(used),
+        "iou_largest": rows[-1].iou,
+        "area_ratio_largest": rows[-1].area_ratio,
+        "wall_time_s": solution.wall_time_s,
+        "loads": [
+            {
+                **row.to_record(),
+                **{k: info[k] for k in ("iterations", "outer_iterations", "convolutions")},
+            }
+            for row, info in zip(rows, solution.per_load, strict=True)
+        ],
+    }
+    write_json(point_path, record)
+    start = ScanStart.of(
         scene.loads_n,
         [f["pressure"] for f in solution.fields],
         indenter.spacing_m,
         indenter.centre_in_scan_m,
+    )
+    return Solved(record, start, scene, solution)
+
+
+def rendered_areas_m2(context: ScanContext, scene, solution, psf_fwhm_m: float) -> list[float]:
+    """The Otsu area (m²) of each load of ``solution`` rendered as the scan renders it, with
+    the PSF's FWHM ``psf_fwhm_m`` (m)."""
+    config = context.base_config
+    rendered = render_load_series(
+        solution.fields,
+        scene.pixel_m,
+        pixel_m=context.pixel_m,
+        psf_fwhm_m=psf_fwhm_m,
+        rendering=config["rendering"],
+        confinement_floor_pa=config["confinement_floor_mpa"] * 1e6,
+        otsu=context.settings,
+    )
+    return [r.otsu.area_m2 for r in rendered]
+
+
+def _at_measured(values: list[float], record: dict) -> list[float]:
+    """``values`` (one per load of a solved value's ``record``, in its order) at the loads the
+    criterion reads: those whose measured image shows a contact."""
+    return [
+        v for v, row in zip(values, record["loads"], strict=True) if row["measured_contact_found"]
+    ]
+
+
+def estimate_model_error(context: ScanContext, best: Solved, rows: list[dict], judgement: dict):
+    """The model's error at the best solved value (amontons.simulate.model_error): the solver
+    pixel's bias from a solve ``model_error_pixel_factor`` times coarser, and the PSF's
+    uncertainty from renders one standard error wider and narrower. Returns the error and
+    its record; (None, why) where it cannot be measured, which the record then says."""
+    factor = judgement["model_error_pixel_factor"]
+    coarse_scene = replace(best.scene, pixel_m=best.scene.pixel_m * factor)
+    log.info(
+        "model error: the best value solved again at %.0f nm (%g x the pixel)",
+        coarse_scene.pixel_m * 1e9,
+        factor,
+    )
+    try:
+        coarse = solve_scene(
+            coarse_scene,
+            context.indenter(coarse_scene),
+            threads=context.threads,
+            backend=context.solver_backend,
+        )
+        fine_m2 = rendered_areas_m2(context, best.scene, best.solution, context.psf_fwhm_m)
+        coarse_m2 = rendered_areas_m2(context, coarse_scene, coarse, context.psf_fwhm_m)
+        bias = richardson_log_bias(
+            _at_measured(fine_m2, best.record), _at_measured(coarse_m2, best.record), factor
+        )
+    except (ContactError, ScanError) as error:
+        log.warning("model error not measured: %s", error)
+        return None, {"estimated": False, "why": str(error)}
+    psf_change = psf_log_change(context, best)
+    loads = [row["load_mn"] for row in rows]
+    error, record = model_error_of(loads, bias, judgement["model_error_order_sd"], psf_change)
+    return error, {
+        "estimated": True,
+        "value": best.record["value"],
+        "solver_pixel_nm": best.scene.pixel_m * 1e9,
+        "coarse_pixel_nm": coarse_scene.pixel_m * 1e9,
+        "coarse_wall_time_s": coarse.wall_time_s,
+        **record,
+    }
+
+
+def psf_log_change(context: ScanContext, best: Solved) -> list[float] | None:
+    """Half the change of ln(rendered area) per load between the PSF one standard error
+    wider and one narrower (None where the PSF states no standard error)."""
+    se_nm = read_json(context.psf_path)["fwhm_nm"].get("standard_error")
+    if not se_nm:
+        return None
+    fwhm = context.psf_fwhm_m
+    wide, narrow = (
+        _at_measured(rendered_areas_m2(context, best.scene, best.solution, f), best.record)
+        for f in (fwhm + se_nm * 1e-9, max(fwhm - se_nm * 1e-9, 0.5 * fwhm))
+    )
+    return [0.5 * math.log(w / n) for w, n in zip(wide, narrow, strict=True)]
+
+
+def judge_and_refine(context, chain, solved, best, judgement, refinement_path):
+    """After the coarse grid: the criterion of the measured areas, the model's error at the
+    best value, and the values solved about the estimate and the interval's ends
+    (amontons.simulate.scan_refine), each from its nearest solved neighbour's pressures.
+    Writes ``refinement_path`` (what best_scan_value judges with beside the grid)."""
+    folder = Path(chain[0]["point"]).parent.parent
+    names = (Path(chain[0]["point"]).name, Path(chain[0]["rendered"]).name)
+    if best is None:
+        write_json(
+            refinement_path,
+            {
+                "judged": False,
+                "why": "no value gives a contact in the window",
+                "refined_points": [],
+            },
+        )
+        return
+    rows = measured_rows(best.record)
+    loads = [row["load_mn"] for row in rows]
+    try:
+        criterion = Criterion.of_measured(loads, [row["measured_area_um2"] for row in rows])
+    except TooFewLoads as error:
+        log.warning("not judged, no refinement: %s", error)
+        write_json(refinement_path, {"judged": False, "why": str(error), "refined_points": []})
+        return
+    error, error_record = estimate_model_error(context, best, rows, judgement)
+    if error is not None:
+        criterion = replace(criterion, model_error=error)
+    records = {value: result.record for value, result in solved.items()}
+    starts = {value: result.start for value, result in solved.items()}
+    refined = []
+
+    def solve(value: float):
+        label = value_label(value)
+        neighbour = min(starts, key=lambda v: abs(math.log(v / value)))
+        result = solve_value(
+            context,
+            value,
+            str(folder / label / names[0]),
+            str(folder / label / names[1]),
+            starts[neighbour],
+        )
+        starts[value] = result.start
+        refined.append(str(folder / label / names[0]))
+        return point_from_record(result.record, criterion.n)
+
+    points = [point_from_record(r, criterion.n) for r in records.values()]
+    _, refinement = refine_scan(
+        points,
+        criterion,
+        judgement["confidence"],
+        solve,
+        judgement["refine_fraction"],
+        judgement["refine_max_values"],
+    )
+    log.info(
+        "refinement: %d values in %d rounds (%s)",
+        len(refinement.values),
+        refinement.rounds,
+        refinement.stopped,
+    )
+    write_json(
+        refinement_path,
+        {
+            "judged": True,
+            "model_error": error_record,
+            "refinement": refinement.to_record(),
+            "refined_points": refined,
+        },
     )
 
 
@@ -261,20 +441,32 @@ def first_start(seed: list[str]) -> ScanStart:
     return ScanStart.from_scene_fields(seed[0])
 
 
-def main(context: ScanContext, chain: list[dict], seed: list[str]) -> None:
-    """Every value of ``chain`` (amontons.workflow.scenes.Scenes.scan_value_files: value,
-    point and rendered paths, in the order they are solved), each from the one before, the
-    first from the elastic scene's fields ``seed`` (none or one path)."""
+def main(
+    context: ScanContext, chain: list[dict], seed: list[str], judgement: dict, refinement_path: str
+) -> None:
+    """Every value of ``chain`` (amontons.simulate.workflow.scenes.Scenes.scan_value_files:
+    value, point and rendered paths, in the order they are solved), each from the one before,
+    the first from the elastic scene's fields ``seed`` (none or one path); then the model's
+    error and the refinement (:func:`judge_and_refine`)."""
     start = first_start(seed)
+    solved, best = {}, None
     for value in chain:
-        start = solve_value(context, float(value["value"]), value["point"], value["rendered"],
-                            start)  # fmt: skip
+        result = solve_value(
+            context, float(value["value"]), value["point"], value["rendered"], start
+        )
+        start = result.start
+        if best is None or result.distance < best.distance:
+            best = result if result.solution is not None else best
+        solved[result.record["value"]] = Solved(result.record, result.start)  # no fields kept
+    judge_and_refine(context, chain, solved, best, judgement, refinement_path)
 
 
-def run(chain: list[dict], seed: list[str], **context) -> None:
-    """The scan job: its context (:class:`ScanContext`'s arguments) built and its chain
-    solved, inside its log."""
-    main(ScanContext(**context), chain, seed)
+def run(
+    chain: list[dict], seed: list[str], judgement: dict, refinement_path: str, **context
+) -> None:
+    """The scan job: its context (:class:`ScanContext`'s arguments) built, its chain solved
+    and refined, inside its log."""
+    main(ScanContext(**context), chain, seed, judgement, refinement_path)
 
 
 if __name__ == "__main__":
@@ -288,6 +480,8 @@ if __name__ == "__main__":
         fluorescence=sm.input.fluorescence,
         chain=sm.params.chain,
         seed=list(sm.input.seed),
+        judgement=sm.params.judgement,
+        refinement_path=sm.output.refinement,
         scan=sm.params.scan,
         base_config=sm.params.base,
         sphere=sm.wildcards.sphere,

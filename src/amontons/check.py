@@ -29,6 +29,7 @@ from amontons.io.layout import PLANE_NOUN, RawDataError
 from amontons.io.ptu import read_ptu_header
 from amontons.io.rheometer_files import read_rheometer_file, reader_label
 from amontons.io.tiff import read_tiff
+from amontons.simulate.scan_grid import MIN_LOADS
 from amontons.workflow.params import image_choice
 from amontons.workflow.run import WorkflowRun
 from amontons.workflow.scenes import outside_scan_lines
@@ -233,17 +234,27 @@ def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
 
 
 def undecided_scans(run: WorkflowRun, sphere: str, coverage: dict) -> dict[str, str]:
-    """The sphere's parameter scans that will have nothing to judge, each with why: their
-    scene keeps no load inside the AFM scan (``coverage``: :meth:`Scenes.scan_coverage`), so
-    their best.json will say 'not decided' (docs/study.md §6)."""
-    return {
-        scan: f"scan {scan}: not decided (its scene {spec['scene']} keeps no load inside the "
-        "AFM scan, so no value is solved)"
-        for scan, spec in run.scenes.scans.items()
-        if scan in run.scenes.runnable_scans(sphere)
-        and spec["scene"] in coverage
-        and not coverage[spec["scene"]]["simulated_mn"]
-    }
+    """The sphere's parameter scans that will have nothing or too little to judge, each with
+    why: their scene keeps no load inside the AFM scan (``coverage``:
+    :meth:`Scenes.scan_coverage`), so no value is solved, or fewer loads than the criterion
+    needs (:data:`MIN_LOADS`); their best.json will say 'not decided' (docs/study.md §6)."""
+    undecided = {}
+    for scan, spec in run.scenes.scans.items():
+        if scan not in run.scenes.runnable_scans(sphere) or spec["scene"] not in coverage:
+            continue
+        held = coverage[spec["scene"]]["simulated_mn"]
+        if not held:
+            undecided[scan] = (
+                f"scan {scan}: not decided (its scene {spec['scene']} keeps no load inside the "
+                "AFM scan, so no value is solved)"
+            )
+        elif len(held) < MIN_LOADS:
+            loads = ", ".join(f"{f:g}" for f in held)
+            undecided[scan] = (
+                f"scan {scan}: not decided (its scene {spec['scene']} keeps {len(held)} loads "
+                f"inside the AFM scan, {loads} mN; the criterion needs at least {MIN_LOADS})"
+            )
+    return undecided
 
 
 def check(configfiles: list[str], workflow_dir: Path = WORKFLOW_DIR) -> list[dict]:

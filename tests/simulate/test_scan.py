@@ -69,8 +69,7 @@ def test_log_area_scatter_of_an_exact_power_law_is_zero_and_grows_with_noise():
 def _points(values, true_value, slope=0.3):
     """A model whose areas are off by a factor (v/v0)^slope at every load: D = slope |ln v/v0|."""
     return [
-        _point(v, slope * math.log(v / true_value), 0.9, (v / true_value) ** slope)
-        for v in values
+        _point(v, slope * math.log(v / true_value), 0.9, (v / true_value) ** slope) for v in values
     ]
 
 
@@ -106,9 +105,7 @@ def test_a_scatter_wider_than_the_misfit_widens_the_interval_beyond_the_neighbou
 
 def test_a_flat_criterion_leaves_the_interval_open_and_ties_go_to_the_better_overlap():
     values = [1000.0, 2000.0, 4000.0, 8000.0]
-    points = [
-        _point(v, 0.05, iou) for v, iou in zip(values, [0.8, 0.9, 0.85, 0.8], strict=True)
-    ]
+    points = [_point(v, 0.05, iou) for v, iou in zip(values, [0.8, 0.9, 0.85, 0.8], strict=True)]
     best = best_scan_value(points, _scatter_only(0.05), 0.95)
     assert best.value == 2000.0  # the IoU tie-break
     assert best.scatter_low is None and best.scatter_high is None

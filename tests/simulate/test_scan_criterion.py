@@ -161,3 +161,27 @@ def test_refinement_resolves_an_estimate_the_parabola_misplaces():
     assert fine.value in [p.value for p in grid]
     resolution = interval_resolution([p.value for p in points], fine)
     assert resolution["estimate"]["spacing_ln"] < 0.5 * math.log(82.38 / 50)
+
+
+def test_an_end_next_to_a_value_whose_contact_leaves_the_window_is_bisected():
+    """Below 150 every value's contact leaves the window (no χ²), and χ² rises steeply
+    above the truth 160: the coarse interval's low end sits on the lowest solvable value
+    (its crossing with an infinite χ² is not interpolated). Refinement bisects between them
+    until they lie within the allowed movement: the low end then lies within that of 150."""
+    measured = 40 * LOADS_MN**0.85
+
+    def simulate(v):
+        if v < 150.0:
+            return ScanPoint.outside_window(v, N)
+        return _point(v, measured * math.exp(0.3 * math.log(v / 160.0)), measured)
+
+    criterion = Criterion(tuple(LOADS_MN), 0.02, ModelError.none(N))
+    grid = [simulate(v) for v in scan_values(100.0, [0.2, 4.0], 7)]
+    coarse = best_scan_value(grid, criterion, 0.95)
+    assert coarse.scatter_low == 242.8  # the lowest solvable grid value (147.4 is not)
+    points, refinement = refine_scan(grid, criterion, 0.95, simulate, 0.1, 12)
+    fine = best_scan_value(points, criterion, 0.95, [p.value for p in grid])
+    print(fine, refinement)
+    assert refinement.resolved and len(refinement.values) <= 12
+    assert 150.0 <= fine.scatter_low <= 150.0 * math.exp(refinement.allowed_ln)
+    assert _inside(160.0, fine)

@@ -53,6 +53,9 @@ CASES = {
 # 43.5 µm) and 100 mN's contact with the solver's margin (1.25 × 36.6 µm, the window clipped
 # from 55 µm), not 200 mN's (1.25 × 46 µm); 24 µm holds no contact (23 µm at 25 mN).
 CUT_SCANS = {"PS-cutscan": 50.0, "PS-noload": 24.0}
+# A scan that holds two loads' contacts with the solver's margin (25 and 50 mN: 1.25 × 23 and
+# 1.25 × 29 µm), not 100 mN's (1.25 × 36.6 µm): too few for the scans' criterion.
+TWO_LOAD_SCANS = {"PS-twoloads": 40.0}
 # The lab's two rheometer programs: RheoCompass, whose exports config/config.yaml's single
 # map reads (named 'export'), and TRIOS, whose map the lab's config adds by a name (Snakemake
 # merges the two files key by key). PS-trios's row names its map; PS-ptu's RheoCompass files
@@ -131,8 +134,8 @@ def _lab_sphere(small_data, lab: Path, name: str, remove: list[str]) -> Path:
     for entry in remove:
         path = folder / entry
         shutil.rmtree(path) if path.is_dir() else path.unlink()
-    if name in CUT_SCANS:
-        _cut_scans(folder, CUT_SCANS[name])
+    if name in CUT_SCANS | TWO_LOAD_SCANS:
+        _cut_scans(folder, (CUT_SCANS | TWO_LOAD_SCANS)[name])
     if name in EXPORTED:
         _exported_rheometer(folder, EXPORTED[name][0])
     if name == PTU_SPHERE:
@@ -554,7 +557,7 @@ def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
     them, and best.json and the model table list 200 and 300 mN as outside_scan. Beside it,
     a sphere whose scan holds no load's contact: its scan is not decided, an answer that
     says why, and the run exits 0 (test_a_scan_with_nothing_to_judge_says_why)."""
-    project = _project(tmp_path, small_data, {"PS-cutscan": [], "PS-noload": []})
+    project = _project(tmp_path, small_data, {"PS-cutscan": [], "PS-noload": [], "PS-twoloads": []})
     path = project / "config" / "test.yaml"
     config = yaml.safe_load(path.read_text())
     config.update(run_scenes=["penetration_hardness"], run_scans=["p_y"])
@@ -578,10 +581,39 @@ def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
     cut = models[models["sphere"] == "PS-cutscan"]
     assert set(cut["left_out"]) == {"outside_scan: 200, 300 mN"}
     _a_scan_with_nothing_to_judge_says_why(project, models)
-    # the data check said so before the run, and of that sphere only
+    _a_scan_with_too_few_loads_says_why(project, models)
+    # the data check said so before the run, and of those spheres only
     plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
     assert list(plans["PS-noload"]["undecided_scans"]) == ["p_y"]
+    assert plans["PS-twoloads"]["undecided_scans"]["p_y"] == (
+        "scan p_y: not decided (its scene penetration_hardness keeps 2 loads inside the AFM "
+        "scan, 25, 50 mN; the criterion needs at least 3)"
+    )
     assert plans["PS-cutscan"]["undecided_scans"] == {}
+
+
+def _a_scan_with_too_few_loads_says_why(project, models):
+    """PS-twoloads' 40 µm scan holds two loads' contacts (issue 65: a lab's sphere whose scan
+    held one load stopped the run with a ScanError): its values are solved on them, but two
+    loads leave the measured scatter no degree of freedom, so the scan is not decided, with
+    the loads it holds and the loads the criterion needs, in best.json, the model table, the
+    verdict and summary.md; and the run exits 0."""
+    scan = project / "results" / SMALL / "PS" / "PS-twoloads" / "scans" / "p_y"
+    best = json.loads((scan / "best.json").read_text())
+    assert "estimate" not in best and "grid_best" not in best
+    assert best["measured_loads_mn"] == pytest.approx([25, 50]) and best["loads_needed"] == 3
+    assert best["not_decided"].startswith("too few loads to judge: 2 measured loads (25, 50 mN)")
+    assert [row["load_mn"] for row in best["outside_scan"]] == [100.0, 200.0, 300.0]
+    points = pd.read_csv(scan / "scan.csv")
+    assert len(points) == 3 and not points["best"].any()
+    own = models[(models["sphere"] == "PS-twoloads") & models["source"].str.startswith("scan")]
+    (row,) = own.to_dict("records")
+    assert row["source"] == "scan p_y, not decided"
+    assert row["left_out"] == f"not decided: {best['not_decided']}"
+    verdict = pd.read_csv(project / "results" / SMALL / "verdict.csv").set_index("sphere")
+    assert verdict.loc["PS-twoloads", "penetration_hardness_source"] == "scan p_y, not decided"
+    summary = (project / "results" / SMALL / "summary.md").read_text()
+    assert f"not decided: {best['not_decided']}" in summary
 
 
 def _a_scan_with_nothing_to_judge_says_why(project, models):

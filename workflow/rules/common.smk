@@ -32,6 +32,7 @@ from amontons.workflow.paths import (
     LOAD_AREA_FIT,
     PSF,
     REGISTRATION,
+    REFINEMENT,
     RENDERED,
     RENDER_TABLE,
     SPHERE_FITS,
@@ -109,6 +110,13 @@ scene_sphere_record = SPHERES.scene_record
 # Config slices as params (amontons.workflow.params).
 config_slice = partial(_config_slice, config)
 OTSU = otsu_settings(config)
+# How a scan is judged beyond its grid (docs/study.md §1): the model's error and the
+# refinement, at the load-area fits' confidence.
+SCAN_JUDGEMENT = {
+    **config["scan_judgement"],
+    "confidence": config["load_area"]["confidence"],
+}
+SCAN_REFINED = SCAN_JUDGEMENT["refine_max_values"]
 RING_OPTICS = ring_optics(config)
 AFM_READING = afm_reading(config)
 # Which plane of a confocal file is the image: the fluorescence and bead one, the reflection one.

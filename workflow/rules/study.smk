@@ -15,8 +15,11 @@ rule scan_scene:
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
         pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
     output:
-        # every value's result and rendered fields, a folder per value
+        # every value's result and rendered fields, a folder per value (the grid's and the
+        # refinement's)
         values=directory(PATHS.scan_values()),
+        # the model's error at the best value and the values refinement solved
+        refinement=f"{SCAN}/{REFINEMENT}",
     log:
         f"{SCAN_LOGS}/scan_scene.log",
     benchmark:
@@ -26,8 +29,8 @@ rule scan_scene:
     threads: 1
     resources:
         **SOLVE_GPU,
-        mem_mb=solve_mem_mb(scan_solves(SCANS, RUN.scenes.scan_chain)),
-        runtime=solve_runtime(scan_solves(SCANS, RUN.scenes.scan_chain)),
+        mem_mb=solve_mem_mb(scan_solves(SCANS, RUN.scenes.scan_chain, SCAN_REFINED)),
+        runtime=solve_runtime(scan_solves(SCANS, RUN.scenes.scan_chain, SCAN_REFINED)),
     params:
         **SOLVE_BACKEND,
         scan=lambda wc: RUN.scenes.scan_params(wc.sphere, wc.scan),
@@ -38,6 +41,7 @@ rule scan_scene:
         pixel_nm=lambda wc: pixel_nm(wc.sphere),
         images=lambda wc: fluorescence_choice(wc.sphere),
         otsu=OTSU,
+        judgement=SCAN_JUDGEMENT,
     script:
         "../../scripts/scan_scene.py"
 
@@ -45,6 +49,7 @@ rule scan_scene:
 rule best_scan_value:
     input:
         values=rules.scan_scene.output.values,
+        refinement=rules.scan_scene.output.refinement,
     output:
         table=f"{SCAN}/{SCAN_TABLE}",
         best=f"{SCAN}/{BEST}",

@@ -19,6 +19,7 @@ the measured scatter and the model's error), the estimate and its interval.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -35,6 +36,8 @@ __all__ = [
     "best_targets",
     "interval_resolution",
     "interval_width_ln",
+    "measured_rows",
+    "point_from_record",
     "not_decided_record",
     "too_few_loads_record",
 ]
@@ -263,6 +266,33 @@ def best_targets(best: ScanBest) -> dict[str, float]:
     """The values a scan's answer is read at: its estimate and its interval's closed ends."""
     targets = {"estimate": best.refined, "low": best.scatter_low, "high": best.scatter_high}
     return {name: value for name, value in targets.items() if value is not None}
+
+
+def measured_rows(record: Mapping) -> list[dict]:
+    """A solved value's comparison rows (scan_point.json) at the loads the criterion reads:
+    those whose measured image shows a contact."""
+    return [row for row in record["loads"] if row["measured_contact_found"]]
+
+
+def point_from_record(record: Mapping, n_loads: int) -> ScanPoint:
+    """A value's :class:`ScanPoint` from its scan_point.json (``n_loads``: the criterion's
+    loads; a value whose contact left the window is never best)."""
+    if record["outside_window"] is not None:
+        return ScanPoint.outside_window(record["value"], n_loads)
+    # a load with no simulated contact matches nothing: an infinite residual
+    residuals = tuple(
+        math.log(row["simulated_area_um2"] / row["measured_area_um2"])
+        if row["simulated_area_um2"] > 0
+        else math.inf
+        for row in measured_rows(record)
+    )
+    return ScanPoint(
+        record["value"],
+        record["log_area_distance"],
+        record["iou_largest"],
+        record["area_ratio_largest"],
+        residuals,
+    )
 
 
 def too_few_loads_record(record: Mapping, error: TooFewLoads, values: Sequence[float]) -> dict:

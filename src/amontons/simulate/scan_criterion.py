@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, stats
 
-from amontons.simulate.scan_grid import ScanError
+from amontons.simulate.scan_grid import MIN_LOADS, ScanError
 
 __all__ = [
     "MIN_LOADS",
@@ -44,9 +44,6 @@ __all__ = [
     "log_area_scatter",
 ]
 
-# The fewest measured loads that leave the scatter a degree of freedom (a line through ln A
-# against ln F takes two).
-MIN_LOADS = 3
 # The interval's quantile: "f", F(1, n - 2) for a scatter estimated from the data (the
 # pipeline's); "chi2", χ²(1), for a scatter taken as known (the scans before issue 65).
 QUANTILES = ("f", "chi2")
@@ -154,10 +151,9 @@ class Criterion:
         and slope (ln area²)."""
         x = np.log(np.asarray(self.loads_mn))
         centred = x - x.mean()
-        shared = (
-            self.model_error.offset_sd**2 * np.ones((self.n, self.n))
-            + self.model_error.slope_sd**2 * np.outer(centred, centred)
-        )
+        shared = self.model_error.offset_sd**2 * np.ones(
+            (self.n, self.n)
+        ) + self.model_error.slope_sd**2 * np.outer(centred, centred)
         return random_sd**2 * np.eye(self.n) + shared
 
     def corrected(self, residuals: Sequence[float]) -> np.ndarray:

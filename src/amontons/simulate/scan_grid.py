@@ -7,6 +7,10 @@ import math
 from collections.abc import Sequence
 
 SPACINGS = ("log", "linear")
+# The fewest measured loads a scan is judged on: the scatter of the measured areas about their
+# power law, which the criterion weighs the model against, needs a degree of freedom beyond
+# the line's two (amontons.simulate.scan_criterion).
+MIN_LOADS = 3
 
 
 class ScanError(ValueError):

@@ -19,6 +19,17 @@ def is_decided(best: Mapping) -> bool:
     return NOT_DECIDED not in best
 
 
+def held_no_load(best: Mapping) -> bool:
+    """Whether a scan not decided solved nothing (its AFM scan held no load's window), as
+    against one that solved its values but holds too few loads to judge them."""
+    return not is_decided(best) and "largest_window_in_scan_um" in best
+
+
+def not_decided_note(best: Mapping) -> str:
+    """Why a scan is not decided, in a few words for a figure."""
+    return "no load in the scan" if held_no_load(best) else "too few loads to judge"
+
+
 def estimate_columns(best: Mapping | None) -> dict:
     """A scan's estimate and the interval that belongs to it, as model-table columns, from its
     best.json record (``None``, for a scene's row, or a scan not decided: empty columns). The

@@ -6,13 +6,16 @@ solved values close about each target, not off an interpolation across a coarse 
 
 Each round judges the values solved so far
 (:func:`amontons.simulate.scan_best.best_scan_value`) and solves each target that no solved
-value lies within half the allowed movement of (rounded to its 4-digit folder label).
+value lies within half the allowed movement of (rounded to its 4-digit folder label); and,
+where an end of the interval lies next to a value whose contact left the window (no χ² to
+interpolate), bisects between the two until they lie within the allowed movement.
 ``max_values`` bounds the cost; a scan that reaches it says so, with how far each target
 moved in its last round.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -29,19 +32,45 @@ from amontons.simulate.scan_best import (
 from amontons.simulate.scan_criterion import Criterion
 from amontons.simulate.scan_grid import value_label
 
-__all__ = ["Refinement", "movement_ln", "refine_scan", "refinement_values"]
+__all__ = ["Refinement", "gap_values", "movement_ln", "refine_scan", "target_values"]
 
 
-def refinement_values(best: ScanBest, solved: Sequence[float], near_ln: float) -> list[float]:
-    """The targets of ``best`` (its estimate and closed ends) to solve next, rounded to their
-    folder labels: those with no solved value within ``near_ln`` in ln v."""
+def target_values(best: ScanBest, solved: Sequence[float], near_ln: float) -> list[float]:
+    """Each target of ``best`` (its estimate and closed ends) with no solved value within
+    ``near_ln`` in ln v, rounded to its folder label."""
     done = np.log(np.asarray(solved, dtype=float))
-    proposals = []
-    for target in best_targets(best).values():
-        value = float(value_label(target))
-        if np.min(np.abs(done - np.log(value))) > near_ln and value not in proposals:
-            proposals.append(value)
-    return sorted(proposals)
+    values = [float(value_label(t)) for t in best_targets(best).values()]
+    return [v for v in values if np.min(np.abs(done - np.log(v))) > near_ln]
+
+
+def gap_values(
+    best: ScanBest, solved: Sequence[float], near_ln: float, unsolvable: Sequence[float]
+) -> list[float]:
+    """Where an end of the interval lies next to a value whose contact left the window
+    (``unsolvable``: χ² infinite, so the crossing between them is not interpolated but lies
+    somewhere between), the value halfway between the two in ln v, while they lie more than
+    ``2 near_ln`` apart."""
+    values = []
+    for end, step in ((best.scatter_low, -1), (best.scatter_high, +1)):
+        outer = _outer_neighbour(solved, end, step)
+        if (
+            outer is not None
+            and outer in set(unsolvable)
+            and abs(np.log(outer / end)) > 2 * near_ln
+        ):
+            values.append(float(value_label(np.sqrt(outer * end))))
+    return values
+
+
+def _outer_neighbour(solved: Sequence[float], end: float | None, step: int) -> float | None:
+    """The solved value next beyond an interval's ``end`` on the side ``step`` (-1: below)."""
+    if end is None:
+        return None
+    # beyond by more than rounding: an end read off a solved value lies at it to ~1e-16
+    beyond = [v for v in solved if math.log(v / end) * step > 1e-9]
+    if not beyond:
+        return None
+    return min(beyond) if step > 0 else max(beyond)
 
 
 def movement_ln(before: ScanBest, after: ScanBest) -> dict[str, float]:
@@ -82,8 +111,11 @@ class Refinement:
         }
 
 
-CONVERGED = "converged: the last round moved no target by more than the allowed fraction"
-AT_SOLVED = "every target lies at a solved value"
+CONVERGED = (
+    "converged: the last round moved no target by more than the allowed fraction, and no "
+    "end lies next to an unsolvable value further than that"
+)
+AT_SOLVED = "every target lies at or near a solved value"
 MAX_VALUES = "max_values reached before the targets stopped moving"
 
 
@@ -108,14 +140,16 @@ def refine_scan(
         best = best_scan_value(points, criterion, confidence, grid)
         solved = [p.value for p in points]
         allowed = fraction * interval_width_ln(best, solved)
+        unsolvable = [p.value for p in points if not np.all(np.isfinite(p.residuals))]
+        proposals = gap_values(best, solved, allowed / 2, unsolvable)
         if before is not None:
             moved = movement_ln(before, best)
-            if all(m <= allowed for m in moved.values()):
-                stopped = CONVERGED
-                break
-        proposals = refinement_values(best, solved, allowed / 2)
+        if before is None or any(m > allowed for m in moved.values()):
+            proposals += target_values(best, solved, allowed / 2)
+        done = {float(value_label(v)) for v in solved}
+        proposals = sorted(set(proposals) - done)
         if not proposals:
-            stopped = AT_SOLVED
+            stopped = CONVERGED if before is not None else AT_SOLVED
             break
         if len(added) + len(proposals) > max_values:
             stopped = MAX_VALUES

@@ -38,6 +38,8 @@ SCENE_FITS = "scene_fits.json"
 SCAN_POINT = "scan_point.json"
 SCAN_TABLE = "scan.csv"
 BEST = "best.json"
+# A scan job's judgement inputs beyond its grid: the model's error and the refined values.
+REFINEMENT = "refinement.json"
 TRUTH = "truth.json"
 ACCURACY_SUMMARY = "summary.json"
 MODELS_TABLE = "models.csv"

@@ -132,15 +132,21 @@ class SolveResources:
         return lambda wildcards: mem_mb_of(self.predicted(solves_of, wildcards)[1])
 
 
-def scan_solves(scans: Mapping, chain: Callable[[str, str], list[str]]) -> SolvesOf:
+def scan_solves(
+    scans: Mapping, chain: Callable[[str, str], list[str]], refined: int = 0
+) -> SolvesOf:
     """A scan job's solves for the timing model: its scene on its sphere at each value of
-    ``chain(sphere, scan)``."""
+    ``chain(sphere, scan)``, and, at most, ``refined`` values more and the model error's
+    coarser solve (docs/study.md §1), each costed as the grid's middle value: an upper bound,
+    so that a cluster's time limit holds the refined scan too."""
 
     def solves_of(wildcards):
         scan = scans[wildcards.scan]
+        values = chain(wildcards.sphere, wildcards.scan)
+        middle = sorted(values, key=float)[len(values) // 2]
         return [
             (scan["scene"], wildcards.sphere, scan["parameter"], value)
-            for value in chain(wildcards.sphere, wildcards.scan)
+            for value in [*values, *[middle] * (refined + 1)]
         ]
 
     return solves_of
