@@ -6,7 +6,8 @@ solved values close about each target, not off an interpolation across a coarse 
 
 Each round judges the values solved so far
 (:func:`amontons.simulate.scan_best.best_scan_value`) and solves each target that no solved
-value lies within half the allowed movement of (rounded to its 4-digit folder label); and,
+value lies within half the allowed movement of (rounded to its 4-digit folder label; after
+the first round, only the targets the last round still moved by more than allowed); and,
 where an end of the interval lies next to a value whose contact left the window (no χ² to
 interpolate), bisects between the two until they lie within the allowed movement.
 ``max_values`` bounds the cost; a scan that reaches it says so, with how far each target
@@ -35,11 +36,14 @@ from amontons.simulate.scan_grid import value_label
 __all__ = ["Refinement", "gap_values", "movement_ln", "refine_scan", "target_values"]
 
 
-def target_values(best: ScanBest, solved: Sequence[float], near_ln: float) -> list[float]:
-    """Each target of ``best`` (its estimate and closed ends) with no solved value within
-    ``near_ln`` in ln v, rounded to its folder label."""
+def target_values(
+    best: ScanBest, solved: Sequence[float], near_ln: float, names: Sequence[str] | None = None
+) -> list[float]:
+    """Each target of ``best`` (its estimate and closed ends; only those ``names``, where
+    given) with no solved value within ``near_ln`` in ln v, rounded to its folder label."""
     done = np.log(np.asarray(solved, dtype=float))
-    values = [float(value_label(t)) for t in best_targets(best).values()]
+    targets = best_targets(best)
+    values = [float(value_label(t)) for n, t in targets.items() if names is None or n in names]
     return [v for v in values if np.min(np.abs(done - np.log(v))) > near_ln]
 
 
@@ -142,10 +146,12 @@ def refine_scan(
         allowed = fraction * interval_width_ln(best, solved)
         unsolvable = [p.value for p in points if not np.all(np.isfinite(p.residuals))]
         proposals = gap_values(best, solved, allowed / 2, unsolvable)
-        if before is not None:
-            moved = movement_ln(before, best)
-        if before is None or any(m > allowed for m in moved.values()):
+        if before is None:
             proposals += target_values(best, solved, allowed / 2)
+        else:  # only the targets the last round still moved by more than allowed
+            moved = movement_ln(before, best)
+            moving = [name for name, m in moved.items() if m > allowed]
+            proposals += target_values(best, solved, allowed / 2, moving)
         done = {float(value_label(v)) for v in solved}
         proposals = sorted(set(proposals) - done)
         if not proposals:
