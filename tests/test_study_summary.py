@@ -43,6 +43,10 @@ def _row(model, source, exponent, ratio=1.0, parameter=None, **scan):
         **MEASURED,
         "exponent_difference": exponent - MEASURED["measured_exponent"],
         "area_ratio_largest": ratio,
+        "chi2_best": scan.get("chi2_best"),
+        "chi2_elastic_end": scan.get("chi2_elastic_end"),
+        "chi2_rise": 10.128 if "chi2_best" in scan else None,
+        "n_loads": 5 if "chi2_best" in scan else None,
     }
 
 
@@ -64,6 +68,8 @@ def models_table() -> pd.DataFrame:
                 estimate=178.9,
                 low=178.9,
                 high=194.4,
+                chi2_best=40.0,
+                chi2_elastic_end=60.0,
             ),
             _row(
                 "hardening",
@@ -75,6 +81,8 @@ def models_table() -> pd.DataFrame:
                 estimate=5.26,
                 low=4.61,
                 high=float("nan"),
+                chi2_best=2.0,
+                chi2_elastic_end=50.0,
             ),
         ]
     )
@@ -191,3 +199,16 @@ def test_a_failed_sphere_is_named_on_the_first_page_and_in_the_summary():
     text = summary_markdown("small", "measured data", None, None, [], [reason], [failed])
     assert f"## Failed: held out of every table and figure\n\n- {failed}\n\n## What" in text
     assert "Failed" not in summary_markdown("small", "measured data", None, None, [], [reason])
+
+
+def test_the_verdict_table_states_the_decision_by_the_areas():
+    """The sphere's k scan fits (χ² 2), its p_Y scan and both elastic ends do not (38 and 48
+    above it, beyond F(1, 3)'s 10.1): contact hardening is named, beside the exponent's
+    verdict."""
+    verdict = pd.DataFrame(verdict_rows(models_table(), "PS", "models.csv"))
+    assert verdict.loc[0, "decided"] == "hardening"
+    assert verdict.loc[0, "k_chi2_best"] == 2.0 and verdict.loc[0, "p_y_chi2_elastic_end"] == 60
+    lines = {line[0]: line[1:] for line in display_rows(verdict, 0.95)}
+    assert lines["decided by the areas at every load (95%, scatter and model error)"] == [
+        "contact hardening only"
+    ]

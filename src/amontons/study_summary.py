@@ -22,6 +22,7 @@ import pandas as pd
 
 from amontons.config.scenes import SCAN_MODELS
 from amontons.simulate.scan_record import (
+    JUDGEMENT_COLUMNS,
     NOT_DECIDED,
     NOT_DECIDED_SOURCE,
     PARAMETER_SYMBOLS,
@@ -29,6 +30,7 @@ from amontons.simulate.scan_record import (
     is_decided,
     significant,
 )
+from amontons.study_decision import Decision, decide
 
 # The models of the verdict, in the order the study discusses them (docs/study.md §4), and
 # how a reader names them.
@@ -55,6 +57,7 @@ MODEL_TABLE_COLUMNS = (
     "measured_ci_low",
     "measured_ci_high",
     "area_ratio_largest",
+    *JUDGEMENT_COLUMNS.values(),
 )
 # verdict.csv's column stem of a scanned parameter.
 PARAMETER_STEMS = {"k_mpa_per_nm": "k", "p_y_mpa": "p_y"}
@@ -138,11 +141,32 @@ def verdict_rows(table: pd.DataFrame, material: str, source: str) -> list[dict]:
                 ("low", "estimate_low"),
                 ("high", "estimate_high"),
                 ("grid_best", "value"),
+                ("chi2_best", "chi2_best"),
+                ("chi2_elastic_end", "chi2_elastic_end"),
             ):
                 row[f"{stem}_{column}"] = _cell(chosen[key]) if scanned else None
         row["matching"] = ";".join(matching_models(row))
+        decision = model_decision(row, own)
+        row["decided"] = ";".join(decision.kept)
+        row["decided_why"] = decision.why
         rows.append(row)
     return rows
+
+
+def model_decision(row: Mapping, own: pd.DataFrame) -> Decision:
+    """The decision between the models a verdict row's scans judged
+    (:func:`amontons.study_decision.decide`), from their χ² columns (``own``: the sphere's
+    model-table rows, for the quantile and the loads)."""
+    best, elastic_end = {}, {}
+    for model, parameter in MODEL_PARAMETERS.items():
+        stem = PARAMETER_STEMS[parameter]
+        if _present(row[f"{stem}_chi2_best"]):
+            best[model] = row[f"{stem}_chi2_best"]
+            elastic_end[model] = row[f"{stem}_chi2_elastic_end"]
+    judged = own[own["chi2_rise"].notna()] if "chi2_rise" in own else own.iloc[0:0]
+    if judged.empty:
+        return decide({}, {}, float("nan"), 0)
+    return decide(best, elastic_end, judged["chi2_rise"].iloc[0], int(judged["n_loads"].iloc[0]))
 
 
 def verdict_table(tables: Mapping[str, str]) -> pd.DataFrame:
@@ -205,6 +229,18 @@ def verdict_text(row: Mapping) -> str:
     return f"{', '.join(matching)}: not decided"
 
 
+def decided_text(row: Mapping) -> str:
+    """The decision by the areas at every load, in words: the one model the data name, or
+    'not decided' with the models they cannot tell apart (an empty cell: no scan judged)."""
+    cell = row.get("decided")
+    kept = [MODELS[m] for m in cell.split(";") if m] if isinstance(cell, str) else []
+    if not kept:
+        return "no scan judged"
+    if len(kept) == 1:
+        return f"{kept[0]} only"
+    return f"not decided: {', '.join(kept)}"
+
+
 def display_rows(verdict: pd.DataFrame, confidence: float) -> list[list[str]]:
     """The verdict as a reader's table: a header of spheres, then one line per quantity
     (measured exponent, each model, each scanned parameter, the verdict)."""
@@ -242,6 +278,12 @@ def display_rows(verdict: pd.DataFrame, confidence: float) -> list[list[str]]:
         [
             f"exponent inside the measured {confidence:.0%} interval",
             *(verdict_text(r) for r in records),
+        ]
+    )
+    lines.append(
+        [
+            f"decided by the areas at every load ({confidence:.0%}, scatter and model error)",
+            *(decided_text(r) for r in records),
         ]
     )
     return lines
@@ -407,6 +449,14 @@ def model_headlines(row: Mapping, verdict_path: str, models_path: str) -> list[H
                 f"`{verdict_path}`: sphere {row['sphere']}, columns {model}_exponent, "
                 f"{model}_exponent_difference, {model}_area_ratio (from `{models_path}`, row "
                 f"{row[f'{model}_source']!r})",
+            )
+        )
+    if isinstance(row.get("decided"), str) and row["decided"]:
+        out.append(
+            Headline(
+                f"{row['sphere']}: decided by the areas at every load",
+                f"{decided_text(row)}: {row['decided_why']}",
+                f"`{verdict_path}`: sphere {row['sphere']}, columns decided, decided_why",
             )
         )
     return out

@@ -83,6 +83,17 @@ class ScanBest:
     confidence: float
     rise: float
     at_scan_edge: bool
+    chi2_min_measured: float = float("nan")
+    elastic_end: float = float("nan")
+    chi2_elastic_end: float = float("nan")
+    chi2_elastic_end_measured: float = float("nan")
+
+    @property
+    def elastic_excluded(self) -> bool:
+        """Whether the data exclude the scan's elastic end (its highest value: the most
+        nearly elastic contact it solved) against its best value, at the interval's
+        confidence."""
+        return bool(self.chi2_elastic_end - self.chi2_min > self.rise)
 
     def to_record(self) -> dict:
         """best.json's judgement: the scan's estimate inside its own interval first, then the
@@ -97,6 +108,11 @@ class ScanBest:
             "distance": self.distance,
             "chi2_min": self.chi2_min,
             "chi2_rise": self.rise,
+            "chi2_min_measured_sd": self.chi2_min_measured,
+            "elastic_end": self.elastic_end,
+            "chi2_elastic_end": self.chi2_elastic_end,
+            "chi2_elastic_end_measured_sd": self.chi2_elastic_end_measured,
+            "elastic_excluded": self.elastic_excluded,
             "measured_log_area_sd": self.scatter_sd,
             "log_area_sd_used": self.scatter_sd_used,
             "n_loads": self.n_loads,
@@ -112,6 +128,10 @@ class ScanBest:
             "grid_best_definition": "the coarse grid's value of least chi2 (also `best`); "
             "distance, iou_largest, area_ratio_largest, best_loads and best_rendered_fit are "
             "its, and it may lie outside interval, which belongs to the estimate",
+            "elastic_end_definition": "the scan's highest solved value, its most nearly "
+            "elastic contact: elastic_excluded where its chi2 lies above chi2_min by more than "
+            "chi2_rise; the *_measured_sd chi2 are taken under the measured scatter, before "
+            "the Birge ratio: the verdict compares the models by them",
             "interval_definition": "values whose chi2 lies within chi2_rise (the F(1, n - 2) "
             "quantile at `confidence`) of its minimum; s the residual sd of the measured ln "
             "areas about their power-law fit, inflated by the Birge ratio where the best value "
@@ -192,14 +212,15 @@ def _neighbours(values: np.ndarray, target: float) -> tuple[float | None, float 
 
 def chi2_of_points(
     points: Sequence[ScanPoint], criterion: Criterion
-) -> tuple[np.ndarray, float, int]:
-    """(χ² of every point, in the order of ``points``; the random part it was taken with,
-    Birge-inflated at the best point; the index of least χ²)."""
+) -> tuple[np.ndarray, np.ndarray, float, int]:
+    """(χ² of every point, in the order of ``points``, under the random part Birge-inflated at
+    the best point, and under the measured scatter; that random part; the index of least
+    χ²)."""
     floor = max(criterion.scatter_sd, SD_FLOOR)
-    first = np.array([criterion.chi2(p.residuals, floor) for p in points])
-    best = _best_index(first, points, range(len(points)))
+    measured = np.array([criterion.chi2(p.residuals, floor) for p in points])
+    best = _best_index(measured, points, range(len(points)))
     sd = criterion.random_sd_used(points[best].residuals)
-    return np.array([criterion.chi2(p.residuals, sd) for p in points]), sd, best
+    return np.array([criterion.chi2(p.residuals, sd) for p in points]), measured, sd, best
 
 
 def best_scan_value(
@@ -213,7 +234,7 @@ def best_scan_value(
     point is the grid's)."""
     points = sorted(points, key=lambda p: p.value)
     values = np.array([p.value for p in points])
-    chi2, sd, best = chi2_of_points(points, criterion)
+    chi2, measured, sd, best = chi2_of_points(points, criterion)
     rise = criterion.rise(confidence)
     low, high, refined = _profile_interval(np.log(values), chi2, best, rise)
     coarse = None if grid is None else {float(g) for g in grid}
@@ -238,6 +259,10 @@ def best_scan_value(
         confidence=float(confidence),
         rise=rise,
         at_scan_edge=grid_best in (on_grid[0], on_grid[-1]),
+        chi2_min_measured=float(measured[best]),
+        elastic_end=float(values[-1]),
+        chi2_elastic_end=float(chi2[-1]),
+        chi2_elastic_end_measured=float(measured[-1]),
     )
 
 

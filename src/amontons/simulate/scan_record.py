@@ -30,14 +30,32 @@ def not_decided_note(best: Mapping) -> str:
     return "no load in the scan" if held_no_load(best) else "too few loads to judge"
 
 
+# best.json's numbers the verdict judges the models by (docs/study.md §6), as model-table
+# columns of a scan's row: χ² under the measured scatter at the best value and at the scan's
+# elastic end, the quantile's rise and the loads it counts.
+JUDGEMENT_COLUMNS = {
+    "chi2_min_measured_sd": "chi2_best",
+    "chi2_elastic_end_measured_sd": "chi2_elastic_end",
+    "chi2_rise": "chi2_rise",
+    "n_loads": "n_loads",
+}
+
+
 def estimate_columns(best: Mapping | None) -> dict:
-    """A scan's estimate and the interval that belongs to it, as model-table columns, from its
-    best.json record (``None``, for a scene's row, or a scan not decided: empty columns). The
-    interval's ends are ``None`` where it is open at the scan's end."""
+    """A scan's estimate and the interval that belongs to it, and the χ² the verdict judges
+    by (:data:`JUDGEMENT_COLUMNS`), as model-table columns, from its best.json record
+    (``None``, for a scene's row, or a scan not decided: empty columns). The interval's ends
+    are ``None`` where it is open at the scan's end."""
     if best is None or not is_decided(best):
-        return {"estimate": None, "estimate_low": None, "estimate_high": None}
+        empty = ("estimate", "estimate_low", "estimate_high", *JUDGEMENT_COLUMNS.values())
+        return dict.fromkeys(empty)
     low, high = best["interval"]
-    return {"estimate": best["estimate"], "estimate_low": low, "estimate_high": high}
+    return {
+        "estimate": best["estimate"],
+        "estimate_low": low,
+        "estimate_high": high,
+        **{column: best[key] for key, column in JUDGEMENT_COLUMNS.items()},
+    }
 
 
 def significant(value: float, digits: int = 3) -> str:
