@@ -2,14 +2,15 @@
 criterion of :mod:`amontons.simulate.scan_criterion` (χ² of the log-area residuals, counting
 the measured scatter and the model's error), the estimate and its interval.
 
-* **The interval**: the values whose χ² lies within the criterion's quantile (F(1, n − 2))
-  above its minimum. Near the best solved value χ² is the parabola in ln v through it and its
-  two solved neighbours (its vertex is the ``refined`` value, the scan's **estimate**);
-  beyond them it is interpolated linearly in ln v between solved values. Read off solved
-  values only where they lie close about it: the scan job refines the grid there
-  (:mod:`amontons.simulate.scan_refine`) and :func:`interval_resolution` says how close
-  they lie. Where the interval reaches the end of the scan, that side is open (``None``):
-  the data bound the parameter on one side only, and the record states a bound.
+* **The interval**: the values whose χ² lies within the criterion's quantile (F(1, ν), ν the
+  parameter's degrees of freedom: n − 2 without model error) above its minimum. Near the
+  best solved value χ² is the parabola in ln v through it and its two solved neighbours (its
+  vertex is the ``refined`` value, the scan's **estimate**); beyond them it is interpolated
+  linearly in ln v between solved values. Read off solved values only where they lie close
+  about it: the scan job refines the grid there (:mod:`amontons.simulate.scan_refine`) and
+  :func:`interval_resolution` says how close they lie. Where the interval reaches the end
+  of the scan, that side is open (``None``): the data bound the parameter on one side only,
+  and the record states a bound.
 * **The grid's best**: the coarse grid's value of least χ² (the figures and the model table
   show the model there, and name it so). It need not lie inside the interval, which belongs
   to the estimate.
@@ -132,8 +133,10 @@ class ScanBest:
             "elastic contact: elastic_excluded where its chi2 lies above chi2_min by more than "
             "chi2_rise; the *_measured_sd chi2 are taken under the measured scatter, before "
             "the Birge ratio: the verdict compares the models by them",
-            "interval_definition": "values whose chi2 lies within chi2_rise (the F(1, n - 2) "
-            "quantile at `confidence`) of its minimum; s the residual sd of the measured ln "
+            "interval_definition": "values whose chi2 lies within chi2_rise (the F(1, nu) "
+            "quantile at `confidence`, nu = n - 2 without model error and more, by "
+            "Welch-Satterthwaite, as the stated model error takes a share of the parameter's "
+            "variance) of its minimum; s the residual sd of the measured ln "
             "areas about their power-law fit, inflated by the Birge ratio where the best value "
             "misses by more than s and the model error allow (log_area_sd_used); a parabola in "
             "ln(value) near the estimate, linear between solved values beyond; null: open at "
@@ -223,6 +226,18 @@ def chi2_of_points(
     return np.array([criterion.chi2(p.residuals, sd) for p in points]), measured, sd, best
 
 
+def residual_gradient(points: Sequence[ScanPoint], best: int) -> np.ndarray | None:
+    """How the residuals move per unit of ln v at the best point: the mean of its one-sided
+    differences to its solved neighbours with finite residuals (None where it has none)."""
+    here = np.asarray(points[best].residuals)
+    slopes = []
+    for j in (best - 1, best + 1):
+        if 0 <= j < len(points) and np.all(np.isfinite(points[j].residuals)):
+            step = math.log(points[j].value / points[best].value)
+            slopes.append((np.asarray(points[j].residuals) - here) / step)
+    return np.mean(slopes, axis=0) if slopes else None
+
+
 def best_scan_value(
     points: Sequence[ScanPoint],
     criterion: Criterion,
@@ -235,7 +250,7 @@ def best_scan_value(
     points = sorted(points, key=lambda p: p.value)
     values = np.array([p.value for p in points])
     chi2, measured, sd, best = chi2_of_points(points, criterion)
-    rise = criterion.rise(confidence)
+    rise = criterion.rise(confidence, residual_gradient(points, best), sd)
     low, high, refined = _profile_interval(np.log(values), chi2, best, rise)
     coarse = None if grid is None else {float(g) for g in grid}
     on_grid = [i for i, v in enumerate(values) if coarse is None or float(v) in coarse]

@@ -20,8 +20,10 @@ With σ_off = σ_slope = 0 and b = 0, χ² = n D² / σ², D the rms log-area di
 :func:`amontons.simulate.scan.log_area_distance`: the criterion of the scans before the
 model's error was counted.
 
-The interval's quantile is that of F(1, n − 2), since σ is estimated from n − 2 degrees of
-freedom (7.71 at 95 % for n = 6, 10.1 for n = 5; χ²(1)'s 3.84 only as n grows). A scan with
+The interval's quantile is that of F(1, ν): σ is estimated from n − 2 degrees of freedom
+(7.71 at 95 % for n = 6, 10.1 for n = 5), and where the model's error, whose size is stated
+rather than estimated, takes a share of the parameter's variance, ν grows by
+Welch–Satterthwaite (:meth:`Criterion.effective_dof`) towards χ²(1)'s 3.84. A scan with
 fewer than :data:`MIN_LOADS` measured loads has no σ to judge with: :class:`TooFewLoads`.
 """
 
@@ -189,8 +191,35 @@ class Criterion:
             return high
         return float(optimize.brentq(excess, sd, high, xtol=1e-300))
 
-    def rise(self, confidence: float) -> float:
-        """The rise of χ² above its minimum that bounds the interval at ``confidence``."""
+    def effective_dof(self, direction: Sequence[float] | None, random_sd: float) -> float:
+        """The degrees of freedom of the parameter's variance (Welch–Satterthwaite): n − 2
+        where all of it comes from the estimated random part, more as the model's error,
+        whose size is stated, not estimated, takes a larger share. ``direction``: how the
+        residuals move per unit of ln v at the estimate (None: alike at every load). The
+        variance of the estimate along it is V = 1 / (gᵀ C⁻¹ g), the random part's share
+        f = σ² V gᵀ C⁻² g, and ν = (n − 2) / f²."""
+        g = np.ones(self.n) if direction is None else np.asarray(direction, dtype=float)
+        if not np.all(np.isfinite(g)) or not np.any(g):
+            g = np.ones(self.n)
+        inverse_g = np.linalg.solve(self.covariance(random_sd), g)
+        variance = 1.0 / float(g @ inverse_g)
+        share = random_sd**2 * variance * float(inverse_g @ inverse_g)
+        return (self.n - 2) / min(share, 1.0) ** 2 if share > 0 else float("inf")
+
+    def rise(
+        self,
+        confidence: float,
+        direction: Sequence[float] | None = None,
+        random_sd: float | None = None,
+    ) -> float:
+        """The rise of χ² above its minimum that bounds the interval at ``confidence``: the
+        F(1, ν) quantile, ν the :meth:`effective_dof` along ``direction`` at ``random_sd``
+        (the measured scatter where None): n − 2 without model error. χ²(1)'s under the
+        ``"chi2"`` quantile."""
         if self.quantile == "chi2":
             return float(stats.chi2.ppf(confidence, 1))
-        return float(stats.f.ppf(confidence, 1, self.n - 2))
+        sd = max(self.scatter_sd, SD_FLOOR) if random_sd is None else random_sd
+        dof = self.effective_dof(direction, sd)
+        if not np.isfinite(dof) or dof > 1e6:
+            return float(stats.chi2.ppf(confidence, 1))
+        return float(stats.f.ppf(confidence, 1, dof))
