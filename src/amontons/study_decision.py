@@ -12,7 +12,7 @@ areas follow another law, or sit at another level, misses at some loads.
   model misses by more than the errors allow (χ²_min over n − 1 degrees of freedom), so that
   every model is judged under the same errors.
 - A model is **excluded** where its χ² lies above the least by more than the scans'
-  quantile (F(1, n − 2)'s rise, as for an interval). A model is **named** only where every
+  quantile (the larger of the scans' interval quantiles). A model is **named** only where every
   other model is excluded; otherwise the answer is "not decided", with the models the data
   cannot tell apart and the difference against the quantile.
 

@@ -166,7 +166,8 @@ def model_decision(row: Mapping, own: pd.DataFrame) -> Decision:
     judged = own[own["chi2_rise"].notna()] if "chi2_rise" in own else own.iloc[0:0]
     if judged.empty:
         return decide({}, {}, float("nan"), 0)
-    return decide(best, elastic_end, judged["chi2_rise"].iloc[0], int(judged["n_loads"].iloc[0]))
+    # the larger of the scans' quantiles: a model is excluded only where both would exclude it
+    return decide(best, elastic_end, judged["chi2_rise"].max(), int(judged["n_loads"].iloc[0]))
 
 
 def verdict_table(tables: Mapping[str, str]) -> pd.DataFrame:
