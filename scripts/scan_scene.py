@@ -35,6 +35,7 @@ from amontons.simulate.scan_criterion import Criterion, TooFewLoads
 from amontons.simulate.scan_grid import ScanError, value_label
 from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.scan_start import ScanStart
+from amontons.simulate.scene import SceneError
 from amontons.simulate.solve import solve_scene
 from amontons.simulate.surface import Indenter, afm_indenter, afm_scene, load_levelled_map
 
@@ -329,10 +330,11 @@ def estimate_model_error(context: ScanContext, best: Solved, rows: list[dict], j
         bias = richardson_log_bias(
             _at_measured(fine_m2, best.record), _at_measured(coarse_m2, best.record), factor
         )
-    except (ContactError, ScanError) as error:
+    except (ContactError, ScanError, SceneError) as error:
+        # a coarser grid that does not converge, does not fit the scan, or renders nothing
         log.warning("model error not measured: %s", error)
         return None, {"estimated": False, "why": str(error)}
-    psf_change = psf_log_change(context, best)
+    psf_change, psf_note = psf_log_change(context, best)
     loads = [row["load_mn"] for row in rows]
     error, record = model_error_of(loads, bias, judgement["model_error_order_sd"], psf_change)
     return error, {
@@ -341,22 +343,31 @@ def estimate_model_error(context: ScanContext, best: Solved, rows: list[dict], j
         "solver_pixel_nm": best.scene.pixel_m * 1e9,
         "coarse_pixel_nm": coarse_scene.pixel_m * 1e9,
         "coarse_wall_time_s": coarse.wall_time_s,
+        "psf": psf_note,
         **record,
     }
 
 
-def psf_log_change(context: ScanContext, best: Solved) -> list[float] | None:
+def psf_log_change(context: ScanContext, best: Solved) -> tuple[list[float] | None, str]:
     """Half the change of ln(rendered area) per load between the PSF one standard error
-    wider and one narrower (None where the PSF states no standard error)."""
+    wider and one narrower, and what was done; None where the PSF states no standard error
+    or a render loses its contact (then the PSF's share is not counted, and the note says
+    why)."""
     se_nm = read_json(context.psf_path)["fwhm_nm"].get("standard_error")
     if not se_nm:
-        return None
+        return None, "not counted: the PSF states no standard error (a FWHM from the config)"
     fwhm = context.psf_fwhm_m
     wide, narrow = (
         _at_measured(rendered_areas_m2(context, best.scene, best.solution, f), best.record)
         for f in (fwhm + se_nm * 1e-9, max(fwhm - se_nm * 1e-9, 0.5 * fwhm))
     )
-    return [0.5 * math.log(w / n) for w, n in zip(wide, narrow, strict=True)]
+    if min(wide + narrow) <= 0:
+        return (
+            None,
+            f"not counted: a render at FWHM {fwhm * 1e9:.0f} ± {se_nm:.0f} nm lost its contact",
+        )
+    change = [0.5 * math.log(w / n) for w, n in zip(wide, narrow, strict=True)]
+    return change, f"counted: FWHM {fwhm * 1e9:.0f} ± {se_nm:.0f} nm (one standard error)"
 
 
 def judge_and_refine(context, chain, solved, best, judgement, refinement_path):
@@ -389,6 +400,11 @@ def judge_and_refine(context, chain, solved, best, judgement, refinement_path):
         criterion = replace(criterion, model_error=error)
     records = {value: result.record for value, result in solved.items()}
     starts = {value: result.start for value, result in solved.items()}
+    points = [point_from_record(r, criterion.n) for r in records.values()]
+    if not any(math.isfinite(sum(p.residuals)) for p in points):  # best_scan_value says why
+        why = "no value's contact fits the window at every load"
+        write_json(refinement_path, {"judged": False, "why": why, "refined_points": []})
+        return
     refined = []
 
     def solve(value: float):
@@ -405,7 +421,6 @@ def judge_and_refine(context, chain, solved, best, judgement, refinement_path):
         refined.append(str(folder / label / names[0]))
         return point_from_record(result.record, criterion.n)
 
-    points = [point_from_record(r, criterion.n) for r in records.values()]
     _, refinement = refine_scan(
         points,
         criterion,

@@ -167,7 +167,7 @@ def model_decision(row: Mapping, own: pd.DataFrame) -> Decision:
     if judged.empty:
         return decide({}, {}, float("nan"), 0)
     # the larger of the scans' quantiles: a model is excluded only where both would exclude it
-    return decide(best, elastic_end, judged["chi2_rise"].max(), int(judged["n_loads"].iloc[0]))
+    return decide(best, elastic_end, judged["chi2_rise"].max(), int(judged["n_loads"].min()))
 
 
 def verdict_table(tables: Mapping[str, str]) -> pd.DataFrame:

@@ -120,12 +120,21 @@ def test_richardson_recovers_a_linear_error_exactly():
 
 
 def test_the_model_error_record_corrects_its_line_and_counts_the_order():
+    """A bias that is a line in ln F is subtracted exactly; its order's uncertainty is one
+    mode that scales the whole line (order_sd of it), the PSF's another, and the line's own
+    standard errors (zero for an exact line) the offset and slope."""
     bias = np.log(1.09) + 0.01 * (np.log(LOADS_MN) - np.log(LOADS_MN).mean())
-    error, record = model_error_of(LOADS_MN, bias, order_sd=0.5)
+    psf = np.full(N, 0.004)
+    error, record = model_error_of(LOADS_MN, bias, order_sd=0.5, psf_log_change=psf)
     assert np.array(error.bias) == pytest.approx(bias, abs=1e-12)  # a line: fitted exactly
-    assert error.offset_sd == pytest.approx(0.5 * np.log(1.09), rel=1e-9)
-    assert error.slope_sd == pytest.approx(0.005, rel=1e-6)
+    assert error.offset_sd == pytest.approx(0.0, abs=1e-12)
+    assert np.array(error.modes[0]) == pytest.approx(0.5 * bias, abs=1e-12)
+    assert np.array(error.modes[1]) == pytest.approx(psf, abs=1e-12)
     assert record["pixel_bias_line"]["slope"] == pytest.approx(0.01, rel=1e-9)
+    # the mode is fully correlated: C adds 0.25 b bᵀ, not independent offset and slope
+    criterion = Criterion(tuple(LOADS_MN), 0.03, error)
+    expected = 0.03**2 * np.eye(N) + 0.25 * np.outer(bias, bias) + np.outer(psf, psf)
+    assert criterion.covariance(0.03) == pytest.approx(expected, abs=1e-15)
     line = shared_line(LOADS_MN, [1.0, 2.0, 1.0, 2.0, 1.0])
     assert line.offset_se > 0 and line.slope_se > 0
 
@@ -164,10 +173,11 @@ def test_refinement_resolves_an_estimate_the_parabola_misplaces():
 
 
 def test_an_end_next_to_a_value_whose_contact_leaves_the_window_is_bisected():
-    """Below 150 every value's contact leaves the window (no χ²), and χ² rises steeply
-    above the truth 160: the coarse interval's low end sits on the lowest solvable value
-    (its crossing with an infinite χ² is not interpolated). Refinement bisects between them
-    until they lie within the allowed movement: the low end then lies within that of 150."""
+    """Below 150 every value's contact leaves the window (no χ²), and χ² rises slowly below
+    the truth 160: the crossing lies somewhere between the lowest solvable grid value and the
+    unsolvable one below it, so the coarse interval keeps the whole step (its low end at the
+    unsolvable value: wider, never narrower). Refinement bisects the step until the two lie
+    within the allowed movement: the low end then lies within that below 150."""
     measured = 40 * LOADS_MN**0.85
 
     def simulate(v):
@@ -178,13 +188,25 @@ def test_an_end_next_to_a_value_whose_contact_leaves_the_window_is_bisected():
     criterion = Criterion(tuple(LOADS_MN), 0.02, ModelError.none(N))
     grid = [simulate(v) for v in scan_values(100.0, [0.2, 4.0], 7)]
     coarse = best_scan_value(grid, criterion, 0.95)
-    assert coarse.scatter_low == 242.8  # the lowest solvable grid value (147.4 is not)
+    assert coarse.scatter_low == pytest.approx(147.4)  # 242.8: the lowest solvable grid value
     points, refinement = refine_scan(grid, criterion, 0.95, simulate, 0.1, 12)
     fine = best_scan_value(points, criterion, 0.95, [p.value for p in grid])
     print(fine, refinement)
     assert refinement.resolved and len(refinement.values) <= 12
-    assert 150.0 <= fine.scatter_low <= 150.0 * math.exp(refinement.allowed_ln)
+    assert 150.0 * math.exp(-refinement.allowed_ln) <= fine.scatter_low < 150.0
     assert _inside(160.0, fine)
+    assert refinement.to_record()["resolved"]
+
+
+def test_a_refinement_switched_off_says_the_interval_is_not_resolved():
+    measured = 40 * LOADS_MN**0.85
+    grid = [
+        _point(v, measured * (v / 100.0) ** 0.3, measured) for v in scan_values(80.0, [0.2, 4.0], 7)
+    ]
+    criterion = Criterion(tuple(LOADS_MN), 0.02, ModelError.none(N))
+    points, refinement = refine_scan(grid, criterion, 0.95, lambda v: None, 0.1, 0)
+    assert points == grid and refinement.values == () and not refinement.resolved
+    assert refinement.stopped.startswith("refinement off")
 
 
 def _coverage(trials, offset_sd, slope_sd, count_model_error, seed):

@@ -46,13 +46,14 @@ def _parabolic_points(values, true_value, slope, offset, rng, n_loads):
     return points
 
 
-@pytest.mark.parametrize(("quantile", "outside_at_least"), [("chi2", 100), ("f", 20)])
+@pytest.mark.parametrize(("quantile", "outside_at_least"), [("chi2", 100), ("f", 10)])
 def test_the_estimate_lies_inside_its_interval_on_any_scan(quantile, outside_at_least):
     """2000 random scans (truth anywhere in or beyond the grid, misfits from none to large,
     noisy distances, values outside the window, ties): the estimate is inside the interval
     every time, exactly (no tolerance: the interval is built about it), under either quantile.
     The grid's best falls outside it often under χ²(1)'s (issue 35's case); less often under
-    F(1, n - 2)'s wider one (58 of these scans), but still."""
+    F(1, n - 2)'s wider one, whose ends next to a value outside the window keep the whole step
+    (19 of these scans), but still."""
     rng = np.random.default_rng(35)
     grid_best_outside = 0
     for _ in range(2000):

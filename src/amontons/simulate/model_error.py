@@ -15,14 +15,16 @@ hardening). A coarser step, not a finer one: it costs a quarter of a solve at h,
 eight.
 
 **What stays uncertain of it, shared by every load.** The bias is fitted by a line in
-x − x̄ (x = ln F): an offset and a slope, subtracted from the residuals. What remains is the
-convergence order, which the ladder shows between about 0.6 and 1.6 (the factor 1/(2^p − 1)
-between 1.9 and 0.5): a relative standard deviation ``order_sd`` of each coefficient, added
-in quadrature to the coefficient's own standard error from the loads' scatter about the line.
+x − x̄ (x = ln F), subtracted from the residuals. What remains is, first, the convergence
+order: the ladder's errors fall 2.0–2.2× per halving of the pixel for the elastic contact
+(p ≈ 1.0–1.1) and 1.9–5× for contact hardening (p ≈ 0.9–2.3), so the factor 1/(2^p − 1) that
+p = 1 takes as 1 lies between about 1.15 and 0.25. It scales the whole bias at once: one mode
+of the covariance, ``order_sd`` times the bias line. Second, the line's own standard errors
+from the loads' scatter about it, as an offset and a slope.
 
 **The PSF's uncertainty.** The best value's solution rendered again with the PSF's FWHM one
 standard error wider and narrower: half the difference in ln area, fitted by the same line,
-adds to the offset and the slope.
+is a second mode (one parameter moves every load at once).
 
 **What it leaves out.** Below the AFM map's own pixel nothing is known: the map is the
 finest scale the model sees, and its own discretisation is not counted. Nor is the bias's
@@ -103,15 +105,6 @@ def shared_line(loads_mn: Sequence[float], values: Sequence[float]) -> SharedLin
     return SharedLine(offset, slope, float(np.sqrt(s2 / x.size)), float(np.sqrt(s2 / sxx)))
 
 
-def _uncertain(line: SharedLine, order_sd: float) -> tuple[float, float]:
-    """The offset's and the slope's standard deviations: ``order_sd`` of each, in quadrature
-    with its standard error."""
-    return (
-        float(np.hypot(order_sd * line.offset, line.offset_se)),
-        float(np.hypot(order_sd * line.slope, line.slope_se)),
-    )
-
-
 def model_error_of(
     loads_mn: Sequence[float],
     log_bias: Sequence[float],
@@ -119,22 +112,24 @@ def model_error_of(
     psf_log_change: Sequence[float] | None = None,
 ) -> tuple[ModelError, dict]:
     """The criterion's model error at ``loads_mn``: the line fitted to the pixel's bias
-    ``log_bias`` (subtracted), its uncertainty (``order_sd``, the coefficients' standard
-    errors) and, where given, the PSF's (``psf_log_change``: the change of ln area per
-    standard error of the FWHM), as shared offset and slope; and the record that says how."""
+    ``log_bias`` (subtracted); its uncertainty as one mode, ``order_sd`` times the line
+    (the convergence order scales the whole bias at once), and the line's own standard errors
+    as offset and slope; and, where given, the PSF's as a second mode (``psf_log_change``:
+    the change of ln area per standard error of the FWHM, fitted by a line). With the record
+    that says how."""
     bias = shared_line(loads_mn, log_bias)
-    offset_sd, slope_sd = _uncertain(bias, order_sd)
+    line = bias.at(loads_mn)
+    modes = [tuple(float(order_sd * b) for b in line)]
     record = {
         "pixel_bias_per_load": [float(b) for b in log_bias],
         "pixel_bias_line": {"offset": bias.offset, "slope": bias.slope},
-        "pixel_bias_sd": {"offset": offset_sd, "slope": slope_sd},
+        "pixel_bias_se": {"offset": bias.offset_se, "slope": bias.slope_se},
         "order_sd": order_sd,
     }
     if psf_log_change is not None:
         psf = shared_line(loads_mn, psf_log_change)
         record["psf_change_per_load"] = [float(c) for c in psf_log_change]
-        record["psf_sd"] = {"offset": abs(psf.offset), "slope": abs(psf.slope)}
-        offset_sd = float(np.hypot(offset_sd, psf.offset))
-        slope_sd = float(np.hypot(slope_sd, psf.slope))
-    error = ModelError(tuple(float(b) for b in bias.at(loads_mn)), offset_sd, slope_sd)
+        record["psf_line"] = {"offset": psf.offset, "slope": psf.slope}
+        modes.append(tuple(float(c) for c in psf.at(loads_mn)))
+    error = ModelError(tuple(float(b) for b in line), bias.offset_se, bias.slope_se, tuple(modes))
     return error, {**record, **error.to_record()}

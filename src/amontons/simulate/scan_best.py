@@ -155,7 +155,11 @@ def _best_index(chi2: np.ndarray, points: Sequence[ScanPoint], among: Sequence[i
 
 def _crossing(x, chi2, i, j, level) -> float:
     """Where χ² crosses ``level`` between scan points i (inside) and j (outside), linear in
-    x = ln(value)."""
+    x = ln(value); at j itself where j has no χ² (its contact left the window: the crossing
+    lies somewhere between, and the interval keeps the whole step, which refinement
+    bisects)."""
+    if not np.isfinite(chi2[j]):
+        return float(np.exp(x[j]))
     f = (level - chi2[i]) / (chi2[j] - chi2[i])
     return float(np.exp(x[i] + f * (x[j] - x[i])))
 
@@ -221,9 +225,13 @@ def chi2_of_points(
     χ²)."""
     floor = max(criterion.scatter_sd, SD_FLOOR)
     measured = np.array([criterion.chi2(p.residuals, floor) for p in points])
-    best = _best_index(measured, points, range(len(points)))
-    sd = criterion.random_sd_used(points[best].residuals)
-    return np.array([criterion.chi2(p.residuals, sd) for p in points]), measured, sd, best
+    sd = criterion.random_sd_used(
+        points[_best_index(measured, points, range(len(points)))].residuals
+    )
+    chi2 = np.array([criterion.chi2(p.residuals, sd) for p in points])
+    # the least under the covariance the interval is read with: a shared error can reorder
+    # the values between the measured scatter and the inflated one
+    return chi2, measured, sd, _best_index(chi2, points, range(len(points)))
 
 
 def residual_gradient(points: Sequence[ScanPoint], best: int) -> np.ndarray | None:
@@ -274,7 +282,7 @@ def best_scan_value(
         confidence=float(confidence),
         rise=rise,
         at_scan_edge=grid_best in (on_grid[0], on_grid[-1]),
-        chi2_min_measured=float(measured[best]),
+        chi2_min_measured=float(np.min(measured)),
         elastic_end=float(values[-1]),
         chi2_elastic_end=float(chi2[-1]),
         chi2_elastic_end_measured=float(measured[-1]),

@@ -5,7 +5,7 @@ model's own error as shared by every load.
 With x_i = ln F_i and r_i(v) = ln A_sim,i(v) − b_i − ln A_meas,i over the n loads where the
 measured image shows a contact,
 
-    C = σ² I + σ_off² 1 1ᵀ + σ_slope² (x − x̄)(x − x̄)ᵀ,        χ²(v) = r(v)ᵀ C⁻¹ r(v)
+    C = σ² I + σ_off² 1 1ᵀ + σ_slope² (x − x̄)(x − x̄)ᵀ + Σ_k u_k u_kᵀ,   χ²(v) = rᵀ C⁻¹ r
 
 * σ, the random part: the residual standard deviation of the measured ln areas about their
   own power-law line (n − 2 degrees of freedom), what even a perfect model would miss each
@@ -13,8 +13,9 @@ measured image shows a contact,
 * b_i, the model's bias in ln area, known with its sign (the solver pixel's discretisation,
   :mod:`amontons.simulate.model_error`): subtracted, so that a biased model is corrected,
   not only widened.
-* σ_off and σ_slope, what remains uncertain of the model's error, shared by every load (an
-  offset, and a slope in ln F): they do not average down with n.
+* σ_off, σ_slope and the modes u_k, what remains uncertain of the model's error, shared by
+  every load (an offset, a slope in ln F, and errors whose whole shape over the loads moves
+  at once): they do not average down with n.
 
 With σ_off = σ_slope = 0 and b = 0, χ² = n D² / σ², D the rms log-area distance of
 :func:`amontons.simulate.scan.log_area_distance`: the criterion of the scans before the
@@ -83,13 +84,16 @@ def log_area_scatter(loads: Sequence[float], areas: Sequence[float]) -> float:
 @dataclass(frozen=True)
 class ModelError:
     """The model's error in ln(rendered area), per load of the criterion: the bias ``bias``
-    (known with its sign, subtracted from the residuals), and the standard deviations of
-    what remains uncertain, shared by every load: ``offset_sd`` (the same at every load) and
-    ``slope_sd`` (per unit of ln F about the loads' mean)."""
+    (known with its sign, subtracted from the residuals), and what remains uncertain of it,
+    shared by every load: ``offset_sd`` (the same at every load), ``slope_sd`` (per unit of
+    ln F about the loads' mean) and ``modes``, vectors over the loads each of whose whole
+    shape is uncertain at one standard deviation (one error that moves every load at once,
+    such as the convergence order's scaling of the bias: a rank-one term u uᵀ of C)."""
 
     bias: tuple[float, ...]
     offset_sd: float
     slope_sd: float
+    modes: tuple[tuple[float, ...], ...] = ()
 
     @classmethod
     def none(cls, n: int) -> ModelError:
@@ -98,13 +102,15 @@ class ModelError:
 
     @classmethod
     def from_record(cls, record: Mapping) -> ModelError:
-        return cls(tuple(record["bias"]), record["offset_sd"], record["slope_sd"])
+        modes = tuple(tuple(mode) for mode in record.get("modes", []))
+        return cls(tuple(record["bias"]), record["offset_sd"], record["slope_sd"], modes)
 
     def to_record(self) -> dict:
         return {
             "bias": list(self.bias),
             "offset_sd": self.offset_sd,
             "slope_sd": self.slope_sd,
+            "modes": [list(mode) for mode in self.modes],
         }
 
 
@@ -122,10 +128,10 @@ class Criterion:
     def __post_init__(self):
         if len(self.loads_mn) < MIN_LOADS:
             raise TooFewLoads(self.loads_mn)
-        if len(self.model_error.bias) != len(self.loads_mn):
+        sizes = {len(self.model_error.bias), *(len(m) for m in self.model_error.modes)}
+        if sizes != {len(self.loads_mn)}:
             raise ScanError(
-                f"model error for {len(self.model_error.bias)} loads; the criterion has "
-                f"{len(self.loads_mn)}"
+                f"model error for {sorted(sizes)} loads; the criterion has {len(self.loads_mn)}"
             )
         if self.quantile not in QUANTILES:
             raise ScanError(f"quantile = {self.quantile!r}; expected one of {QUANTILES}")
@@ -149,13 +155,15 @@ class Criterion:
         return len(self.loads_mn)
 
     def covariance(self, random_sd: float) -> np.ndarray:
-        """C: the random part ``random_sd``² on the diagonal and the model's shared offset
-        and slope (ln area²)."""
+        """C: the random part ``random_sd``² on the diagonal and the model's shared offset,
+        slope and modes (ln area²)."""
         x = np.log(np.asarray(self.loads_mn))
         centred = x - x.mean()
-        shared = self.model_error.offset_sd**2 * np.ones(
-            (self.n, self.n)
-        ) + self.model_error.slope_sd**2 * np.outer(centred, centred)
+        error = self.model_error
+        shared = error.offset_sd**2 * np.ones((self.n, self.n))
+        shared += error.slope_sd**2 * np.outer(centred, centred)
+        for mode in error.modes:
+            shared += np.outer(mode, mode)
         return random_sd**2 * np.eye(self.n) + shared
 
     def corrected(self, residuals: Sequence[float]) -> np.ndarray:

@@ -50,19 +50,17 @@ def target_values(
 def gap_values(
     best: ScanBest, solved: Sequence[float], near_ln: float, unsolvable: Sequence[float]
 ) -> list[float]:
-    """Where an end of the interval lies next to a value whose contact left the window
-    (``unsolvable``: χ² infinite, so the crossing between them is not interpolated but lies
-    somewhere between), the value halfway between the two in ln v, while they lie more than
-    ``2 near_ln`` apart."""
+    """Where an end of the interval lies at a value whose contact left the window
+    (``unsolvable``: no χ², so the crossing lies somewhere between it and the solved value
+    inside, and the interval keeps the whole step), the value halfway between the two in
+    ln v, while they lie more than ``2 near_ln`` apart."""
     values = []
     for end, step in ((best.scatter_low, -1), (best.scatter_high, +1)):
-        outer = _outer_neighbour(solved, end, step)
-        if (
-            outer is not None
-            and outer in set(unsolvable)
-            and abs(np.log(outer / end)) > 2 * near_ln
-        ):
-            values.append(float(value_label(np.sqrt(outer * end))))
+        if end is None or not any(abs(math.log(v / end)) <= 1e-9 for v in unsolvable):
+            continue
+        inner = _outer_neighbour(solved, end, -step)
+        if inner is not None and abs(math.log(end / inner)) > 2 * near_ln:
+            values.append(float(value_label(math.sqrt(inner * end))))
     return values
 
 
@@ -101,13 +99,15 @@ class Refinement:
 
     @property
     def resolved(self) -> bool:
-        return self.stopped != MAX_VALUES
+        return self.stopped in (CONVERGED, AT_SOLVED, NEAR_SOLVED)
 
     def to_record(self) -> dict:
+        # an end that opened or closed moved without bound: null, not an infinite number
+        moved = {k: (m if math.isfinite(m) else None) for k, m in self.movement_ln.items()}
         return {
             "refined_values": list(self.values),
             "rounds": self.rounds,
-            "last_movement_ln": self.movement_ln,
+            "last_movement_ln": moved,
             "allowed_movement_ln": self.allowed_ln,
             "resolution": self.resolution,
             "stopped": self.stopped,
@@ -120,7 +120,12 @@ CONVERGED = (
     "end lies next to an unsolvable value further than that"
 )
 AT_SOLVED = "every target lies at or near a solved value"
+NEAR_SOLVED = (
+    "the targets the last round still moved lie within half the allowed movement of a solved "
+    "value: the interpolation about them cannot move them further than that"
+)
 MAX_VALUES = "max_values reached before the targets stopped moving"
+OFF = "refinement off (max_values 0): the interval is read off the coarse grid"
 
 
 def refine_scan(
@@ -155,10 +160,11 @@ def refine_scan(
         done = {float(value_label(v)) for v in solved}
         proposals = sorted(set(proposals) - done)
         if not proposals:
-            stopped = CONVERGED if before is not None else AT_SOLVED
+            still = before is not None and any(m > allowed for m in moved.values())
+            stopped = NEAR_SOLVED if still else CONVERGED if before is not None else AT_SOLVED
             break
         if len(added) + len(proposals) > max_values:
-            stopped = MAX_VALUES
+            stopped = OFF if max_values == 0 else MAX_VALUES
             break
         for value in proposals:
             points.append(solve(value))
