@@ -144,6 +144,7 @@ def refine_scan(
     added: list[float] = []
     before = None
     moved: dict[str, float] = {}
+    moving: list[str] = []
     rounds = 0
     while True:
         best = best_scan_value(points, criterion, confidence, grid)
@@ -153,14 +154,15 @@ def refine_scan(
         proposals = gap_values(best, solved, allowed / 2, unsolvable)
         if before is None:
             proposals += target_values(best, solved, allowed / 2)
-        else:  # only the targets the last round still moved by more than allowed
+        else:  # only the targets the last round still moved by more than allowed (an end
+            # that opened is a bound now, with nothing to solve)
             moved = movement_ln(before, best)
-            moving = [name for name, m in moved.items() if m > allowed]
+            moving = [n for n, m in moved.items() if m > allowed and n in best_targets(best)]
             proposals += target_values(best, solved, allowed / 2, moving)
         done = {float(value_label(v)) for v in solved}
         proposals = sorted(set(proposals) - done)
         if not proposals:
-            still = before is not None and any(m > allowed for m in moved.values())
+            still = before is not None and bool(moving)
             stopped = NEAR_SOLVED if still else CONVERGED if before is not None else AT_SOLVED
             break
         if len(added) + len(proposals) > max_values:
