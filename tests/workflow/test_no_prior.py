@@ -66,7 +66,7 @@ def test_a_scan_without_prior_finds_what_the_scan_about_the_prior_finds(
     free = pd.read_csv(
         project / "results" / SMALL / "PS" / "PS-noprior" / "scans" / scan / "scan.csv"
     )
-    values = free["value"].to_numpy()
+    values = free[~free["refined"]]["value"].to_numpy()  # the grid's, not refinement's
     step = math.log(values[1] / values[0])
     config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["scans"][scan]
     assert len(values) == config["prior_free_steps"]
