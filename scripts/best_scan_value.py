@@ -11,13 +11,13 @@ from amontons.io.files import read_json, write_json, write_table
 from amontons.runlog import run_logged
 from amontons.simulate.scan_best import (
     best_scan_value,
+    criterion_of_record,
     interval_resolution,
-    measured_rows,
     not_decided_record,
     point_from_record,
     too_few_loads_record,
 )
-from amontons.simulate.scan_criterion import Criterion, ModelError, TooFewLoads
+from amontons.simulate.scan_criterion import ModelError, TooFewLoads
 from amontons.simulate.scan_grid import ScanError
 from amontons.simulate.scan_record import NOT_DECIDED
 
@@ -47,20 +47,6 @@ def write_not_decided(records: list[dict], table_path: str, best_path: str, scan
     write_json(best_path, best)
 
 
-def criterion_of(record: dict, model_error: dict | None) -> Criterion:
-    """The criterion of a solved value's measured loads (every solved value has the same),
-    with the model's error where the scan job measured it."""
-    rows = measured_rows(record)
-    error = (
-        ModelError.from_record(model_error)
-        if model_error is not None and model_error.get("estimated")
-        else None
-    )
-    return Criterion.of_measured(
-        [row["load_mn"] for row in rows], [row["measured_area_um2"] for row in rows], error
-    )
-
-
 def main(
     point_paths: list[str],
     refinement_path: str,
@@ -83,8 +69,10 @@ def main(
             "the contact leaves the base scene's window; expected a range_factor whose values "
             "give contacts that fit (or a larger window_factor)"
         )
+    model_error = judgement.get("model_error") or {}
+    error = ModelError.from_record(model_error) if model_error.get("estimated") else None
     try:
-        criterion = criterion_of(solved[0], judgement.get("model_error"))
+        criterion = criterion_of_record(solved[0], error)
     except TooFewLoads as error:
         best = {
             "scan": scan_name,

@@ -30,8 +30,8 @@ from amontons.simulate.model_error import model_error_of, richardson_log_bias
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
-from amontons.simulate.scan_best import measured_rows, point_from_record
-from amontons.simulate.scan_criterion import Criterion, TooFewLoads
+from amontons.simulate.scan_best import criterion_of_record, point_from_record
+from amontons.simulate.scan_criterion import TooFewLoads
 from amontons.simulate.scan_grid import ScanError, value_label
 from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.scan_start import ScanStart
@@ -137,12 +137,14 @@ class ScanContext:
 @dataclass
 class Solved:
     """One value solved: its result (scan_point.json), the next value's start, and where its
-    contact fit the window, its scene and solution (what the model's error is measured on)."""
+    contact fit the window, its scene, solution and rendered areas (what the model's error is
+    measured on)."""
 
     record: dict
     start: ScanStart
     scene: object = None
     solution: object = None
+    rendered_m2: tuple[float, ...] = ()  # each load's rendered Otsu area (m²), in its order
 
     @property
     def distance(self) -> float:
@@ -279,7 +281,7 @@ def solve_value(
         indenter.spacing_m,
         indenter.centre_in_scan_m,
     )
-    return Solved(record, start, scene, solution)
+    return Solved(record, start, scene, solution, tuple(r.simulated_area_m2 for r in rows))
 
 
 def rendered_areas_m2(context: ScanContext, scene, solution, psf_fwhm_m: float) -> list[float]:
@@ -306,11 +308,12 @@ def _at_measured(values: list[float], record: dict) -> list[float]:
     ]
 
 
-def estimate_model_error(context: ScanContext, best: Solved, rows: list[dict], judgement: dict):
+def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement: dict):
     """The model's error at the best solved value (amontons.simulate.model_error): the solver
     pixel's bias from a solve ``model_error_pixel_factor`` times coarser, and the PSF's
-    uncertainty from renders one standard error wider and narrower. Returns the error and
-    its record; (None, why) where it cannot be measured, which the record then says."""
+    uncertainty from renders one standard error wider and narrower, at the criterion's loads
+    ``loads_mn``. Returns the error and its record; (None, why) where it cannot be measured,
+    which the record then says."""
     factor = judgement["model_error_pixel_factor"]
     coarse_scene = replace(best.scene, pixel_m=best.scene.pixel_m * factor)
     log.info(
@@ -325,18 +328,18 @@ def estimate_model_error(context: ScanContext, best: Solved, rows: list[dict], j
             threads=context.threads,
             backend=context.solver_backend,
         )
-        fine_m2 = rendered_areas_m2(context, best.scene, best.solution, context.psf_fwhm_m)
         coarse_m2 = rendered_areas_m2(context, coarse_scene, coarse, context.psf_fwhm_m)
         bias = richardson_log_bias(
-            _at_measured(fine_m2, best.record), _at_measured(coarse_m2, best.record), factor
+            _at_measured(best.rendered_m2, best.record),
+            _at_measured(coarse_m2, best.record),
+            factor,
         )
     except (ContactError, ScanError, SceneError) as error:
         # a coarser grid that does not converge, does not fit the scan, or renders nothing
         log.warning("model error not measured: %s", error)
         return None, {"estimated": False, "why": str(error)}
     psf_change, psf_note = psf_log_change(context, best)
-    loads = [row["load_mn"] for row in rows]
-    error, record = model_error_of(loads, bias, judgement["model_error_order_sd"], psf_change)
+    error, record = model_error_of(loads_mn, bias, judgement["model_error_order_sd"], psf_change)
     return error, {
         "estimated": True,
         "value": best.record["value"],
@@ -387,15 +390,13 @@ def judge_and_refine(context, chain, solved, best, judgement, refinement_path):
             },
         )
         return
-    rows = measured_rows(best.record)
-    loads = [row["load_mn"] for row in rows]
     try:
-        criterion = Criterion.of_measured(loads, [row["measured_area_um2"] for row in rows])
+        criterion = criterion_of_record(best.record)
     except TooFewLoads as error:
         log.warning("not judged, no refinement: %s", error)
         write_json(refinement_path, {"judged": False, "why": str(error), "refined_points": []})
         return
-    error, error_record = estimate_model_error(context, best, rows, judgement)
+    error, error_record = estimate_model_error(context, best, criterion.loads_mn, judgement)
     if error is not None:
         criterion = replace(criterion, model_error=error)
     records = {value: result.record for value, result in solved.items()}
@@ -470,8 +471,8 @@ def main(
             context, float(value["value"]), value["point"], value["rendered"], start
         )
         start = result.start
-        if best is None or result.distance < best.distance:
-            best = result if result.solution is not None else best
+        if result.solution is not None and (best is None or result.distance < best.distance):
+            best = result
         solved[result.record["value"]] = Solved(result.record, result.start)  # no fields kept
     judge_and_refine(context, chain, solved, best, judgement, refinement_path)
 

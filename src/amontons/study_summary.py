@@ -27,6 +27,7 @@ from amontons.simulate.scan_record import (
     NOT_DECIDED_SOURCE,
     PARAMETER_SYMBOLS,
     interval_text,
+    is_bound,
     is_decided,
     significant,
 )
@@ -163,7 +164,7 @@ def model_decision(row: Mapping, own: pd.DataFrame) -> Decision:
         if _present(row[f"{stem}_chi2_best"]):
             best[model] = row[f"{stem}_chi2_best"]
             elastic_end[model] = row[f"{stem}_chi2_elastic_end"]
-    judged = own[own["chi2_rise"].notna()] if "chi2_rise" in own else own.iloc[0:0]
+    judged = own[own["chi2_rise"].notna()]  # verdict_rows has checked the column is there
     if judged.empty:
         return decide({}, {}, float("nan"), 0)
     # the larger of the scans' quantiles: a model is excluded only where both would exclude it
@@ -213,16 +214,20 @@ def parameter_text(row: Mapping, parameter: str) -> str:
         return NOT_DECIDED_SOURCE if _not_decided(row, SCAN_MODELS[parameter]) else "not scanned"
     low, high = (_cell(row[f"{stem}_{end}"]) for end in ("low", "high"))
     grid = f"grid's best {significant(row[f'{stem}_grid_best'])}"
-    if low is None or high is None:  # the interval reaches the scan's end: a bound
+    if is_bound(low, high):
         return f"{interval_text(low, high)} (bound); {grid}"
     return f"{significant(estimate)} ({interval_text(low, high)}); {grid}"
 
 
+def _model_names(cell) -> list[str]:
+    """A verdict cell of ';'-separated models as readers name them (an empty cell, which a
+    CSV reads back as NaN: none)."""
+    return [MODELS[m] for m in cell.split(";") if m] if isinstance(cell, str) else []
+
+
 def verdict_text(row: Mapping) -> str:
-    """Which models give the measured exponent, in words (an empty cell, which a CSV reads
-    back as NaN: none)."""
-    cell = row["matching"]
-    matching = [MODELS[m] for m in cell.split(";") if m] if isinstance(cell, str) else []
+    """Which models give the measured exponent, in words."""
+    matching = _model_names(row["matching"])
     if not matching:
         return "no model"
     if len(matching) == 1:
@@ -233,8 +238,7 @@ def verdict_text(row: Mapping) -> str:
 def decided_text(row: Mapping) -> str:
     """The decision by the areas at every load, in words: the one model the data name, or
     'not decided' with the models they cannot tell apart (an empty cell: no scan judged)."""
-    cell = row.get("decided")
-    kept = [MODELS[m] for m in cell.split(";") if m] if isinstance(cell, str) else []
+    kept = _model_names(row.get("decided"))
     if not kept:
         return "no scan judged"
     if len(kept) == 1:
@@ -418,7 +422,7 @@ def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
     low, high = best["interval"]
     edge = "; the grid's best is at the scan's end" if best["at_scan_edge"] else ""
     grid = f"grid's best {significant(best['grid_best'])}{edge}"
-    if low is None or high is None:  # the interval reaches the scan's end: a bound
+    if is_bound(low, high):
         value = f"{interval_text(low, high)} ({best['confidence']:.0%} bound; {grid})"
     else:
         value = (

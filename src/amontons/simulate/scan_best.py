@@ -26,7 +26,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from amontons.simulate.scan_criterion import MIN_LOADS, SD_FLOOR, Criterion, TooFewLoads
+from amontons.simulate.scan_criterion import (
+    MIN_LOADS,
+    SD_FLOOR,
+    Criterion,
+    ModelError,
+    TooFewLoads,
+)
 from amontons.simulate.scan_grid import ScanError
 from amontons.simulate.scan_record import NOT_DECIDED
 
@@ -35,6 +41,7 @@ __all__ = [
     "ScanPoint",
     "best_scan_value",
     "best_targets",
+    "criterion_of_record",
     "interval_resolution",
     "interval_width_ln",
     "measured_rows",
@@ -320,6 +327,15 @@ def measured_rows(record: Mapping) -> list[dict]:
     """A solved value's comparison rows (scan_point.json) at the loads the criterion reads:
     those whose measured image shows a contact."""
     return [row for row in record["loads"] if row["measured_contact_found"]]
+
+
+def criterion_of_record(record: Mapping, model_error: ModelError | None = None) -> Criterion:
+    """The criterion of a solved value's measured loads (scan_point.json; every solved value
+    of a scan has the same), with ``model_error`` (None: the measured scatter alone)."""
+    rows = measured_rows(record)
+    return Criterion.of_measured(
+        [row["load_mn"] for row in rows], [row["measured_area_um2"] for row in rows], model_error
+    )
 
 
 def point_from_record(record: Mapping, n_loads: int) -> ScanPoint:

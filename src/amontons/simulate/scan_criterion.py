@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy import optimize, stats
@@ -154,9 +155,10 @@ class Criterion:
     def n(self) -> int:
         return len(self.loads_mn)
 
-    def covariance(self, random_sd: float) -> np.ndarray:
-        """C: the random part ``random_sd``² on the diagonal and the model's shared offset,
-        slope and modes (ln area²)."""
+    @cached_property
+    def shared_covariance(self) -> np.ndarray:
+        """The model error's part of C, shared by every load: its offset, slope and modes
+        (ln area²). The same at every random part, so built once."""
         x = np.log(np.asarray(self.loads_mn))
         centred = x - x.mean()
         error = self.model_error
@@ -164,7 +166,12 @@ class Criterion:
         shared += error.slope_sd**2 * np.outer(centred, centred)
         for mode in error.modes:
             shared += np.outer(mode, mode)
-        return random_sd**2 * np.eye(self.n) + shared
+        return shared
+
+    def covariance(self, random_sd: float) -> np.ndarray:
+        """C: the random part ``random_sd``² on the diagonal and the model's shared offset,
+        slope and modes (ln area²)."""
+        return random_sd**2 * np.eye(self.n) + self.shared_covariance
 
     def corrected(self, residuals: Sequence[float]) -> np.ndarray:
         """The residuals ln A_sim − ln A_meas less the model's known bias."""

@@ -76,8 +76,10 @@ def interval_text(low: float | None, high: float | None) -> str:
     return f"{significant(low)}–{significant(high)}"
 
 
-def _is_bound(best: Mapping) -> bool:
-    return None in best["interval"]
+def is_bound(low: float | None, high: float | None) -> bool:
+    """Whether an interval reaches a scan's end on one side or both: then it is stated as
+    the bound it is, not as an interval."""
+    return low is None or high is None
 
 
 def estimate_text(best: Mapping) -> str:
@@ -89,7 +91,7 @@ def estimate_text(best: Mapping) -> str:
     symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
     low, high = best["interval"]
     grid = f"grid's best {significant(best['grid_best'])}"
-    if _is_bound(best):
+    if is_bound(low, high):
         return (
             f"{symbol} {interval_text(low, high)} {unit} ({best['confidence']:.0%} bound, open "
             f"at the scan's end; {grid})"
@@ -107,7 +109,7 @@ def grid_best_text(best: Mapping) -> str:
     symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
     low, high = best["interval"]
     grid = f"the grid's best {symbol} = {significant(best['grid_best'])} {unit}"
-    if _is_bound(best):
+    if is_bound(low, high):
         return f"{grid} ({best['confidence']:.0%} bound {symbol} {interval_text(low, high)})"
     return (
         f"{grid} (estimate {significant(best['estimate'])}, {best['confidence']:.0%} interval "

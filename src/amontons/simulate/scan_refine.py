@@ -64,10 +64,8 @@ def gap_values(
     return values
 
 
-def _outer_neighbour(solved: Sequence[float], end: float | None, step: int) -> float | None:
+def _outer_neighbour(solved: Sequence[float], end: float, step: int) -> float | None:
     """The solved value next beyond an interval's ``end`` on the side ``step`` (-1: below)."""
-    if end is None:
-        return None
     # beyond by more than rounding: an end read off a solved value lies at it to ~1e-16
     beyond = [v for v in solved if math.log(v / end) * step > 1e-9]
     if not beyond:
@@ -128,6 +126,14 @@ MAX_VALUES = "max_values reached before the targets stopped moving"
 OFF = "refinement off (max_values 0): the interval is read off the coarse grid"
 
 
+def _settled(first_round: bool, moving: Sequence[str]) -> str:
+    """Why refinement stops with nothing left to solve: every target at a solved value before
+    any round; targets that still moved but lie near solved values; or converged."""
+    if first_round:
+        return AT_SOLVED
+    return NEAR_SOLVED if moving else CONVERGED
+
+
 def refine_scan(
     points: Sequence[ScanPoint],
     criterion: Criterion,
@@ -151,19 +157,16 @@ def refine_scan(
         solved = [p.value for p in points]
         allowed = fraction * interval_width_ln(best, solved)
         unsolvable = [p.value for p in points if not np.all(np.isfinite(p.residuals))]
-        proposals = gap_values(best, solved, allowed / 2, unsolvable)
-        if before is None:
-            proposals += target_values(best, solved, allowed / 2)
-        else:  # only the targets the last round still moved by more than allowed (an end
-            # that opened is a bound now, with nothing to solve)
+        if before is not None:  # after the first round, only the targets the last round
+            # still moved by more than allowed (an end that opened is a bound now)
             moved = movement_ln(before, best)
             moving = [n for n, m in moved.items() if m > allowed and n in best_targets(best)]
-            proposals += target_values(best, solved, allowed / 2, moving)
-        done = {float(value_label(v)) for v in solved}
-        proposals = sorted(set(proposals) - done)
+        proposals = gap_values(best, solved, allowed / 2, unsolvable) + target_values(
+            best, solved, allowed / 2, None if before is None else moving
+        )
+        proposals = sorted(set(proposals) - {float(value_label(v)) for v in solved})
         if not proposals:
-            still = before is not None and bool(moving)
-            stopped = NEAR_SOLVED if still else CONVERGED if before is not None else AT_SOLVED
+            stopped = _settled(before is None, moving)
             break
         if len(added) + len(proposals) > max_values:
             stopped = OFF if max_values == 0 else MAX_VALUES
