@@ -128,8 +128,8 @@ class ScanBest:
             "at_scan_edge": self.at_scan_edge,
             "criterion": "chi2 of the residuals ln(rendered Otsu area) - bias - ln(measured "
             "Otsu area) over the loads, under C = s^2 I + offset_sd^2 11' + slope_sd^2 "
-            "(x - mean x)(x - mean x)', x = ln F (model_error); tie-break: IoU at the largest "
-            "load",
+            "(x - mean x)(x - mean x)' + sum of u u' over the modes, x = ln F (model_error); "
+            "tie-break: IoU at the largest load",
             "estimate_definition": "the vertex in ln(value) of the parabola of chi2 through the "
             "solved value of least chi2 and its two solved neighbours (that value itself where "
             "it lies at the scan's end or the three are not convex); it lies inside interval",
