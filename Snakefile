@@ -31,6 +31,7 @@ include: "workflow/rules/surface.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/study.smk"
 include: "workflow/rules/accuracy.smk"
+include: "workflow/rules/validation.smk"
 include: "workflow/rules/summary.smk"
 
 

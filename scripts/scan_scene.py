@@ -310,32 +310,33 @@ def _at_measured(values: list[float], record: dict) -> list[float]:
 
 def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement: dict):
     """The model's error at the best solved value (amontons.simulate.model_error): the solver
-    pixel's bias from a solve ``model_error_pixel_factor`` times coarser, and the PSF's
-    uncertainty from renders one standard error wider and narrower, at the criterion's loads
-    ``loads_mn``. Returns the error and its record; (None, why) where it cannot be measured,
-    which the record then says."""
+    pixel's bias from a solve at ``model_error_pixel_factor`` times the pixel (0.5: one step
+    finer), and the PSF's uncertainty from renders one standard error wider and narrower, at
+    the criterion's loads ``loads_mn``. Returns the error and its record; (None, why) where it
+    cannot be measured, which the record then says."""
     factor = judgement["model_error_pixel_factor"]
-    coarse_scene = replace(best.scene, pixel_m=best.scene.pixel_m * factor)
+    check_scene = replace(best.scene, pixel_m=best.scene.pixel_m * factor)
     log.info(
         "model error: the best value solved again at %.0f nm (%g x the pixel)",
-        coarse_scene.pixel_m * 1e9,
+        check_scene.pixel_m * 1e9,
         factor,
     )
     try:
-        coarse = solve_scene(
-            coarse_scene,
-            context.indenter(coarse_scene),
+        check = solve_scene(
+            check_scene,
+            context.indenter(check_scene),
             threads=context.threads,
             backend=context.solver_backend,
         )
-        coarse_m2 = rendered_areas_m2(context, coarse_scene, coarse, context.psf_fwhm_m)
+        check_m2 = rendered_areas_m2(context, check_scene, check, context.psf_fwhm_m)
         bias = richardson_log_bias(
             _at_measured(best.rendered_m2, best.record),
-            _at_measured(coarse_m2, best.record),
+            _at_measured(check_m2, best.record),
             factor,
+            judgement["model_error_order"],
         )
     except (ContactError, ScanError, SceneError) as error:
-        # a coarser grid that does not converge, does not fit the scan, or renders nothing
+        # a second grid that does not converge, does not fit the scan, or renders nothing
         log.warning("model error not measured: %s", error)
         return None, {"estimated": False, "why": str(error)}
     psf_change, psf_note = psf_log_change(context, best)
@@ -344,8 +345,9 @@ def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement
         "estimated": True,
         "value": best.record["value"],
         "solver_pixel_nm": best.scene.pixel_m * 1e9,
-        "coarse_pixel_nm": coarse_scene.pixel_m * 1e9,
-        "coarse_wall_time_s": coarse.wall_time_s,
+        "check_pixel_nm": check_scene.pixel_m * 1e9,
+        "check_wall_time_s": check.wall_time_s,
+        "order": judgement["model_error_order"],
         "psf": psf_note,
         **record,
     }

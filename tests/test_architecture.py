@@ -91,6 +91,21 @@ def test_the_analysis_and_the_generator_never_import_each_other(source, target):
     assert _edges(source, target) == []
 
 
+def test_only_the_validation_study_connects_them_and_nothing_of_either_imports_it():
+    """amontons.validation (docs/study.md §7) is, beside the tests, the one place that joins
+    the generator's truths to the analysis's judgement, as the tests do; no part of either
+    half, of the simulation or of the verdict may import it (the workflow names its jobs)."""
+    assert _edges("amontons.validation", "amontons.virtual")
+    assert _edges("amontons.validation", "amontons.measure")
+    halves = ("measure", "virtual", "simulate", "study_decision", "study_summary", "contact")
+    for source in halves:
+        assert _edges(f"amontons.{source}", "amontons.validation") == []
+    assert {name for _, name in _edges("amontons.workflow", "amontons.validation")} <= {
+        "amontons.validation.cases",
+        "amontons.validation.cases.case_names",
+    }
+
+
 def test_the_generator_takes_from_simulate_only_what_knows_nothing_of_the_analysis():
     """The virtual experiment shares the simulation's grid tools (docs/simulate.md), but
     simulate imports the analysis (Otsu, levelling): the virtual experiment may import only

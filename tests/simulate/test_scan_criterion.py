@@ -110,13 +110,21 @@ def test_a_planted_offset_bias_excludes_the_truth_under_the_scatter_and_not_unde
     assert _inside(truth, widened)
 
 
-def test_richardson_recovers_a_linear_error_exactly():
-    """A(h) = A*(1 + c h): from h and 2h the bias ln A(h) − ln A* is exact."""
+def test_richardson_recovers_a_power_law_error_exactly():
+    """A(h) = A*(1 + c h^p): from h and 2h, or from h and h/2 (the scans' default), the bias
+    ln A(h) − ln A* is exact to rounding for the order p the extrapolation is told."""
     exact = np.array([10.0, 20.0, 40.0])
-    fine, coarse = exact * 1.093, exact * (1 + 2 * 0.093)
-    assert richardson_log_bias(fine, coarse) == pytest.approx(np.log(1.093), rel=1e-12)
+    at_h = exact * 1.093
+    coarse = exact * (1 + 2 * 0.093)
+    assert richardson_log_bias(at_h, coarse, 2.0) == pytest.approx(np.log(1.093), rel=1e-12)
+    for order in (1.0, 1.585, 2.0):
+        finer = exact * (1 + 0.093 * 0.5**order)
+        bias = richardson_log_bias(at_h, finer, 0.5, order)
+        assert bias == pytest.approx(np.log(1.093), rel=1e-12)
     with pytest.raises(ValueError, match="non-positive area"):
-        richardson_log_bias([1.0], [3.0])
+        richardson_log_bias([1.0], [3.0], 2.0)
+    with pytest.raises(ValueError, match="factor"):
+        richardson_log_bias([1.0], [1.0], 1.0)
 
 
 def test_the_model_error_record_corrects_its_line_and_counts_the_order():

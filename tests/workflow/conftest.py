@@ -6,8 +6,9 @@ small data set (config/test.yaml: PS and glass) in two steps:
 
 - ``small_data``: the virtual experiment only, the raw files that the own-data, no-prior and
   load-series tests copy as "measured" spheres (about a minute);
-- ``small_run``: the whole run and the accuracy study in one Snakemake call, then its report;
-  the workflow, deploy, report, accuracy and executor tests read what it made.
+- ``small_run``: the whole run, the accuracy study and the reduced validation study in one
+  Snakemake call, then its report; the workflow, deploy, report, accuracy, validation and
+  executor tests read what it made.
 
 Under pytest-xdist (``make test`` runs the suite on every core) each worker process asks for
 these fixtures; the first to ask makes them under a file lock in the session's shared
@@ -117,13 +118,14 @@ def small_data(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def small_run(small_data, tmp_path_factory) -> Path:
-    """The deployed folder after the whole small-data run, 2 cores, and the accuracy study
-    (`snakemake accuracy`), with the report at results/small/report.html. Tests only read it
-    (the rerun test's dry runs read an edited copy of its overlay)."""
+    """The deployed folder after the whole small-data run, 2 cores, the accuracy study
+    (`snakemake accuracy`) and the reduced validation study (`snakemake validation`), with
+    the report at results/small/report.html. Tests only read it (the rerun test's dry runs
+    read an edited copy of its overlay)."""
     root = _shared_root(tmp_path_factory)
 
     def make():
-        _snakemake(small_data, "all", "accuracy", "--cores", "2", timeout=2400)
+        _snakemake(small_data, "all", "accuracy", "validation", "--cores", "2", timeout=2400)
         _snakemake(small_data, "--report", f"results/{RUN}/report.html", timeout=600)
 
     _once(root, "small_run", make)

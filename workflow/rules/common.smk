@@ -47,6 +47,7 @@ from amontons.workflow.paths import (
 from amontons.workflow.resources import scan_solves
 from amontons.workflow.run import WorkflowRun
 from amontons.workflow.spheres import RHEOMETER, names_pattern
+from amontons.workflow.validation import validation_cases
 
 CONFIG_SOURCE = ", ".join(
     str(f) for f in (workflow.overwrite_configfiles or ["config/config.yaml"])
@@ -117,6 +118,8 @@ SCAN_JUDGEMENT = {
     "confidence": config["load_area"]["confidence"],
 }
 SCAN_REFINED = SCAN_JUDGEMENT["refine_max_values"]
+# The validation study's cases (docs/study.md §7): one job each.
+VALIDATION_CASES = validation_cases(config)
 RING_OPTICS = ring_optics(config)
 AFM_READING = afm_reading(config)
 # Which plane of a confocal file is the image: the fluorescence and bead one, the reflection one.

@@ -46,29 +46,33 @@ __all__ = ["SharedLine", "model_error_of", "richardson_log_bias", "shared_line"]
 
 
 def richardson_log_bias(
-    fine_m2: Sequence[float], coarse_m2: Sequence[float], factor: float = 2.0, order: float = 1.0
+    solved_m2: Sequence[float], check_m2: Sequence[float], factor: float, order: float = 1.0
 ) -> np.ndarray:
-    """b_i = ln A(h) − ln A*: the bias in ln area of each load's area ``fine_m2`` at the
-    solver pixel h, from the same load's ``coarse_m2`` at ``factor``·h, for an error of
-    ``order`` in h (Richardson: A* = (f^p A(h) − A(fh)) / (f^p − 1))."""
-    fine = np.asarray(fine_m2, dtype=float)
-    coarse = np.asarray(coarse_m2, dtype=float)
-    if fine.shape != coarse.shape or fine.size == 0:
-        raise ScanError(f"{fine.size} areas at the solver pixel against {coarse.size} coarser")
-    if np.any(fine <= 0) or np.any(coarse <= 0):
+    """b_i = ln A(h) − ln A*: the bias in ln area of each load's area ``solved_m2`` at the
+    solver pixel h, from the same load's ``check_m2`` solved at ``factor``·h (0.5: one step
+    finer), for an error of ``order`` p in h (Richardson: A(h) − A* = (A(h) − A(fh)) /
+    (1 − f^p))."""
+    solved = np.asarray(solved_m2, dtype=float)
+    check = np.asarray(check_m2, dtype=float)
+    if solved.shape != check.shape or solved.size == 0:
+        raise ScanError(
+            f"{solved.size} areas at the solver pixel against {check.size} at the check"
+        )
+    if factor <= 0 or factor == 1:
+        raise ScanError(f"model_error_pixel_factor = {factor:g}; expected a positive factor ≠ 1")
+    if np.any(solved <= 0) or np.any(check <= 0):
         raise ScanError(
             f"a load renders no contact at the solver pixel or {factor:g}x it (areas "
-            f"{fine.tolist()} and {coarse.tolist()} m²): no bias to extrapolate"
+            f"{solved.tolist()} and {check.tolist()} m²): no bias to extrapolate"
         )
-    gain = factor**order
-    extrapolated = (gain * fine - coarse) / (gain - 1.0)
+    extrapolated = solved - (solved - check) / (1.0 - factor**order)
     if np.any(extrapolated <= 0):
         raise ScanError(
-            f"areas {fine.tolist()} m² at the solver pixel and {coarse.tolist()} at "
+            f"areas {solved.tolist()} m² at the solver pixel and {check.tolist()} at "
             f"{factor:g}x it extrapolate to a non-positive area: the pixel is far from the "
-            "linear range, expected a finer solver pixel"
+            "range where the error falls as a power of it; expected a finer solver pixel"
         )
-    return np.log(fine) - np.log(extrapolated)
+    return np.log(solved) - np.log(extrapolated)
 
 
 @dataclass(frozen=True)

@@ -165,6 +165,19 @@ class RunPaths:
     def timing_point(self, point: str) -> str:
         return f"{self.accuracy}/timing/{point}/{ACCURACY_SUMMARY}"
 
+    @property
+    def validation(self) -> str:
+        """The validation study's tables, summary and figure (docs/study.md §7)."""
+        return f"{self.results}/validation"
+
+    @property
+    def validation_logs(self) -> str:
+        return f"{self.logs}/validation"
+
+    def validation_case(self, case: str) -> str:
+        """One validation case's record."""
+        return f"{self.validation}/cases/{case}.json"
+
 
 def figure_files(folder: str, name: str) -> list[str]:
     """A figure ``name`` in ``folder``: its PNG, PDF and CSV."""

@@ -1,0 +1,123 @@
+"""The validation study's truths and cases, from the config's ``validation`` slice
+(config/README.md; docs/study.md §7). Pure Python: the workflow names the cases' jobs from it
+without loading the numerical stack.
+
+A *truth* is a contact model with its parameter (an elastic truth has none); a *case* is one
+truth on one seed's rough sphere, solved ``ratio`` times finer in pixel than the study then
+solves it."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+ELASTIC = "elastic"
+PENETRATION_HARDNESS = "penetration_hardness"
+HARDENING = "hardening"
+# each plastic model's scanned parameter (config ``scans``) and its unit's scale to SI
+PARAMETER_OF = {PENETRATION_HARDNESS: "p_y_mpa", HARDENING: "k_mpa_per_nm"}
+SI_SCALE = {"p_y_mpa": 1e6, "k_mpa_per_nm": 1e15}
+TRUTH_MODELS = (ELASTIC, PENETRATION_HARDNESS, HARDENING)
+# how far a truth's areas lie from the other models' against the study's model error: beyond
+# it, below it, or an elastic truth (which every plastic model approaches at its elastic end)
+CLEAR = "clear"
+BELOW_MODEL_ERROR = "below model error"
+NO_PLASTICITY = "none"
+SIGNALS = (CLEAR, BELOW_MODEL_ERROR, NO_PLASTICITY)
+
+
+@dataclass(frozen=True)
+class Truth:
+    """A contact model and its parameter's value (config units: p_y_mpa, k_mpa_per_nm; None
+    for the elastic truth), under ``name``; ``signal``: whether its areas differ from the
+    other models' by more than the study's model error ('clear'), less ('below model
+    error') or not at all ('none': an elastic truth)."""
+
+    name: str
+    model: str
+    value: float | None
+    signal: str
+
+    def __post_init__(self):
+        if self.model not in TRUTH_MODELS:
+            raise ValueError(
+                f"validation truth {self.name!r}: model = {self.model!r}; expected one of "
+                f"{TRUTH_MODELS}"
+            )
+        if self.signal not in SIGNALS:
+            raise ValueError(
+                f"validation truth {self.name!r}: signal = {self.signal!r}; expected one of "
+                f"{SIGNALS}"
+            )
+        if (self.value is None) != (self.model == ELASTIC):
+            raise ValueError(
+                f"validation truth {self.name!r}: a {self.model} truth needs "
+                f"{'no value' if self.model == ELASTIC else PARAMETER_OF[self.model]}"
+            )
+
+    @property
+    def parameter(self) -> str | None:
+        return PARAMETER_OF.get(self.model)
+
+    @classmethod
+    def from_config(cls, name: str, entry: Mapping) -> Truth:
+        model = entry["model"]
+        parameter = PARAMETER_OF.get(model)
+        value = None if parameter is None else entry.get(parameter)
+        return cls(name, model, None if value is None else float(value), entry["signal"])
+
+
+@dataclass(frozen=True)
+class Case:
+    """One truth on one seed's sphere, solved ``ratio`` times finer in pixel than the study."""
+
+    truth: Truth
+    seed: int
+    ratio: float
+
+    @property
+    def name(self) -> str:
+        return f"{self.truth.name}_r{self.ratio:g}_s{self.seed}"
+
+
+def truths_of(validation: Mapping) -> dict[str, Truth]:
+    """The truths ``run_truths`` names, by name, in its order."""
+    truths = validation["truths"]
+    for name in validation["run_truths"]:
+        if name not in truths:
+            raise ValueError(
+                f"validation.run_truths names {name!r}; expected one of {list(truths)}"
+            )
+    return {name: Truth.from_config(name, truths[name]) for name in validation["run_truths"]}
+
+
+def cases_of(validation: Mapping) -> list[Case]:
+    """Every case of the study: each truth at ``truth_pixel_ratio`` over ``seeds`` seeds, and
+    the truths ``default_ratio_truths`` again at ``default_ratio`` (the default run's truth
+    against its study, for the comparison)."""
+    truths = truths_of(validation)
+    seeds = range(1, validation["seeds"] + 1)
+    cases = [
+        Case(t, s, float(validation["truth_pixel_ratio"])) for t in truths.values() for s in seeds
+    ]
+    for name in validation["default_ratio_truths"]:
+        if name not in truths:
+            raise ValueError(
+                f"validation.default_ratio_truths names {name!r}; expected one of run_truths "
+                f"{list(truths)}"
+            )
+        cases += [Case(truths[name], s, float(validation["default_ratio"])) for s in seeds]
+    return cases
+
+
+def case_named(validation: Mapping, name: str) -> Case:
+    """The case of ``name`` (:attr:`Case.name`)."""
+    for case in cases_of(validation):
+        if case.name == name:
+            return case
+    raise ValueError(f"validation case {name!r} is not one of the config's cases")
+
+
+def case_names(validation: Mapping) -> list[str]:
+    """The names of every case of the study (the jobs' wildcards)."""
+    return [case.name for case in cases_of(validation)]

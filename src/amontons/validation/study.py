@@ -1,0 +1,258 @@
+"""A validation case judged as the study judges a sphere (docs/study.md §1 and §6): each
+plastic model's scan over its grid about the prior, the model's error measured at the best
+grid value (a solve at ``model_error_pixel_factor`` times the pixel, and the PSF's standard
+error),
+the refinement about the estimate and the interval's ends, the scan's estimate and interval
+(amontons.simulate.scan_best), and the decision between the models
+(amontons.study_decision). The same functions the scan and verdict jobs call, on the truth's
+measured areas (amontons.validation.truth), here in memory.
+
+The study renders with the PSF it measured: the true FWHM plus one draw of its stated
+standard error, which the criterion counts as a mode of the model's error."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from amontons.contact import FreeBoundaryError, solve_load_series
+from amontons.measure.area import OtsuSettings
+from amontons.simulate.model_error import model_error_of, richardson_log_bias
+from amontons.simulate.render import render_load_series
+from amontons.simulate.scan import log_area_distance
+from amontons.simulate.scan_best import ScanBest, ScanPoint, best_scan_value
+from amontons.simulate.scan_criterion import Criterion, TooFewLoads
+from amontons.simulate.scan_grid import scan_values
+from amontons.simulate.scan_refine import refine_scan
+from amontons.simulate.surface import area_average
+from amontons.study_decision import Decision, decide
+from amontons.validation.cases import (
+    HARDENING,
+    PARAMETER_OF,
+    PENETRATION_HARDNESS,
+)
+from amontons.validation.truth import Measured, Sphere, law_of
+
+
+@dataclass(frozen=True)
+class StudySettings:
+    """What the study solves and judges with: its solver pixel (m) and tolerance, each plastic
+    model's prior (config units), the scans' grids (config ``scans``), the judgement (config
+    ``scan_judgement`` with its confidence) and the Otsu settings."""
+
+    pixel_m: float
+    tol: float
+    priors: Mapping[str, float]
+    scans: Mapping[str, Mapping]
+    judgement: Mapping
+    otsu: OtsuSettings
+
+    def grid(self, model: str) -> list[float]:
+        """The scan's coarse grid of ``model`` about its prior (config units)."""
+        scan = next(s for s in self.scans.values() if s["parameter"] == PARAMETER_OF[model])
+        return scan_values(
+            self.priors[PARAMETER_OF[model]], scan["range_factor"], scan["steps"], scan["spacing"]
+        )
+
+
+@dataclass
+class Solved:
+    """One value solved: its point of the scan, its pressures (the neighbours' warm start;
+    None where its contact left the window) and its fields."""
+
+    point: ScanPoint
+    pressures: list | None
+    fields: list | None = None
+    rendered_m2: list[float] = field(default_factory=list)
+
+
+class CaseStudy:
+    """The study of one case: the surface at the study's pixel, the measured areas at the
+    loads whose image shows a contact, and the PSF the study measured."""
+
+    def __init__(self, sphere: Sphere, measured: Measured, settings: StudySettings, psf_fwhm_m):
+        self.sphere = sphere
+        self.measured = measured
+        self.settings = settings
+        self.psf_fwhm_m = psf_fwhm_m
+        self.used = [i for i, c in enumerate(measured.contacts) if c.contact_found]
+        self.loads_mn = [sphere.loads_n[i] * 1e3 for i in self.used]
+        self.measured_m2 = [measured.areas_m2[i] for i in self.used]
+        self.solves = 0
+        self._indenters: dict[int, tuple[np.ndarray, float]] = {}
+
+    def indenter(self, factor: float = 1.0) -> tuple[np.ndarray, float]:
+        """The surface averaged onto the study's pixel × ``factor`` (heights m, pixel m)."""
+        if factor not in self._indenters:
+            grids = self.measured.grids
+            n = int(round(grids.study_px / factor))
+            pixel = grids.window_m / n
+            heights = area_average(self.measured.heights, grids.truth_pixel_m, (0.0, 0.0), n, pixel)
+            self._indenters[factor] = (heights, pixel)
+        return self._indenters[factor]
+
+    def render(self, fields: Sequence[Mapping], pixel_m: float, fwhm_m: float) -> list:
+        """Each measured load's rendered Otsu contact (ContactArea)."""
+        rendered = render_load_series(
+            [fields[i] for i in self.used],
+            pixel_m,
+            pixel_m=self.sphere.image_pixel_m,
+            psf_fwhm_m=fwhm_m,
+            rendering="emission",
+            confinement_floor_pa=self.sphere.confinement_floor_pa,
+            otsu=self.settings.otsu,
+        )
+        return [r.otsu for r in rendered]
+
+    def solve_fields(self, model: str, value: float, warm, factor: float = 1.0) -> list[dict]:
+        """The load series of ``model`` at ``value`` on the indenter of ``factor``."""
+        heights, pixel = self.indenter(factor)
+        self.solves += 1
+        results = solve_load_series(
+            heights,
+            pixel,
+            self.sphere.e_star_pa,
+            list(self.sphere.loads_n),
+            plasticity=law_of(model, value),
+            tol=self.settings.tol,
+            warm_starts=warm,
+        )
+        return [{"pressure": r.pressure, "contact": r.contact} for r in results]
+
+    def solve(self, model: str, value: float, warm=None) -> Solved:
+        """One value of the scan of ``model``, warm-started from ``warm`` (a neighbour's
+        pressures, or None)."""
+        n = len(self.used)
+        try:
+            fields = self.solve_fields(model, value, warm)
+        except FreeBoundaryError:  # the contact outgrew the window: never best
+            return Solved(ScanPoint.outside_window(value, n), None)
+        contacts = self.render(fields, self.indenter()[1], self.psf_fwhm_m)
+        rendered = [c.area_m2 for c in contacts]
+        residuals = tuple(
+            math.log(s / m) if s > 0 else math.inf
+            for s, m in zip(rendered, self.measured_m2, strict=True)
+        )
+        point = ScanPoint(
+            value,
+            log_area_distance(rendered, self.measured_m2),
+            iou(contacts[-1].mask, self.measured.contacts[self.used[-1]].mask),
+            rendered[-1] / self.measured_m2[-1],
+            residuals,
+        )
+        return Solved(point, [f["pressure"] for f in fields], fields, rendered)
+
+
+def iou(a: np.ndarray, b: np.ndarray) -> float:
+    """Intersection over union of two masks of one image grid (0 where both are empty)."""
+    union = np.count_nonzero(a | b)
+    return float(np.count_nonzero(a & b) / union) if union else 0.0
+
+
+def nearest_warm(solved: Mapping[float, Solved], value: float):
+    """The pressures of the solved value nearest ``value`` in ln v whose contact fit."""
+    fitting = [v for v, s in solved.items() if s.pressures is not None]
+    if not fitting:
+        return None
+    return solved[min(fitting, key=lambda v: abs(math.log(v / value)))].pressures
+
+
+def model_error(study: CaseStudy, model: str, best: Solved, judgement: Mapping):
+    """The model's error at the best grid value, as the scan job measures it: the bias from
+    a solve at ``model_error_pixel_factor`` times the pixel (Richardson) and the PSF's standard
+    error as a mode (amontons.simulate.model_error). Returns (ModelError, record)."""
+    factor = float(judgement["model_error_pixel_factor"])
+    value = best.point.value
+    other_fields = study.solve_fields(model, value, None, factor)
+    other = [
+        c.area_m2 for c in study.render(other_fields, study.indenter(factor)[1], study.psf_fwhm_m)
+    ]
+    bias = richardson_log_bias(best.rendered_m2, other, factor, judgement["model_error_order"])
+    se = study.sphere.psf_se_m
+    fwhm = study.psf_fwhm_m
+    pixel = study.indenter()[1]
+    wide, narrow = (
+        [c.area_m2 for c in study.render(best.fields, pixel, f)]
+        for f in (fwhm + se, max(fwhm - se, 0.5 * fwhm))
+    )
+    psf = [0.5 * math.log(w / n) for w, n in zip(wide, narrow, strict=True)]
+    return model_error_of(study.loads_mn, bias, judgement["model_error_order_sd"], psf)
+
+
+@dataclass(frozen=True)
+class ScanAnswer:
+    """One plastic model's scan: its estimate and interval (amontons.simulate.scan_best), its
+    model error's record, the refinement's stop and the values it solved."""
+
+    model: str
+    best: ScanBest
+    model_error: dict
+    refinement: str
+    values: tuple[float, ...]
+
+
+def run_scan(study: CaseStudy, model: str) -> ScanAnswer:
+    """The scan of ``model``: its grid solved in a chain, the criterion with the model's
+    error at the grid's best value (least D), refined, judged."""
+    settings = study.settings
+    judgement = settings.judgement
+    grid = settings.grid(model)
+    solved: dict[float, Solved] = {}
+    warm, best = None, None
+    for value in grid:
+        result = study.solve(model, value, warm)
+        solved[value] = result
+        warm = result.pressures
+        if result.fields is not None and (
+            best is None or result.point.distance < best.point.distance
+        ):
+            best = result
+        if result is not best:
+            result.fields = None  # keep only the best value's fields
+    if best is None:
+        raise ValueError(f"{model}: no value of {grid} gives a contact that fits the window")
+    error, record = model_error(study, model, best, judgement)
+    criterion = Criterion.of_measured(study.loads_mn, [a * 1e12 for a in study.measured_m2], error)
+
+    def solve(value: float) -> ScanPoint:
+        result = study.solve(model, value, nearest_warm(solved, value))
+        result.fields = None
+        solved[value] = result
+        return result.point
+
+    points, refinement = refine_scan(
+        [s.point for s in solved.values()],
+        criterion,
+        judgement["confidence"],
+        solve,
+        judgement["refine_fraction"],
+        judgement["refine_max_values"],
+    )
+    answer = best_scan_value(points, criterion, judgement["confidence"], grid)
+    return ScanAnswer(
+        model, answer, record, refinement.stopped, tuple(sorted(p.value for p in points))
+    )
+
+
+def decision_of(answers: Sequence[ScanAnswer]) -> Decision:
+    """The decision between the scanned models and the elastic limit, as the verdict takes
+    it (amontons.study_summary.model_decision): χ² under the measured scatter, the larger of
+    the scans' quantiles, the fewest loads."""
+    return decide(
+        {a.model: a.best.chi2_min_measured for a in answers},
+        {a.model: a.best.chi2_elastic_end_measured for a in answers},
+        max(a.best.rise for a in answers),
+        min(a.best.n_loads for a in answers),
+    )
+
+
+def judge_case(study: CaseStudy) -> tuple[list[ScanAnswer], Decision]:
+    """Both plastic models' scans and the decision (TooFewLoads where the measured images
+    show a contact at fewer loads than the criterion needs)."""
+    if len(study.used) < 3:
+        raise TooFewLoads(study.loads_mn)
+    answers = [run_scan(study, model) for model in (PENETRATION_HARDNESS, HARDENING)]
+    return answers, decision_of(answers)

@@ -1,0 +1,122 @@
+"""The validation study's bookkeeping (docs/study.md §7): which cases it runs, when an
+interval holds a truth, and the coverage, confusion and checks it reports. The solves are
+tested by the small run (tests/workflow/test_validation_run.py); here the records are made by
+hand, so that each rule is seen to fail where it should."""
+
+import math
+
+import pytest
+
+from amontons.simulate.scan_best import ScanBest
+from amontons.validation.case import NOT_DECIDED, holds_truth
+from amontons.validation.cases import Truth, case_names, cases_of
+from amontons.validation.study import ScanAnswer
+from amontons.validation.tables import case_table, checks, confusion_table, coverage_table
+
+VALIDATION = {
+    "run_truths": ["elastic", "hard"],
+    "truths": {
+        "elastic": {"model": "elastic", "signal": "none"},
+        "hard": {"model": "penetration_hardness", "p_y_mpa": 40.0, "signal": "clear"},
+        "unused": {"model": "hardening", "k_mpa_per_nm": 2.0, "signal": "clear"},
+    },
+    "seeds": 3,
+    "truth_pixel_ratio": 4.0,
+    "default_ratio": 1.5,
+    "default_ratio_truths": ["hard"],
+}
+
+
+def test_the_cases_are_every_run_truth_on_every_seed_and_the_default_ratio_again():
+    names = case_names(VALIDATION)
+    assert len(names) == 2 * 3 + 3
+    assert names[0] == "elastic_r4_s1" and names[-1] == "hard_r1.5_s3"
+    assert len(set(names)) == len(names)
+    assert {c.truth.name for c in cases_of(VALIDATION)} == {"elastic", "hard"}
+    with pytest.raises(ValueError, match="run_truths names 'nope'"):
+        case_names({**VALIDATION, "run_truths": ["nope"]})
+    with pytest.raises(ValueError, match="default_ratio_truths names 'unused'"):
+        case_names({**VALIDATION, "default_ratio_truths": ["unused"]})
+
+
+def test_a_truth_must_say_its_value_exactly_when_it_has_a_model_with_one():
+    with pytest.raises(ValueError, match="needs p_y_mpa"):
+        Truth("t", "penetration_hardness", None, "clear")
+    with pytest.raises(ValueError, match="needs no value"):
+        Truth("t", "elastic", 3.0, "none")
+    with pytest.raises(ValueError, match="signal"):
+        Truth("t", "elastic", None, "loud")
+
+
+def _answer(model: str, low, high, estimate=1.0) -> ScanAnswer:
+    best = ScanBest(
+        value=estimate, refined=estimate, distance=0.0, chi2_min=0.0, resolution_low=None,
+        resolution_high=None, scatter_low=low, scatter_high=high, scatter_sd=0.05,
+        scatter_sd_used=0.05, n_loads=7, confidence=0.95, rise=4.0, at_scan_edge=False,
+    )  # fmt: skip
+    return ScanAnswer(model, best, {"bias": [0.0]}, "converged", (estimate,))
+
+
+def test_an_interval_holds_its_own_models_truth_and_an_elastic_truth_only_when_open_above():
+    hard = Truth("hard", "penetration_hardness", 40.0, "clear")
+    assert holds_truth(_answer("penetration_hardness", 35.0, 45.0), hard) is True
+    assert holds_truth(_answer("penetration_hardness", 41.0, 45.0), hard) is False
+    assert holds_truth(_answer("penetration_hardness", None, 39.0), hard) is False
+    assert holds_truth(_answer("penetration_hardness", 30.0, None), hard) is True  # a bound
+    assert holds_truth(_answer("hardening", 1.0, 2.0), hard) is None  # another model's scan
+    elastic = Truth("elastic", "elastic", None, "none")
+    assert holds_truth(_answer("hardening", 10.0, None), elastic) is True
+    assert holds_truth(_answer("hardening", 10.0, 20.0), elastic) is False
+
+
+def _record(truth: str, model: str, value, signal: str, seed: int, ratio: float, verdict: str,
+            held: bool) -> dict:  # fmt: skip
+    scans = {
+        "penetration_hardness": {"estimate": 40.0, "interval": [30.0, 50.0] if held else
+                                 [45.0, 50.0], "holds_truth": held},
+        "hardening": {"estimate": 2.0, "interval": [1.0, 3.0], "holds_truth": None},
+    }  # fmt: skip
+    return {
+        "case": f"{truth}_r{ratio:g}_s{seed}", "truth": truth, "model": model, "value": value,
+        "signal": signal, "seed": seed, "ratio": ratio, "verdict": verdict, "scans": scans,
+        "truth_wall_s": 1.0, "study_wall_s": 2.0, "study_solves": 20,
+    }  # fmt: skip
+
+
+def test_coverage_confusion_and_checks_count_what_the_records_say():
+    records = [
+        _record(
+            "hard",
+            "penetration_hardness",
+            40.0,
+            "clear",
+            s,
+            4.0,
+            "penetration_hardness",
+            held=s != 3,
+        )  # fmt: skip
+        for s in range(1, 11)
+    ] + [_record("hard", "penetration_hardness", 40.0, "clear", 1, 1.5, "hardening", held=False)]
+    coverage = coverage_table(case_table(records))
+    at_four = coverage[coverage["ratio"] == "4"].iloc[0]
+    assert (at_four["cases"], at_four["held"]) == (10, 9)
+    assert at_four["coverage"] == pytest.approx(0.9)
+    # Clopper-Pearson for 9 of 10: [0.555, 0.997]
+    assert at_four["coverage_low"] == pytest.approx(0.5550, abs=1e-3)
+    assert at_four["coverage_high"] == pytest.approx(0.9975, abs=1e-3)
+    confusion = confusion_table(records)
+    row = confusion[confusion["ratio"] == "4"].iloc[0]
+    assert row["penetration_hardness"] == 10 and row[NOT_DECIDED] == 0 and row["cases"] == 10
+    checked = {c["check"]: c for c in checks(coverage, confusion, "4")}
+    assert checked["coverage of the p_y_mpa intervals"]["met"]  # 90 % is the target
+    assert checked["clear truths: the true model named"]["value"] == 1.0
+    assert checked["hard: a wrong model named"]["met"]
+    # the default ratio's wrong verdict is reported, not held to the targets
+    assert confusion[confusion["ratio"] == "1.5"].iloc[0]["hardening"] == 1
+    records[0]["scans"]["penetration_hardness"]["holds_truth"] = False
+    records[1]["verdict"] = "hardening"
+    coverage = coverage_table(case_table(records))
+    checked = {c["check"]: c for c in checks(coverage, confusion_table(records), "4")}
+    assert not checked["coverage of the p_y_mpa intervals"]["met"]  # 8 of 10
+    assert not checked["hard: a wrong model named"]["met"]  # 1 of 10 > 5 %
+    assert math.isclose(checked["clear truths: the true model named"]["value"], 0.9)
