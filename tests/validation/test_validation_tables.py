@@ -22,21 +22,21 @@ VALIDATION = {
     },
     "seeds": 3,
     "truth_pixel_ratio": 4.0,
-    "default_ratio": 1.5,
-    "default_ratio_truths": ["hard"],
+    "comparison_ratios": [1.5, 2.0],
+    "comparison_truths": ["hard"],
 }
 
 
-def test_the_cases_are_every_run_truth_on_every_seed_and_the_default_ratio_again():
+def test_the_cases_are_every_run_truth_on_every_seed_and_the_comparison_ratios_again():
     names = case_names(VALIDATION)
-    assert len(names) == 2 * 3 + 3
-    assert names[0] == "elastic_r4_s1" and names[-1] == "hard_r1.5_s3"
+    assert len(names) == 2 * 3 + 2 * 3
+    assert names[0] == "elastic_r4_s1" and names[-1] == "hard_r2_s3"
     assert len(set(names)) == len(names)
     assert {c.truth.name for c in cases_of(VALIDATION)} == {"elastic", "hard"}
     with pytest.raises(ValueError, match="run_truths names 'nope'"):
         case_names({**VALIDATION, "run_truths": ["nope"]})
-    with pytest.raises(ValueError, match="default_ratio_truths names 'unused'"):
-        case_names({**VALIDATION, "default_ratio_truths": ["unused"]})
+    with pytest.raises(ValueError, match="comparison_truths names 'unused'"):
+        case_names({**VALIDATION, "comparison_truths": ["unused"]})
 
 
 def test_a_truth_must_say_its_value_exactly_when_it_has_a_model_with_one():

@@ -93,20 +93,25 @@ def truths_of(validation: Mapping) -> dict[str, Truth]:
 
 def cases_of(validation: Mapping) -> list[Case]:
     """Every case of the study: each truth at ``truth_pixel_ratio`` over ``seeds`` seeds, and
-    the truths ``default_ratio_truths`` again at ``default_ratio`` (the default run's truth
-    against its study, for the comparison)."""
+    the truths ``comparison_truths`` again at each of ``comparison_ratios`` (the default
+    reproduction's truth against its study, now and before: what a truth close to the study's
+    grid does)."""
     truths = truths_of(validation)
     seeds = range(1, validation["seeds"] + 1)
     cases = [
         Case(t, s, float(validation["truth_pixel_ratio"])) for t in truths.values() for s in seeds
     ]
-    for name in validation["default_ratio_truths"]:
+    for name in validation["comparison_truths"]:
         if name not in truths:
             raise ValueError(
-                f"validation.default_ratio_truths names {name!r}; expected one of run_truths "
+                f"validation.comparison_truths names {name!r}; expected one of run_truths "
                 f"{list(truths)}"
             )
-        cases += [Case(truths[name], s, float(validation["default_ratio"])) for s in seeds]
+        cases += [
+            Case(truths[name], s, float(ratio))
+            for ratio in validation["comparison_ratios"]
+            for s in seeds
+        ]
     return cases
 
 

@@ -48,7 +48,8 @@ def _draw_case(ax, x: float, row, value: float, limits, pale: bool) -> None:
 
 def plot_intervals(cases: pd.DataFrame, study_ratio: float, paths: list[str]) -> None:
     """Per truth with a value: each case's interval of its own model's scan over the truth,
-    by seed, at ``study_ratio`` (solid) and any other ratio (pale, offset)."""
+        by seed, at ``study_ratio`` (solid) and the comparison's ratios (pale, offset to the right
+    in increasing order)."""
     own = cases[cases["holds_truth"].notna() & cases["value"].notna()]
     truths = list(dict.fromkeys(own["truth"]))
     n = max(len(truths), 1)
@@ -57,9 +58,11 @@ def plot_intervals(cases: pd.DataFrame, study_ratio: float, paths: list[str]) ->
         rows = own[own["truth"] == truth]
         value = rows["value"].iloc[0]
         limits = _limits(rows)
+        others = sorted(r for r in rows["ratio"].unique() if not np.isclose(r, study_ratio))
         for _, row in rows.iterrows():
-            pale = not np.isclose(row["ratio"], study_ratio)
-            _draw_case(ax, row["seed"] + (0.3 if pale else 0.0), row, value, limits, pale)
+            pale = row["ratio"] in others
+            offset = 0.25 * (others.index(row["ratio"]) + 1) if pale else 0.0
+            _draw_case(ax, row["seed"] + offset, row, value, limits, pale)
         ax.axhline(1.0, color="k", lw=0.8)
         ax.set_yscale("log")
         ax.set_ylim(*limits)
@@ -72,7 +75,7 @@ def plot_intervals(cases: pd.DataFrame, study_ratio: float, paths: list[str]) ->
     fig.supxlabel("seed", fontsize=8)
     handles = [
         Line2D([], [], color=HELD, lw=2, label=f"holds the truth (truth ×{study_ratio:g} finer)"),
-        Line2D([], [], color=HELD, lw=2, alpha=0.4, label="at the default run's ratio"),
+        Line2D([], [], color=HELD, lw=2, alpha=0.4, label="at the comparison's ratios, right"),
         Line2D([], [], color=MISSED, lw=2, label="misses it"),
     ]
     axes[0][-1].legend(handles=handles, fontsize=6, loc="lower right")
