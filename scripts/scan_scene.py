@@ -26,7 +26,7 @@ from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area, image_pixel_m
 from amontons.runlog import run_logged
 from amontons.simulate.compare import compare_loads, sheet_load_index
-from amontons.simulate.model_error import model_error_of, richardson_log_bias
+from amontons.simulate.model_error import model_error_of, psf_log_change, richardson_log_bias
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
@@ -113,9 +113,15 @@ class ScanContext:
         return image_pixel_m(self.pixel_nm, self.pixel_table)
 
     @cached_property
+    def psf_fwhm_nm(self) -> dict:
+        """The sphere's measured PSF width (psf.json's ``fwhm_nm``: estimate, nm, and its
+        standard error where the PSF was measured)."""
+        return read_json(self.psf_path)["fwhm_nm"]
+
+    @property
     def psf_fwhm_m(self) -> float:
         """The sphere's measured PSF width (m)."""
-        return read_json(self.psf_path)["fwhm_nm"]["estimate"] * 1e-9
+        return self.psf_fwhm_nm["estimate"] * 1e-9
 
     @cached_property
     def registration(self) -> Registration:
@@ -339,7 +345,7 @@ def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement
         # a second grid that does not converge, does not fit the scan, or renders nothing
         log.warning("model error not measured: %s", error)
         return None, {"estimated": False, "why": str(error)}
-    psf_change, psf_note = psf_log_change(context, best)
+    psf_change, psf_note = psf_share(context, best)
     error, record = model_error_of(loads_mn, bias, judgement["model_error_order_sd"], psf_change)
     return error, {
         "estimated": True,
@@ -353,25 +359,27 @@ def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement
     }
 
 
-def psf_log_change(context: ScanContext, best: Solved) -> tuple[list[float] | None, str]:
-    """Half the change of ln(rendered area) per load between the PSF one standard error
-    wider and one narrower, and what was done; None where the PSF states no standard error
-    or a render loses its contact (then the PSF's share is not counted, and the note says
-    why)."""
-    se_nm = read_json(context.psf_path)["fwhm_nm"].get("standard_error")
+def psf_share(context: ScanContext, best: Solved) -> tuple[list[float] | None, str]:
+    """The PSF's share of the model's error at the best value
+    (amontons.simulate.model_error.psf_log_change) and what was done; None where the PSF
+    states no standard error or a render loses its contact (then the PSF's share is not
+    counted, and the note says why)."""
+    se_nm = context.psf_fwhm_nm.get("standard_error")
     if not se_nm:
         return None, "not counted: the PSF states no standard error (a FWHM from the config)"
     fwhm = context.psf_fwhm_m
-    wide, narrow = (
-        _at_measured(rendered_areas_m2(context, best.scene, best.solution, f), best.record)
-        for f in (fwhm + se_nm * 1e-9, max(fwhm - se_nm * 1e-9, 0.5 * fwhm))
+    change = psf_log_change(
+        lambda f: _at_measured(
+            rendered_areas_m2(context, best.scene, best.solution, f), best.record
+        ),
+        fwhm,
+        se_nm * 1e-9,
     )
-    if min(wide + narrow) <= 0:
+    if change is None:
         return (
             None,
             f"not counted: a render at FWHM {fwhm * 1e9:.0f} ± {se_nm:.0f} nm lost its contact",
         )
-    change = [0.5 * math.log(w / n) for w, n in zip(wide, narrow, strict=True)]
     return change, f"counted: FWHM {fwhm * 1e9:.0f} ± {se_nm:.0f} nm (one standard error)"
 
 

@@ -34,7 +34,8 @@ value.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +43,7 @@ import numpy as np
 from amontons.simulate.scan_criterion import ModelError
 from amontons.simulate.scan_grid import ScanError
 
-__all__ = ["SharedLine", "model_error_of", "richardson_log_bias", "shared_line"]
+__all__ = ["SharedLine", "model_error_of", "psf_log_change", "richardson_log_bias", "shared_line"]
 
 
 def richardson_log_bias(
@@ -73,6 +74,19 @@ def richardson_log_bias(
             "range where the error falls as a power of it; expected a finer solver pixel"
         )
     return np.log(solved) - np.log(extrapolated)
+
+
+def psf_log_change(
+    rendered_m2: Callable[[float], Sequence[float]], fwhm_m: float, se_m: float
+) -> list[float] | None:
+    """Half the change of ln(rendered area) per load between renders with the PSF's FWHM
+    ``fwhm_m`` one standard error ``se_m`` wider and one narrower (no narrower than half the
+    FWHM), ``rendered_m2`` giving each load's area (m²) at a FWHM (m); None where a render
+    loses its contact (its share cannot be measured)."""
+    wide, narrow = (rendered_m2(f) for f in (fwhm_m + se_m, max(fwhm_m - se_m, 0.5 * fwhm_m)))
+    if min([*wide, *narrow]) <= 0:
+        return None
+    return [0.5 * math.log(w / n) for w, n in zip(wide, narrow, strict=True)]
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,8 @@ import numpy as np
 
 from amontons.contact import FreeBoundaryError, solve_load_series
 from amontons.measure.area import OtsuSettings
-from amontons.simulate.model_error import model_error_of, richardson_log_bias
+from amontons.simulate.compare import intersection_over_union
+from amontons.simulate.model_error import model_error_of, psf_log_change, richardson_log_bias
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance
 from amontons.simulate.scan_best import ScanBest, ScanPoint, best_scan_value
@@ -139,17 +140,11 @@ class CaseStudy:
         point = ScanPoint(
             value,
             log_area_distance(rendered, self.measured_m2),
-            iou(contacts[-1].mask, self.measured.contacts[self.used[-1]].mask),
+            intersection_over_union(contacts[-1].mask, self.measured.contacts[self.used[-1]].mask),
             rendered[-1] / self.measured_m2[-1],
             residuals,
         )
         return Solved(point, [f["pressure"] for f in fields], fields, rendered)
-
-
-def iou(a: np.ndarray, b: np.ndarray) -> float:
-    """Intersection over union of two masks of one image grid (0 where both are empty)."""
-    union = np.count_nonzero(a | b)
-    return float(np.count_nonzero(a & b) / union) if union else 0.0
 
 
 def nearest_warm(solved: Mapping[float, Solved], value: float):
@@ -171,14 +166,12 @@ def model_error(study: CaseStudy, model: str, best: Solved, judgement: Mapping):
         c.area_m2 for c in study.render(other_fields, study.indenter(factor)[1], study.psf_fwhm_m)
     ]
     bias = richardson_log_bias(best.rendered_m2, other, factor, judgement["model_error_order"])
-    se = study.sphere.psf_se_m
-    fwhm = study.psf_fwhm_m
     pixel = study.indenter()[1]
-    wide, narrow = (
-        [c.area_m2 for c in study.render(best.fields, pixel, f)]
-        for f in (fwhm + se, max(fwhm - se, 0.5 * fwhm))
+    psf = psf_log_change(
+        lambda fwhm: [c.area_m2 for c in study.render(best.fields, pixel, fwhm)],
+        study.psf_fwhm_m,
+        study.sphere.psf_se_m,
     )
-    psf = [0.5 * math.log(w / n) for w, n in zip(wide, narrow, strict=True)]
     return model_error_of(study.loads_mn, bias, judgement["model_error_order_sd"], psf)
 
 
@@ -206,12 +199,14 @@ def run_scan(study: CaseStudy, model: str) -> ScanAnswer:
         result = study.solve(model, value, warm)
         solved[value] = result
         warm = result.pressures
-        if result.fields is not None and (
-            best is None or result.point.distance < best.point.distance
-        ):
+        if result.fields is None:
+            continue
+        if best is None or result.point.distance < best.point.distance:
+            if best is not None:
+                best.fields = None  # only the best value's fields are kept
             best = result
-        if result is not best:
-            result.fields = None  # keep only the best value's fields
+        else:
+            result.fields = None
     if best is None:
         raise ValueError(f"{model}: no value of {grid} gives a contact that fits the window")
     error, record = model_error(study, model, best, judgement)

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 import pandas as pd
 from scipy.stats import binomtest
 
+from amontons.study_summary import markdown_table
 from amontons.validation.case import NOT_DECIDED
 from amontons.validation.cases import (
     BELOW_MODEL_ERROR,
@@ -187,16 +188,16 @@ def cost_table(cases: pd.DataFrame) -> pd.DataFrame:
 
 
 def _markdown(table: pd.DataFrame) -> str:
-    """A table as GitHub markdown (no extra dependency: pipes and 3-significant numbers)."""
+    """A table as a Markdown (pipe) table (amontons.study_summary.markdown_table), numbers to
+    3 significant digits."""
 
-    def cell(v):
+    def cell(v) -> str:
         return f"{v:.3g}" if isinstance(v, float) else str(v)
 
-    lines = ["| " + " | ".join(table.columns) + " |", "|" + "---|" * len(table.columns)]
-    lines += [
-        "| " + " | ".join(cell(v) for v in row) + " |" for row in table.itertuples(index=False)
+    lines = [list(table.columns)] + [
+        [cell(v) for v in row] for row in table.itertuples(index=False)
     ]
-    return "\n".join(lines)
+    return markdown_table(lines).rstrip("\n")
 
 
 def summary_markdown(

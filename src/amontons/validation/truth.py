@@ -17,7 +17,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.fft
 
 from amontons.contact import (
     ContactHardening,
@@ -33,11 +32,8 @@ from amontons.simulate.grid import PixelAverager
 from amontons.simulate.render import image_side_px
 from amontons.validation.cases import HARDENING, PENETRATION_HARDNESS, SI_SCALE, Case, Truth
 from amontons.virtual.fluorescence import render_fluorescence
+from amontons.virtual.rough_contact import HARDENING_RADIUS_GUESS, fast_even
 from amontons.virtual.roughness import Roughness, synthesize
-
-# The hardened or plastic contact outgrows the Hertz one (PMMA: radius ×1.2 at 10 mN,
-# amontons.virtual.rough_contact): the window is sized for ×1.3 of it.
-RADIUS_GUESS = 1.3
 
 
 @dataclass(frozen=True)
@@ -119,20 +115,15 @@ class Grids:
         return self.study_pixel_m / self.truth_pixel_m
 
 
-def even_fast(n: float) -> int:
-    """The smallest even size ≥ n whose FFT is fast (a product of 2, 3, 5, 7)."""
-    m = scipy.fft.next_fast_len(int(np.ceil(n)), real=True)
-    while m % 2:
-        m = scipy.fft.next_fast_len(m + 1, real=True)
-    return m
-
-
 def grids_of(sphere: Sphere, study_pixel_m: float, ratio: float) -> Grids:
-    """The window (``window_factor`` × the hardened Hertz diameter at the largest load) on
-    the study's pixel, and the truth's grid ``ratio`` times finer over it."""
+    """The window (``window_factor`` × the Hertz diameter at the largest load, grown as a
+    plastic contact grows it: the virtual experiment's HARDENING_RADIUS_GUESS) on the study's
+    pixel, and the truth's grid ``ratio`` times finer over it."""
     a = hertz.contact_radius(max(sphere.loads_n), sphere.radius_m, sphere.e_star_pa)
-    study_px = even_fast(sphere.window_factor * 2 * a * RADIUS_GUESS / study_pixel_m)
-    return Grids(study_px, study_pixel_m, even_fast(study_px * ratio))
+    study_px = fast_even(
+        int(np.ceil(sphere.window_factor * 2 * a * HARDENING_RADIUS_GUESS / study_pixel_m))
+    )
+    return Grids(study_px, study_pixel_m, fast_even(int(np.ceil(study_px * ratio))))
 
 
 def case_rng(case: Case, what: str) -> np.random.Generator:

@@ -106,14 +106,14 @@ def initial_window_m(
 def solver_grid(window_m: float, settings: SolverSettings) -> tuple[int, float]:
     """Side (px, even) and pixel (m) of the solver grid: ``settings.pixel_m`` unless the
     window would then exceed ``max_grid_px``, in which case the pixel grows."""
-    n = _fast_even(int(np.ceil(window_m / settings.pixel_m)))
+    n = fast_even(int(np.ceil(window_m / settings.pixel_m)))
     if n <= settings.max_grid_px:
         return n, settings.pixel_m
     n = settings.max_grid_px - settings.max_grid_px % 2
     return n, window_m / n
 
 
-def _fast_even(n: int) -> int:
+def fast_even(n: int) -> int:
     """Smallest even n' >= n whose FFT is fast (a product of 2, 3, 5, 7): a 962² window pads
     to 1924 = 4·13·37, whose transforms are ~4x slower than those of 1000 (measured)."""
     m = scipy.fft.next_fast_len(n, real=True)
