@@ -1,4 +1,4 @@
-"""Fit the cluster resources of every rule to a measured run (amontons.resources).
+"""Fit the cluster resources of every rule to a measured run (amontons.measured_resources).
 
 Reads the benchmark file Snakemake wrote for every job of a run (logs/<run>/**/*.benchmark.tsv:
 wall time s, peak resident memory max_rss in MB). Writes workflow/resources.json, which the
@@ -9,7 +9,7 @@ the record of what they took.
     python benchmarks/fit_job_resources.py --run full --run small   # after both runs
 
 The figures are those of the machine the run took place on, under whatever else ran there:
-amontons.resources asks for twice them.
+amontons.measured_resources asks for twice them.
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def main() -> None:
             "date": datetime.date.today().isoformat(),
             "cores": len(os.sched_getaffinity(0)),
             "note": "wall time s and peak RSS MB of every job's benchmark file; the workflow "
-            "asks for amontons.resources.SAFETY times these",
+            "asks for amontons.measured_resources.SAFETY times these",
         },
         "rules": {
             rule: {

@@ -6,8 +6,8 @@ import logging
 
 import pandas as pd
 
-from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_json, write_table
+from amontons.power_law import fit_power_law
 from amontons.runlog import run_logged
 from amontons.simulate.scan_best import (
     best_scan_value,

@@ -13,7 +13,6 @@ from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_fluorescence_loads
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area, otsu_contact_area
-from amontons.plots import plot_scene_comparison
 from amontons.runlog import run_logged
 from amontons.simulate.compare import (
     OUTSIDE_SCAN,
@@ -25,6 +24,7 @@ from amontons.simulate.compare import (
     warped_mask,
 )
 from amontons.simulate.render import Rendered
+from amontons.study.plots import plot_scene_comparison
 
 log = logging.getLogger(__name__)
 

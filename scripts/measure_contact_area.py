@@ -6,8 +6,8 @@ from amontons.io.files import write_table
 from amontons.io.rawdata import read_fluorescence_loads
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, contact_area_table, image_contact_area
-from amontons.plots import plot_contact_separation
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_contact_separation
 
 log = logging.getLogger(__name__)
 

@@ -10,8 +10,8 @@ from amontons.measure.area import OtsuSettings
 from amontons.measure.edge_gap import measure_edge_gap, unmeasured_edge_gap_record
 from amontons.measure.errors import NotMeasurable
 from amontons.physics.hertz import contact_radius
-from amontons.plots import plot_edge_gap, plot_unmeasured
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_edge_gap, plot_unmeasured
 
 log = logging.getLogger(__name__)
 

@@ -5,8 +5,8 @@ import logging
 from amontons.io.files import write_json
 from amontons.measure.grafting import measure_grafting_density
 from amontons.physics.beer_lambert import M2_PER_MOL_PER_L_PER_MOL_CM
-from amontons.plots import plot_absorbance
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_absorbance
 
 log = logging.getLogger(__name__)
 

@@ -11,8 +11,8 @@ from amontons.measure.intensity import (
     intensity_pressure_table,
     measure_intensity_pressure,
 )
-from amontons.plots import plot_intensity_pressure
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_intensity_pressure
 
 log = logging.getLogger(__name__)
 

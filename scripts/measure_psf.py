@@ -6,8 +6,8 @@ from amontons.io.confocal import ImageChoice
 from amontons.io.files import write_json
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.psf import measure_bead
-from amontons.plots import plot_psf_profile
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_psf_profile
 
 log = logging.getLogger(__name__)
 

@@ -6,8 +6,8 @@ from amontons.io.files import write_json
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.scan_lines import line_levelling_mode
 from amontons.measure.topography import measure_topography, read_fit_record, write_sphere_fits
-from amontons.plots import plot_topography
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_topography
 
 log = logging.getLogger(__name__)
 

@@ -5,8 +5,8 @@ import pandas as pd
 
 from amontons.io.files import write_table
 from amontons.measure.friction import amontons_table
-from amontons.plots import plot_amontons_deviation
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_amontons_deviation
 
 
 def main(

@@ -11,7 +11,7 @@ import pandas as pd
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
 from amontons.simulate.scan_record import is_decided
-from amontons.study_figures import plot_normalised_study
+from amontons.study.figures import BEST_K, plot_normalised_study
 
 log = logging.getLogger(__name__)
 
@@ -34,7 +34,7 @@ def main(amontons_paths, best_paths: dict, table_path, figure_paths, reference_l
                     "load_over_ref": xi,
                     "area_over_ref": a,
                     "friction_over_ref": s,
-                    "best_k_mpa_per_nm": None,
+                    BEST_K: None,
                 }
                 for xi, a, s in zip(x, *measured[sphere][1:], strict=True)
             ]
@@ -59,7 +59,7 @@ def main(amontons_paths, best_paths: dict, table_path, figure_paths, reference_l
                 "load_over_ref": xi,
                 "area_over_ref": a,
                 "friction_over_ref": None,
-                "best_k_mpa_per_nm": best["grid_best"],
+                BEST_K: best["grid_best"],
             }
             for xi, a in zip(*models[sphere], strict=True)
         ]

@@ -10,7 +10,7 @@ import pandas as pd
 
 from amontons.io.files import read_json, write_table
 from amontons.runlog import run_logged
-from amontons.study_figures import Curve, plot_area_curves
+from amontons.study.figures import Curve, plot_area_curves
 
 log = logging.getLogger(__name__)
 

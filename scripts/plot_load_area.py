@@ -4,8 +4,8 @@ import pandas as pd
 
 from amontons.io.files import read_json, write_table
 from amontons.measure.load_area import normalised_load_area
-from amontons.plots import plot_normalised_load_area
 from amontons.runlog import run_logged
+from amontons.study.plots import plot_normalised_load_area
 
 
 def main(

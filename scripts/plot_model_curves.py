@@ -10,12 +10,12 @@ import logging
 import numpy as np
 import pandas as pd
 
-from amontons.fits import fit_power_law
 from amontons.io.files import read_json, write_table
+from amontons.power_law import fit_power_law
 from amontons.runlog import run_logged
 from amontons.simulate.fits import MIN_FIT_LOADS
 from amontons.simulate.scan_record import estimate_text, grid_best_label, is_decided
-from amontons.study_figures import Curve, plot_area_curves
+from amontons.study.figures import Curve, plot_area_curves
 
 log = logging.getLogger(__name__)
 

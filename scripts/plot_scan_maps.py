@@ -12,6 +12,7 @@ from amontons.io.files import read_json, write_table
 from amontons.io.rawdata import read_fluorescence_loads
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area
+from amontons.models import parameter_named
 from amontons.runlog import run_logged
 from amontons.simulate.register import Registration, warp_to_measured
 from amontons.simulate.scan_record import (
@@ -20,7 +21,7 @@ from amontons.simulate.scan_record import (
     is_decided,
     not_decided_note,
 )
-from amontons.study_figures import MapPanel, crop_box, plot_map_grid
+from amontons.study.figures import MapPanel, crop_box, plot_map_grid
 
 log = logging.getLogger(__name__)
 
@@ -86,7 +87,7 @@ def main(
                 )
             )
         rows.append(panels)
-        symbol = {"p_y_mpa": "p_Y (MPa)", "k_mpa_per_nm": "k (MPa/nm)"}[best["parameter"]]
+        symbol = parameter_named(best["parameter"]).label
         labels.append(f"{best['scene']}\n{symbol}")
         estimate = (
             estimate_text(best) if decided else f"{name} not decided ({not_decided_note(best)})"

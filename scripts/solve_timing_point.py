@@ -10,19 +10,19 @@ if "snakemake" in globals():
 
 from amontons.accuracy.problems import cost_record, solve_problem, timing_problem
 from amontons.accuracy.settings import timing_points, timing_setting
-from amontons.contact import FreeBoundaryError, PenetrationHardness
+from amontons.contact import FreeBoundaryError
 from amontons.io.files import write_json
+from amontons.models import model_named
 from amontons.runlog import run_logged
 from amontons.simulate.surface import load_levelled_map
 
 log = logging.getLogger(__name__)
 
 
-def _law_record(law) -> dict:
-    """The plastic law in config units."""
-    if isinstance(law, PenetrationHardness):
-        return {"p_y_mpa": float(law.p_y) * 1e-6}
-    return {"k_mpa_per_nm": float(law.k) * 1e-15}
+def _law_record(model: str, law) -> dict:
+    """The plastic law of ``model`` in config units."""
+    parameter = model_named(model).parameter
+    return {parameter.key: float(getattr(law, parameter.law_field)) * parameter.from_si}
 
 
 def main(point: str, study: dict, levelled_path: str, record: dict, summary_path: str) -> None:
@@ -44,7 +44,7 @@ def main(point: str, study: dict, levelled_path: str, record: dict, summary_path
         "outside_window": None,
         **setting.to_record(),
         "pixel_nm": problem.pixel_m * 1e9,
-        **_law_record(problem.plasticity),
+        **_law_record(model, problem.plasticity),
         **cost_record(problem, results, wall_time_s),
         "loads": [
             {

@@ -9,7 +9,7 @@ import pandas as pd
 
 from amontons.io.files import atomic_path, read_json
 from amontons.runlog import run_logged
-from amontons.study_summary import (
+from amontons.study.summary import (
     amontons_headline,
     curvature_headlines,
     display_rows,

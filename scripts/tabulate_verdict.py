@@ -6,7 +6,7 @@ import logging
 
 from amontons.io.files import write_table
 from amontons.runlog import run_logged
-from amontons.study_summary import verdict_table
+from amontons.study.summary import verdict_table
 
 log = logging.getLogger(__name__)
 

@@ -7,7 +7,7 @@ import pandas as pd
 
 from amontons.io.files import atomic_path
 from amontons.runlog import run_logged
-from amontons.study_summary import ReportFigure, report_page
+from amontons.study.summary import ReportFigure, report_page
 
 log = logging.getLogger(__name__)
 

@@ -97,7 +97,7 @@ def test_only_the_validation_study_connects_them_and_nothing_of_either_imports_i
     half, of the simulation or of the verdict may import it (the workflow names its jobs)."""
     assert _edges("amontons.validation", "amontons.virtual")
     assert _edges("amontons.validation", "amontons.measure")
-    halves = ("measure", "virtual", "simulate", "study_decision", "study_summary", "contact")
+    halves = ("measure", "virtual", "simulate", "study", "contact")
     for source in halves:
         assert _edges(f"amontons.{source}", "amontons.validation") == []
     assert {name for _, name in _edges("amontons.workflow", "amontons.validation")} <= {

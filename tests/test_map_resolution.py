@@ -5,7 +5,7 @@ panel shows, and where, is unchanged."""
 import numpy as np
 
 from amontons.simulate.grid import block_mean
-from amontons.study_figures import MapPanel, at_display_resolution
+from amontons.study.figures import MapPanel, at_display_resolution
 
 
 def test_block_mean_averages_whole_blocks_and_drops_the_rest():
@@ -62,7 +62,7 @@ def test_the_measurement_figures_draw_wide_maps_at_their_panels_pixels(monkeypat
     """Topography (3 in panels, 450 px at 150 dpi), contact areas and scene comparisons
     (2.4 in, 360 px): a 2048² AFM map and 1568² fluorescence images are drawn as block means
     no wider than their panel, and a 300² image as it is."""
-    from amontons.plots import plot_contact_separation, plot_scene_comparison, plot_topography
+    from amontons.study.plots import plot_contact_separation, plot_scene_comparison, plot_topography
 
     shapes = _drawn_shapes(monkeypatch)
     rng = np.random.default_rng(0)

@@ -4,10 +4,10 @@ sphere's AFM map is Hertz; an elastic scene runs no plastic loop; the fields sur
 import numpy as np
 import pytest
 
-from amontons.fits import fit_power_law
 from amontons.io.fields import read_load_series, write_load_series
 from amontons.measure.topography import sphere_cap
 from amontons.physics import hertz
+from amontons.power_law import fit_power_law
 from amontons.simulate.scene import scene_for_sphere
 from amontons.simulate.solve import solve_scene
 from amontons.simulate.surface import afm_indenter, level_afm_map

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from amontons.config import read_config
-from amontons.fits import fit_power_law
 from amontons.io.heightmap import read_height_map
 from amontons.io.layout import RawDataError, fluorescence_images, per_load_files, rheometer_name
 from amontons.io.rawdata import (
@@ -26,6 +25,7 @@ from amontons.measure.area import otsu_contact_area
 from amontons.measure.topography import level_sphere
 from amontons.physics import hertz
 from amontons.physics.roughness import roughness_statistics
+from amontons.power_law import fit_power_law
 from amontons.virtual.experiment import generate_sphere
 from amontons.virtual.settings import InstrumentSettings, SurfaceSettings
 

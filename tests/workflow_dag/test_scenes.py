@@ -9,11 +9,10 @@ import numpy as np
 import pytest
 import tifffile
 
-from amontons.config.scenes import SCAN_COLUMNS
 from amontons.io.tiff import write_image
+from amontons.models import parameter_named
 from amontons.simulate.scan_grid import scan_values, value_label
 from amontons.workflow.paths import FIELDS, RENDERED, SCAN_POINT
-from amontons.workflow.scenes import SCAN_CHAIN_ORDER
 
 
 def _wildcards(**values):
@@ -63,7 +62,7 @@ def test_a_scan_has_one_point_per_value_around_the_sheets_prior(small):
     assert scenes.scans
     sphere = next(iter(small.spheres))
     for scan, spec in scenes.scans.items():
-        prior = small.spheres.row(sphere)[SCAN_COLUMNS[spec["parameter"]]]
+        prior = small.spheres.row(sphere)[parameter_named(spec["parameter"]).sheet_column]
         expected = scan_values(prior, spec["range_factor"], spec["steps"], spec["spacing"])
         labels = scenes.scan_value_labels(sphere, scan)
         assert labels == [value_label(v) for v in expected]
@@ -74,7 +73,7 @@ def test_a_scan_has_one_point_per_value_around_the_sheets_prior(small):
 
 
 def test_a_scans_values_run_as_one_chain_each_from_the_one_before(small):
-    """A sphere's scan job solves every value once, in SCAN_CHAIN_ORDER (from the largest
+    """A sphere's scan job solves every value once, in its parameter's chain order (from the largest
     value down, or the smallest up), and writes each value's files into a folder of its own
     inside the job's output folder, where best_scan_value reads the results."""
     scenes = small.scenes
@@ -84,7 +83,7 @@ def test_a_scans_values_run_as_one_chain_each_from_the_one_before(small):
         wildcards = _wildcards(material=material, sphere=sphere, scan=scan)
         chain = scenes.scan_chain(sphere, scan)
         assert sorted(chain, key=float) == sorted(scenes.scan_value_labels(sphere, scan), key=float)
-        descending = SCAN_CHAIN_ORDER[spec["parameter"]] < 0
+        descending = parameter_named(spec["parameter"]).chain_order < 0
         assert [float(v) for v in chain] == sorted(map(float, chain), reverse=descending)
         value_files = scenes.scan_value_files(wildcards)
         assert [entry["value"] for entry in value_files] == chain
@@ -108,7 +107,7 @@ def test_a_chain_from_the_elastic_end_starts_from_the_spheres_elastic_solve(smal
     for scan, spec in scenes.scans.items():
         wildcards = _wildcards(material=material, sphere=sphere, scan=scan)
         seed = scenes.scan_seed_fields(wildcards)
-        if SCAN_CHAIN_ORDER[spec["parameter"]] < 0:
+        if parameter_named(spec["parameter"]).chain_order < 0:
             assert seed == [small.paths.scene(FIELDS, material, sphere, elastic[0])]
         else:
             assert seed == []

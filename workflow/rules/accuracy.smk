@@ -45,7 +45,7 @@ rule solve_timing_point:
     benchmark:
         f"{ACCURACY_LOGS}/timing/{{point}}/solve_timing_point.benchmark.tsv"
     wildcard_constraints:
-        point=r"(hardening|penetration_hardness)_[sy][0-9.e+-]+",
+        point=TIMING_POINT,
     conda:
         "../envs/amontons.yaml"
     threads: 1

@@ -45,8 +45,9 @@ from amontons.workflow.paths import (
     flat_files,
 )
 from amontons.workflow.resources import scan_solves
+from amontons.workflow.accuracy import TIMING_POINT
 from amontons.workflow.run import WorkflowRun
-from amontons.workflow.spheres import RHEOMETER, names_pattern
+from amontons.workflow.spheres import RHEOMETER, TRUE_HARDENING_COLUMN, names_pattern
 from amontons.workflow.validation import validation_cases
 
 CONFIG_SOURCE = ", ".join(

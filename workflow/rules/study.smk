@@ -166,7 +166,7 @@ rule plot_load_series_maps:
         mem_mb=measured_mem_mb("plot_load_series_maps"),
         runtime=measured_runtime("plot_load_series_maps"),
     params:
-        elastic=lambda wc: RUN.study.load_series_layout(wc)["elastic"],
+        elastic=RUN.study.load_series_elastic,
         k_scan=RUN.study.k_scan,
         loads_mn=lambda wc: loads_mn(wc.sphere),
         pixel_nm=lambda wc: pixel_nm(wc.sphere),

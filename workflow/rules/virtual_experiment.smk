@@ -30,9 +30,7 @@ rule generate_virtual_experiment:
         diameter_mm=lambda wc: float(sphere_row(wc.sphere)["diameter_mm"]),
         e_star_gpa=lambda wc: float(sphere_row(wc.sphere)["e_star_gpa"]),
         roughness_rms_nm=lambda wc: sheet_value(wc.sphere, "roughness_rms_nm"),
-        hardening_k_mpa_per_nm=lambda wc: sheet_value(
-            wc.sphere, "hardening_k_mpa_per_nm"
-        ),
+        hardening_k_mpa_per_nm=lambda wc: sheet_value(wc.sphere, TRUE_HARDENING_COLUMN),
         loads_mn=lambda wc: loads_mn(wc.sphere),
         reflection_load_mn=lambda wc: sheet_value(wc.sphere, "reflection_load_mn"),
         flim_load_mn=lambda wc: sheet_value(wc.sphere, "flim_load_mn"),

@@ -13,7 +13,7 @@ import pandas as pd  # noqa: E402
 
 from amontons.accuracy.front import ERRORS  # noqa: E402
 from amontons.accuracy.settings import REFERENCE  # noqa: E402
-from amontons.plots import _save  # noqa: E402
+from amontons.study.plots import save_figure  # noqa: E402
 
 MARKERS = ("o", "s", "^", "D", "v")
 # an error of exactly 0 (a setting equal to the reference in that measure) is drawn here
@@ -49,4 +49,4 @@ def plot_error_versus_time(table: pd.DataFrame, title: str, paths: list[str]) ->
         ax.set_title(ERRORS[measure], fontsize=7, wrap=True)
     axes[0].legend(fontsize=7)
     fig.suptitle(title, fontsize=9)
-    _save(fig, paths)
+    save_figure(fig, paths)

@@ -10,7 +10,7 @@ import pandas as pd
 
 from amontons.accuracy.compare import relative_l2
 from amontons.accuracy.settings import REFERENCE
-from amontons.fits import fit_power_law
+from amontons.power_law import fit_power_law
 
 # error measure -> what it is (column names of the table end in _error)
 ERRORS = {
@@ -23,7 +23,8 @@ ERRORS = {
 
 
 def exponent(loads_mn: Sequence[float], areas: Sequence[float]) -> float:
-    """The load-area power-law exponent (OLS in log-log, :func:`amontons.fits.fit_power_law`)."""
+    """The load-area power-law exponent (OLS in log-log,
+    :func:`amontons.power_law.fit_power_law`)."""
     loads = np.asarray(loads_mn, dtype=float)
     fit = fit_power_law(loads, np.asarray(areas, dtype=float), x_ref=loads[0])
     return float(fit.exponent.estimate)

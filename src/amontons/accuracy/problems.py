@@ -22,8 +22,9 @@ from amontons.accuracy.settings import Setting, problem_kind
 from amontons.accuracy.timing import law_at_ratio, plastic_ratio
 from amontons.contact import ContactResult, solve_load_series
 from amontons.contact.surfaces import self_affine
+from amontons.measured_resources import fft_points
+from amontons.models import with_parameter
 from amontons.physics.hertz import contact_radius
-from amontons.resources import fft_points
 from amontons.simulate.scene import Scene, scene_for_sphere
 from amontons.simulate.surface import LevelledMap, afm_indenter
 
@@ -71,8 +72,7 @@ def _sphere_scene(name: str, model: str, setting: Setting, map_pixel_m: float, r
         "tol": setting.tol,
         "optics": "none",
         "rendering": "emission",
-        "p_y_mpa": None,
-        "k_mpa_per_nm": None,
+        **{model.parameter.key: None for model in with_parameter()},
     }
     return scene_for_sphere(name, config, record["sphere"], record)
 

@@ -15,14 +15,14 @@ import itertools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from amontons.accuracy.timing import PLASTIC_RATIO
 from amontons.config.errors import ConfigError
+from amontons.models import CONTACT_HARDENING, ELASTIC, timed
 
 # problem -> (contact model, geometry)
 PROBLEMS = {
-    "elastic_sphere": ("elastic", "sphere"),
-    "hardening_sphere": ("hardening", "sphere"),
-    "periodic": ("elastic", "flat_periodic"),
+    "elastic_sphere": (ELASTIC.name, "sphere"),
+    "hardening_sphere": (CONTACT_HARDENING.name, "sphere"),
+    "periodic": (ELASTIC.name, "flat_periodic"),
 }
 REFERENCE = "reference"
 
@@ -70,7 +70,7 @@ def _setting(problem: str, pixel_factor, tol, window_factor, coarse_to_fine) -> 
     """The setting as the problem sees it, None where it means nothing there: coarse-to-fine
     with plasticity (the solver ignores it), a window factor on a periodic surface."""
     model, geometry = problem_kind(problem)
-    if coarse_to_fine and model != "elastic":
+    if coarse_to_fine and model != ELASTIC.name:
         return None
     window = None if geometry == "flat_periodic" else float(window_factor)
     return Setting(int(pixel_factor), float(tol), window, bool(coarse_to_fine))
@@ -112,10 +112,18 @@ def timing_points(config: Mapping) -> dict[str, tuple[str, float]]:
     dimensionless ratio)."""
     spec = config["timing_points"]
     points = {}
-    for model, key in PLASTIC_RATIO.items():
+    for model in timed():
+        key = model.timing_ratio
         for value in spec[key]:
-            points[f"{model}_{key[0]}{value:g}"] = (model, float(value))
+            points[f"{model.name}_{key[0]}{value:g}"] = (model.name, float(value))
     return points
+
+
+def timing_point_pattern() -> str:
+    """The regular expression of a timing point's name (:func:`timing_points`)."""
+    names = "|".join(model.name for model in timed())
+    letters = "".join(sorted({model.timing_ratio[0] for model in timed()}))
+    return rf"({names})_[{letters}][0-9.e+-]+"
 
 
 def timing_setting(config: Mapping) -> Setting:

@@ -38,10 +38,8 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
-from amontons.resources import fft_points
-
-# the dimensionless number each plastic model's convolutions follow (module docstring)
-PLASTIC_RATIO = {"hardening": "stiffness_ratio", "penetration_hardness": "yield_ratio"}
+from amontons.measured_resources import fft_points
+from amontons.models import ELASTIC, model_named
 
 
 def stiffness_ratio(k_pa_per_m: float, pixel_m: float, e_star_pa: float) -> float:
@@ -56,34 +54,53 @@ def yield_ratio(p_y_pa: float, e_star_pa: float, slope_rms: float) -> float:
     return p_y_pa / (0.5 * e_star_pa * slope_rms)
 
 
+def _stiffness_ratio_at(value: float, *, pixel_m: float, e_star_pa: float, slope_rms):
+    return stiffness_ratio(value, pixel_m, e_star_pa)
+
+
+def _yield_ratio_at(value: float, *, pixel_m: float, e_star_pa: float, slope_rms):
+    return yield_ratio(value, e_star_pa, slope_rms) if slope_rms else None
+
+
+# A model's timing ratio (amontons.models: ContactModel.timing_ratio) as a function of its
+# parameter's SI value, the pixel (m), E* (Pa) and the rms slope (None where unknown).
+RATIOS = {"stiffness_ratio": _stiffness_ratio_at, "yield_ratio": _yield_ratio_at}
+
+
 def plastic_ratio(
     model: str,
     *,
     pixel_m: float,
     e_star_pa: float,
-    k_pa_per_m: float | None = None,
-    p_y_pa: float | None = None,
     slope_rms: float | None = None,
+    **law_si: float | None,
 ) -> float | None:
-    """The dimensionless ratio z of a solve under ``model`` (:data:`PLASTIC_RATIO`); None for
-    an elastic solve or where the law or the slope is not known (the elastic limit)."""
-    if model == "hardening" and k_pa_per_m:
-        return stiffness_ratio(k_pa_per_m, pixel_m, e_star_pa)
-    if model == "penetration_hardness" and p_y_pa and slope_rms:
-        return yield_ratio(p_y_pa, e_star_pa, slope_rms)
-    return None
+    """The dimensionless ratio z of a solve under ``model`` (its record's timing ratio,
+    amontons.models), its parameter given as the Scene field of its SI value (``k_pa_per_m``,
+    ``p_y_pa``; others are ignored); None for a model without one, or where the parameter
+    or the slope is not known (the elastic limit)."""
+    record = model_named(model)
+    if record.timing_ratio is None:
+        return None
+    value = law_si.get(record.parameter.scene_field)
+    if not value:
+        return None
+    at = RATIOS[record.timing_ratio]
+    return at(value, pixel_m=pixel_m, e_star_pa=e_star_pa, slope_rms=slope_rms)
 
 
 def law_at_ratio(
     model: str, ratio: float, *, pixel_m: float, e_star_pa: float, slope_rms: float
 ) -> dict:
-    """The plastic law whose ratio is ``ratio``, as Scene fields: hardening
+    """The plastic law whose ratio is ``ratio``, as its Scene field: hardening
     ``k_pa_per_m`` = s·πE*/(2Δx) (Pa/m), penetration hardness ``p_y_pa`` = y·E*·h'_rms/2 (Pa)."""
-    if model == "hardening":
-        return {"k_pa_per_m": ratio / stiffness_ratio(1.0, pixel_m, e_star_pa)}
-    if model == "penetration_hardness":
-        return {"p_y_pa": ratio / yield_ratio(1.0, e_star_pa, slope_rms)}
-    raise ValueError(f"no plastic ratio for model {model!r}; expected one of {list(PLASTIC_RATIO)}")
+    record = model_named(model)
+    if record.timing_ratio is None:
+        raise ValueError(f"no plastic ratio for model {model!r}")
+    unit = RATIOS[record.timing_ratio](
+        1.0, pixel_m=pixel_m, e_star_pa=e_star_pa, slope_rms=slope_rms
+    )
+    return {record.parameter.scene_field: ratio / unit}
 
 
 def convolutions_per_load(
@@ -98,11 +115,11 @@ def convolutions_per_load(
     """Predicted convolutions per load of ``model`` at ``tol``, the contact ``contact_px``
     pixels across (a periodic surface: its side), its dimensionless ``ratio`` z (None: the
     elastic limit). A model the study did not measure takes the elastic count."""
-    coef = record["convolutions"]["elastic"]["coef"]
+    coef = record["convolutions"][ELASTIC.name]["coef"]
     features = _elastic_features(tol, periodic, contact_px)
     count = math.exp(sum(c * f for c, f in zip(coef, features, strict=True)))
     plastic = record["convolutions"].get(model)
-    if model == "elastic" or plastic is None:
+    if model_named(model).timing_ratio is None or plastic is None:
         return count
     share = 1.0 if ratio is None else ratio / (1.0 + ratio)
     return count * math.exp(plastic["offset"]) * share ** plastic["gamma"]
@@ -121,7 +138,7 @@ def predict(
 ) -> tuple[float, float]:
     """(wall time s, peak memory MB) of a load series of ``loads`` loads of ``model`` on a
     ``side_px`` grid at ``tol``: ``contact_px`` the Hertz contact diameter at the largest load
-    in pixels (None or periodic: the grid's side), ``ratio`` its z (:data:`PLASTIC_RATIO`;
+    in pixels (None or periodic: the grid's side), ``ratio`` its z (:func:`plastic_ratio`;
     None: the elastic limit). ``record``: the JSON that
     amontons.accuracy.timing_fit.fit_timing_model writes."""
     points = fft_points(side_px, periodic)

@@ -10,6 +10,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from amontons.accuracy.timing import point_features
+from amontons.models import ELASTIC
 
 
 def _fit_elastic(rows: Sequence[Mapping]) -> dict:
@@ -43,14 +44,14 @@ def fit_timing_model(points: Sequence[Mapping]) -> dict:
     point weighted by 1/t, so small solves count as much as large ones); memory by the line
     under which no point lies above by more than its own measurement (its largest excess
     over the fitted baseline)."""
-    elastic_rows = [p for p in points if p["model"] == "elastic"]
+    elastic_rows = [p for p in points if p["model"] == ELASTIC.name]
     if not elastic_rows:
         raise ValueError("the timing model needs elastic solves: none among the points")
-    counts = {"elastic": _fit_elastic(elastic_rows)}
-    for model in sorted({p["model"] for p in points} - {"elastic"}):
+    counts = {ELASTIC.name: _fit_elastic(elastic_rows)}
+    for model in sorted({p["model"] for p in points} - {ELASTIC.name}):
         rows = [p for p in points if p["model"] == model and p.get("ratio") is not None]
         if rows:
-            counts[model] = _fit_plastic(rows, counts["elastic"])
+            counts[model] = _fit_plastic(rows, counts[ELASTIC.name])
     n = np.array([p["fft_points"] for p in points], float)
     t = np.array([p["wall_time_s"] for p in points], float)
     work = np.array([p["convolutions"] for p in points], float) * n * np.log2(n)

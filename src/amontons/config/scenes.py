@@ -15,12 +15,7 @@ from amontons.config.geometry import (
     synthetic_frame,
     window_m,
 )
-
-# The scan parameters: the model each belongs to, and the sheet column its prior is in.
-SCAN_MODELS = {"p_y_mpa": "penetration_hardness", "k_mpa_per_nm": "hardening"}
-SCAN_COLUMNS = {"p_y_mpa": "hardness_mpa", "k_mpa_per_nm": "hardening_k_mpa_per_nm"}
-# The model parameter a scene takes from the sheet where its own is null: model -> (key, column).
-SCENE_PRIORS = {model: (key, SCAN_COLUMNS[key]) for key, model in SCAN_MODELS.items()}
+from amontons.models import ASPERITY_STATISTICS, model_named, model_of_parameter
 
 
 def _check_scene_window(name: str, scene: Mapping, frames: Mapping[str, Frame], source: str):
@@ -44,10 +39,10 @@ def sheet_prior(scene: Mapping) -> tuple[str, str] | None:
     """(key, sheet column) of the model parameter a scene on a sphere's map takes from the
     sheet because its own value is null; None where it needs none. A sphere without that
     column does not run the scene (amontons.workflow.scenes says so per sphere)."""
-    if scene["model"] not in SCENE_PRIORS or scene["surface"] == "synthetic":
+    parameter = model_named(scene["model"]).parameter
+    if parameter is None or scene["surface"] == "synthetic":
         return None
-    key, column = SCENE_PRIORS[scene["model"]]
-    return None if scene[key] is not None else (key, column)
+    return None if scene[parameter.key] is not None else (parameter.key, parameter.sheet_column)
 
 
 def _check_one_scene(name: str, scene: Mapping, spheres: Mapping[str, dict], source: str):
@@ -58,10 +53,11 @@ def _check_one_scene(name: str, scene: Mapping, spheres: Mapping[str, dict], sou
             f"{where}: optics = 'microscope' on a synthetic surface; expected 'none' (there is "
             "no measured image of a synthetic surface to render like or compare with)"
         )
-    if scene["model"] == "greenwood_tripp" and scene["optics"] == "microscope":
+    model = model_named(scene["model"])
+    if model.kind == ASPERITY_STATISTICS and scene["optics"] == "microscope":
         raise ConfigError(
-            f"{where}: optics = 'microscope' with model greenwood_tripp; expected 'none' "
-            "(Greenwood-Tripp gives a mean area fraction, not a contact map to render)"
+            f"{where}: optics = 'microscope' with model {model.name}; expected 'none' "
+            f"({model.label} gives a mean area fraction, not a contact map to render)"
         )
     if synthetic and "synthetic" not in scene:
         raise ConfigError(f"{where}: surface = 'synthetic' needs the key synthetic")
@@ -146,7 +142,7 @@ def _check_one_scan(name: str, scan: Mapping, config: Mapping, source: str) -> N
                 f"{where}: base scene {base} has {key} = {scene[key]!r}; expected {value!r} "
                 "(a scan is judged against the measured images at the measured loads)"
             )
-    model = SCAN_MODELS[scan["parameter"]]
+    model = model_of_parameter(scan["parameter"]).name
     if scene["model"] != model:
         raise ConfigError(
             f"{where}: parameter {scan['parameter']} belongs to model {model}, but base scene "

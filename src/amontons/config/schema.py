@@ -10,12 +10,53 @@ import jsonschema
 import yaml
 
 from amontons.config.errors import ConfigError
+from amontons.models import model_names, parameter_keys, with_parameter
 
 
 def load_schema(path: str | Path) -> dict:
-    """Read a JSON Schema written as YAML."""
+    """Read a JSON Schema written as YAML, with what the contact models' records decide
+    filled in (:func:`with_models`)."""
     with open(path) as stream:
-        return yaml.safe_load(stream)
+        return with_models(yaml.safe_load(stream))
+
+
+def _parameter_property(parameter) -> dict:
+    return {
+        "type": ["number", "null"],
+        "exclusiveMinimum": 0,
+        "description": f"{parameter.description}; null takes the sheet's {parameter.sheet_column}.",
+    }
+
+
+def _sheet_column_property(parameter) -> dict:
+    return {
+        "type": "number",
+        "exclusiveMinimum": 0,
+        "description": f"{parameter.description}, the prior of the scenes and scans of it.",
+    }
+
+
+def with_models(schema: dict) -> dict:
+    """``schema`` with the contact models' records (amontons.models) filled in, in place:
+    in the config schema, the allowed models of a scene and parameters of a scan, and each
+    parameter as a scene key; in the sample sheet's, each parameter's column. A key the
+    schema describes itself keeps its own description."""
+    parameters = [m.parameter for m in with_parameter()]
+    properties = schema.get("properties", {})
+    if "scenes" in properties and "scans" in properties:
+        scene = properties["scenes"]["additionalProperties"]
+        scene["properties"]["model"]["enum"] = list(model_names())
+        properties["scans"]["additionalProperties"]["properties"]["parameter"]["enum"] = list(
+            parameter_keys()
+        )
+        for parameter in parameters:
+            scene["properties"].setdefault(parameter.key, _parameter_property(parameter))
+            if parameter.key not in scene["required"]:
+                scene["required"].append(parameter.key)
+    elif "sphere" in properties:
+        for parameter in parameters:
+            properties.setdefault(parameter.sheet_column, _sheet_column_property(parameter))
+    return schema
 
 
 def _key_path(error: jsonschema.ValidationError) -> str:

@@ -7,7 +7,7 @@ dilated by ``margin_px``: the PSF spreads a patchy contact's light beyond its Ot
 share that shrinks as the contact grows, which biased a mask-only mean by +0.1 in the
 exponent on the rough virtual spheres), while the pixels beyond the margin are background.
 The appendix finds intensity ∝ √pressure; the exponent comes from a log–log OLS fit
-(amontons.fits.fit_power_law).
+(amontons.power_law.fit_power_law).
 """
 
 from __future__ import annotations
@@ -20,13 +20,13 @@ import numpy as np
 import pandas as pd
 from scipy.ndimage import binary_dilation
 
-from amontons.fits import PowerLawFit, fit_power_law
 from amontons.io.confocal import NO_CHOICE, ImageChoice
 from amontons.io.layout import RawDataError
 from amontons.io.rawdata import read_fluorescence_series
 from amontons.io.tiff import saturated_pixels
 from amontons.measure.area import OtsuSettings, separated_contact
 from amontons.measure.errors import NoContact
+from amontons.power_law import PowerLawFit, fit_power_law
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 import pandas as pd
 
-from amontons.fits import fit_power_law
+from amontons.power_law import fit_power_law
 
 log = logging.getLogger(__name__)
 

@@ -7,7 +7,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from amontons.fits import fit_power_law
+from amontons.power_law import fit_power_law
 
 # fit_power_law's standard errors need three points: a scene with fewer loads is not fitted.
 MIN_FIT_LOADS = 3

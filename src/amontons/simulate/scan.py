@@ -28,22 +28,24 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from amontons.config.scenes import SCAN_MODELS
+from amontons.models import UnknownModelError, model_of_parameter, parameter_keys
 from amontons.simulate.scan_grid import ScanError
 
-__all__ = ["PARAMETERS", "ScanError", "log_area_distance", "scene_config_at"]
-
-# The model each scan parameter belongs to: the config's table, one definition.
-PARAMETERS = SCAN_MODELS
+__all__ = ["ScanError", "log_area_distance", "scene_config_at"]
 
 
 def scene_config_at(base: Mapping, parameter: str, value: float) -> dict:
-    """The base scene's config with the scanned parameter set to ``value``."""
-    if parameter not in PARAMETERS:
-        raise ScanError(f"parameter = {parameter!r}; expected one of {list(PARAMETERS)}")
-    if base["model"] != PARAMETERS[parameter]:
+    """The base scene's config with the scanned parameter (its config key, amontons.models)
+    set to ``value``."""
+    try:
+        model = model_of_parameter(parameter).name
+    except UnknownModelError as exc:
         raise ScanError(
-            f"parameter {parameter} belongs to model {PARAMETERS[parameter]!r}, but the base "
+            f"parameter = {parameter!r}; expected one of {list(parameter_keys())}"
+        ) from exc
+    if base["model"] != model:
+        raise ScanError(
+            f"parameter {parameter} belongs to model {model!r}, but the base "
             f"scene's model is {base['model']!r}"
         )
     return {**base, parameter: float(value)}

@@ -6,12 +6,18 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from amontons.models import parameter_named
+
 # best.json's key that holds why a scan was not decided (amontons.simulate.scan_best), and
 # how the model table's source names such a scan.
 NOT_DECIDED = "not_decided"
 NOT_DECIDED_SOURCE = "not decided"
-# How a parameter is written in figures and tables: symbol and unit.
-PARAMETER_SYMBOLS = {"p_y_mpa": ("p_Y", "MPa"), "k_mpa_per_nm": ("k", "MPa/nm")}
+
+
+def symbol_and_unit(best: Mapping) -> tuple[str, str]:
+    """How figures and tables write a best.json record's parameter: symbol and unit."""
+    parameter = parameter_named(best["parameter"])
+    return parameter.symbol, parameter.unit
 
 
 def is_decided(best: Mapping) -> bool:
@@ -88,7 +94,7 @@ def estimate_text(best: Mapping) -> str:
     data set; and the grid's best named as such ('k = 5.31 MPa/nm (95% interval 4.61–6.13;
     grid's best 4.47)', 'k ≥ 2170 MPa/nm (95% bound, open at the scan's end; grid's best
     40000)')."""
-    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    symbol, unit = symbol_and_unit(best)
     low, high = best["interval"]
     grid = f"grid's best {significant(best['grid_best'])}"
     if is_bound(low, high):
@@ -106,7 +112,7 @@ def grid_best_text(best: Mapping) -> str:
     """The grid's best value of a best.json record, for a figure that shows the model there,
     with the estimate and its interval, or the bound, beside it ("the grid's best k = 4.47
     MPa/nm (estimate 5.31, 95% interval 4.61–6.13)")."""
-    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    symbol, unit = symbol_and_unit(best)
     low, high = best["interval"]
     grid = f"the grid's best {symbol} = {significant(best['grid_best'])} {unit}"
     if is_bound(low, high):
@@ -120,5 +126,5 @@ def grid_best_text(best: Mapping) -> str:
 def grid_best_label(best: Mapping) -> str:
     """The grid's best value of a best.json record, short, for a legend or a panel
     ("grid's best k = 4.47 MPa/nm")."""
-    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    symbol, unit = symbol_and_unit(best)
     return f"grid's best {symbol} = {significant(best['grid_best'])} {unit}"

@@ -3,7 +3,7 @@
 Neighbouring values of a scan give neighbouring contacts, so a value's load series starts
 each load from its neighbour's pressure at the same load instead of from its own previous
 load scaled up. One job solves a sphere's scan, its values in a fixed order
-(:data:`amontons.workflow.scenes.SCAN_CHAIN_ORDER`), and hands each value's pressures to the
+(its parameter's chain order, :mod:`amontons.models`), and hands each value's pressures to the
 next in memory.
 
 The chain's first value has no neighbour in the scan. Where the chain starts at the scan's

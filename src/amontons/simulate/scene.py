@@ -17,10 +17,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
+from amontons import contact
 from amontons.config import geometry
 from amontons.contact import ContactHardening, PenetrationHardness
+from amontons.models import UnknownModelError, model_named, model_names, with_parameter
 
-MODELS = ("greenwood_tripp", "elastic", "penetration_hardness", "hardening")
 INCREMENTS = {"local": "local", "volume_conserving": "volume"}
 
 
@@ -77,12 +78,20 @@ class Scene:
     @property
     def plasticity(self) -> PenetrationHardness | ContactHardening | None:
         """The plasticity law, None for an elastic (or Greenwood-Tripp) scene: no plastic loop."""
-        increment = INCREMENTS[self.increment]
-        if self.model == "penetration_hardness":
-            return PenetrationHardness(self.p_y_pa, increment=increment, alpha=self.alpha)
-        if self.model == "hardening":
-            return ContactHardening(self.k_pa_per_m, increment=increment, alpha=self.alpha)
-        return None
+        model = model_named(self.model)
+        if model.law is None:
+            return None
+        law = getattr(contact, model.law)
+        value = getattr(self, model.parameter.scene_field)
+        return law(value, increment=INCREMENTS[self.increment], alpha=self.alpha)
+
+    def _parameters_record(self) -> dict:
+        """Every model parameter in config units (None where the scene has none)."""
+        out = {}
+        for model in with_parameter():
+            value = getattr(self, model.parameter.scene_field)
+            out[model.parameter.key] = None if value is None else value * model.parameter.from_si
+        return out
 
     def to_record(self) -> dict:
         """JSON/HDF5-attribute-ready settings, units in the key names."""
@@ -100,8 +109,7 @@ class Scene:
             "tol": self.tol,
             "optics": self.optics,
             "rendering": self.rendering,
-            "p_y_mpa": None if self.p_y_pa is None else self.p_y_pa * 1e-6,
-            "k_mpa_per_nm": None if self.k_pa_per_m is None else self.k_pa_per_m * 1e-15,
+            **self._parameters_record(),
             "increment": self.increment,
             "alpha": self.alpha,
         }
@@ -140,18 +148,23 @@ def _sheet_or(name: str, config: Mapping, key: str, record: Mapping, column: str
 
 
 def _model_parameters(name: str, config: Mapping, record: Mapping) -> dict:
-    model = config["model"]
-    if model not in MODELS:
-        raise SceneError(f"scene {name}: model = {model!r}; expected one of {MODELS}")
+    try:
+        model = model_named(config["model"])
+    except UnknownModelError as exc:
+        raise SceneError(
+            f"scene {name}: model = {config['model']!r}; expected one of {model_names()}"
+        ) from exc
     out = {"increment": config.get("increment", "local"), "alpha": config.get("alpha", 1.0)}
-    if model == "penetration_hardness":
-        out["p_y_pa"] = _sheet_or(name, config, "p_y_mpa", record, "hardness_mpa", 1e6)
-        if out["p_y_pa"] <= 0:
-            raise SceneError(f"scene {name}: p_y_mpa = {out['p_y_pa'] * 1e-6:g}; expected > 0")
-    if model == "hardening":
-        out["k_pa_per_m"] = _sheet_or(
-            name, config, "k_mpa_per_nm", record, "hardening_k_mpa_per_nm", 1e15
+    parameter = model.parameter
+    if parameter is not None:
+        value = _sheet_or(
+            name, config, parameter.key, record, parameter.sheet_column, parameter.to_si
         )
+        if value <= 0:
+            raise SceneError(
+                f"scene {name}: {parameter.key} = {value * parameter.from_si:g}; expected > 0"
+            )
+        out[parameter.scene_field] = value
     return out
 
 

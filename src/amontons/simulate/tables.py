@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from amontons.models import model_named
 from amontons.simulate.scan_record import NOT_DECIDED, NOT_DECIDED_SOURCE
 
 # The exponent columns of a scene that was not fitted: empty, with left_out saying why.
@@ -104,9 +105,8 @@ def model_table_rows(
     for name, scene in scenes.items():
         area, fit = _chosen_fit(scene["fit"])
         largest = scene["largest"]
-        parameter = {"penetration_hardness": "p_y_mpa", "hardening": "k_mpa_per_nm"}.get(
-            models[name]
-        )
+        own = model_named(models[name]).parameter
+        parameter = None if own is None else own.key
         rows.append(
             {
                 "sphere": sphere,

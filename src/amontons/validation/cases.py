@@ -11,12 +11,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-ELASTIC = "elastic"
-PENETRATION_HARDNESS = "penetration_hardness"
-HARDENING = "hardening"
-# each plastic model's scanned parameter (config ``scans``) and its unit's scale to SI
-PARAMETER_OF = {PENETRATION_HARDNESS: "p_y_mpa", HARDENING: "k_mpa_per_nm"}
-SI_SCALE = {"p_y_mpa": 1e6, "k_mpa_per_nm": 1e15}
+from amontons import models
+
+ELASTIC = models.ELASTIC.name
+PENETRATION_HARDNESS = models.PENETRATION_HARDNESS.name
+HARDENING = models.CONTACT_HARDENING.name
+# each plastic model's scanned parameter (config ``scans``)
+PARAMETER_OF = {m.name: m.parameter.key for m in models.with_parameter()}
 TRUTH_MODELS = (ELASTIC, PENETRATION_HARDNESS, HARDENING)
 # how far a truth's areas lie from the other models' against the study's model error: beyond
 # it, below it, or an elastic truth (which every plastic model approaches at its elastic end)

@@ -16,7 +16,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from amontons.plots import _save  # noqa: E402
+from amontons.study.plots import save_figure  # noqa: E402
 
 # how far past the panel's data an open end is drawn (×)
 OPEN_REACH = 1.5
@@ -79,4 +79,4 @@ def plot_intervals(cases: pd.DataFrame, study_ratio: float, paths: list[str]) ->
         Line2D([], [], color=MISSED, lw=2, label="misses it"),
     ]
     axes[0][-1].legend(handles=handles, fontsize=6, loc="lower right")
-    _save(fig, paths)
+    save_figure(fig, paths)

@@ -4,7 +4,7 @@ grid value (a solve at ``model_error_pixel_factor`` times the pixel, and the PSF
 error),
 the refinement about the estimate and the interval's ends, the scan's estimate and interval
 (amontons.simulate.scan_best), and the decision between the models
-(amontons.study_decision). The same functions the scan and verdict jobs call, on the truth's
+(amontons.study.decision). The same functions the scan and verdict jobs call, on the truth's
 measured areas (amontons.validation.truth), here in memory.
 
 The study renders with the PSF it measured: the true FWHM plus one draw of its stated
@@ -29,7 +29,7 @@ from amontons.simulate.scan_criterion import Criterion, TooFewLoads
 from amontons.simulate.scan_grid import scan_values
 from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.surface import area_average
-from amontons.study_decision import Decision, decide
+from amontons.study.decision import Decision, decide
 from amontons.validation.cases import (
     HARDENING,
     PARAMETER_OF,
@@ -234,7 +234,7 @@ def run_scan(study: CaseStudy, model: str) -> ScanAnswer:
 
 def decision_of(answers: Sequence[ScanAnswer]) -> Decision:
     """The decision between the scanned models and the elastic limit, as the verdict takes
-    it (amontons.study_summary.model_decision): χ² under the measured scatter, the larger of
+    it (amontons.study.summary.model_decision): χ² under the measured scatter, the larger of
     the scans' quantiles, the fewest loads."""
     return decide(
         {a.model: a.best.chi2_min_measured for a in answers},

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import pandas as pd
 from scipy.stats import binomtest
 
-from amontons.study_summary import markdown_table
+from amontons.study.summary import markdown_table
 from amontons.validation.case import NOT_DECIDED
 from amontons.validation.cases import (
     BELOW_MODEL_ERROR,
@@ -188,7 +188,7 @@ def cost_table(cases: pd.DataFrame) -> pd.DataFrame:
 
 
 def _markdown(table: pd.DataFrame) -> str:
-    """A table as a Markdown (pipe) table (amontons.study_summary.markdown_table), numbers to
+    """A table as a Markdown (pipe) table (amontons.study.summary.markdown_table), numbers to
     3 significant digits."""
 
     def cell(v) -> str:

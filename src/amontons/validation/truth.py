@@ -18,19 +18,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from amontons.contact import (
-    ContactHardening,
-    FreeBoundaryError,
-    PenetrationHardness,
-    solve_load_series,
-)
+from amontons import contact
+from amontons.contact import FreeBoundaryError, solve_load_series
 from amontons.contact.surfaces import sphere as sphere_cap
 from amontons.measure.area import ContactArea, OtsuSettings, otsu_contact_area
+from amontons.models import model_named
 from amontons.physics import hertz
 from amontons.physics.emission import confined_emission
 from amontons.simulate.grid import PixelAverager
 from amontons.simulate.render import image_side_px
-from amontons.validation.cases import HARDENING, PENETRATION_HARDNESS, SI_SCALE, Case, Truth
+from amontons.validation.cases import Case, Truth
 from amontons.virtual.fluorescence import render_fluorescence
 from amontons.virtual.rough_contact import HARDENING_RADIUS_GUESS, fast_even
 from amontons.virtual.roughness import Roughness, synthesize
@@ -80,11 +77,10 @@ class Sphere:
 def law_of(model: str, value: float | None):
     """The plasticity law of ``model`` at ``value`` (config units: p_y_mpa, k_mpa_per_nm), SI;
     None for the elastic model."""
-    if model == PENETRATION_HARDNESS:
-        return PenetrationHardness(value * SI_SCALE["p_y_mpa"])
-    if model == HARDENING:
-        return ContactHardening(value * SI_SCALE["k_mpa_per_nm"])
-    return None
+    record = model_named(model)
+    if record.law is None:
+        return None
+    return getattr(contact, record.law)(value * record.parameter.to_si)
 
 
 def truth_law(truth: Truth):

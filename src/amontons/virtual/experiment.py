@@ -21,7 +21,6 @@ from pathlib import Path
 
 import numpy as np
 
-from amontons.fits import fit_power_law
 from amontons.io.files import write_json
 from amontons.io.layout import (
     ABSORBANCE_NAME,
@@ -33,8 +32,10 @@ from amontons.io.layout import (
     rheometer_name,
 )
 from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
+from amontons.models import CONTACT_HARDENING
 from amontons.physics import hertz
 from amontons.physics.newton_rings import ring_gap
+from amontons.power_law import fit_power_law
 from amontons.virtual.instruments import (
     ABSORBANCE_PEAK_NM,
     COATED_FACES,
@@ -174,10 +175,12 @@ def generate_sphere(
     fit = fit_power_law(np.array(loads_n), areas, x_ref=loads_n[0])
     truth.update(
         {
-            "forward_model": "rough sphere, contact hardening (elastic half-space + Winkler layer)",
+            "forward_model": (
+                f"rough sphere, {CONTACT_HARDENING.label} (elastic half-space + Winkler layer)"
+            ),
             "diameter_mm": diameter_m * 1e3,
             "e_star_gpa": e_star_pa * 1e-9,
-            "hardening_k_mpa_per_nm": hardening_k_pa_per_m * 1e-15,
+            CONTACT_HARDENING.parameter.sheet_column: hardening_k_pa_per_m * 1e-15,
             "roughness": {
                 "rms_nm_at_afm_pixel": roughness_rms_m * 1e9,
                 "hurst": surface.hurst,

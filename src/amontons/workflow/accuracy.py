@@ -5,10 +5,18 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from amontons.accuracy.settings import problem_kind, settings_by_name, timing_points
+from amontons.accuracy.settings import (
+    problem_kind,
+    settings_by_name,
+    timing_point_pattern,
+    timing_points,
+)
 from amontons.workflow import paths as files
 from amontons.workflow.paths import RunPaths
 from amontons.workflow.spheres import Spheres
+
+# The wildcard constraint of a timing point's name.
+TIMING_POINT = timing_point_pattern()
 
 
 class AccuracyStudy:

@@ -1,8 +1,8 @@
 """Cluster resources of each job (docs/cluster.md): each rule's measured wall time and peak
-memory (workflow/resources.json, amontons.resources), and for the solves the accuracy study's
-timing model (workflow/timing_model.json, docs/accuracy.md §6) in their FFT grid, loads,
-tolerance and plastic ratio. The grid is the scene's own (amontons.config.geometry), so that
-what a job asks for grows with what it solves."""
+memory (workflow/resources.json, amontons.measured_resources), and for the solves the
+accuracy study's timing model (workflow/timing_model.json, docs/accuracy.md §6) in their
+FFT grid, loads, tolerance and plastic ratio. The grid is the scene's own
+(amontons.config.geometry), so that what a job asks for grows with what it solves."""
 
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ from pathlib import Path
 
 from amontons.accuracy.timing import plastic_ratio, predict
 from amontons.config import geometry
-from amontons.resources import JobResources, mem_mb_of, runtime_min
+from amontons.measured_resources import JobResources, mem_mb_of, runtime_min
+from amontons.models import with_parameter
 from amontons.workflow.spheres import Spheres
 
 # A job's solves, one after the other, from its wildcards: each (scene, sphere or None for a
@@ -73,8 +74,8 @@ class SolveResources:
 
     def solve_size(self, scene, sphere=None, scan=None, value=None) -> tuple[str, dict]:
         """What the timing model needs of a scene's solve on ``sphere`` (None: synthetic),
-        with the scan parameter ``scan`` (p_y_mpa or k_mpa_per_nm) at ``value`` if given:
-        model and the keyword arguments of amontons.accuracy.timing.predict."""
+        with the scan parameter ``scan`` (a parameter's config key, amontons.models) at
+        ``value`` if given: model and the keyword arguments of amontons.accuracy.timing.predict."""
         spec = self.scenes[scene]
         if sphere is None:
             frame = geometry.synthetic_frame(spec)
@@ -85,8 +86,8 @@ class SolveResources:
             frame = geometry.sphere_frame(spec, row)
             slope = None  # the map's slope is known only once it is levelled
             law = {
-                "p_y_mpa": spec["p_y_mpa"] or row.get("hardness_mpa"),
-                "k_mpa_per_nm": spec["k_mpa_per_nm"] or row.get("hardening_k_mpa_per_nm"),
+                p.key: spec[p.key] or row.get(p.sheet_column)
+                for p in (m.parameter for m in with_parameter())
             }
         if scan is not None:
             law = {**law, scan: float(value)}
@@ -100,8 +101,10 @@ class SolveResources:
             spec["model"],
             pixel_m=pixel,
             e_star_pa=frame.e_star_pa,
-            k_pa_per_m=(law.get("k_mpa_per_nm") or 0.0) * 1e15,
-            p_y_pa=(law.get("p_y_mpa") or 0.0) * 1e6,
+            **{
+                p.scene_field: (law.get(p.key) or 0.0) * p.to_si
+                for p in (m.parameter for m in with_parameter())
+            },
             slope_rms=slope,
         )
         return spec["model"], {

@@ -1,30 +1,27 @@
 """The expansion of scenes and scans into jobs (docs/simulate.md, docs/study.md): a scene on
 a sphere's AFM map runs for every selected sphere; a synthetic scene runs once and reads
-nothing of the experiment; each value of a sphere's scan is a job of its own. Only what a
-scene names is scheduled: its comparison files exist only with optics."""
+nothing of the experiment; a sphere's scan is one job, which solves its values one after
+another. Only what a scene names is scheduled: its comparison files exist only with
+optics."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 
 from amontons.config import geometry
-from amontons.config.scenes import SCAN_COLUMNS, sheet_prior
+from amontons.config.scenes import sheet_prior
 from amontons.io.pixel_probe import tiff_scan_side_m
+from amontons.models import ELASTIC, FIELD, model_named, parameter_named
 from amontons.simulate.scan_grid import scan_values, value_label
 from amontons.workflow import paths as files
 from amontons.workflow.params import sorted_keys
 from amontons.workflow.paths import FilesInFolder, RunPaths
 from amontons.workflow.spheres import AFM_BEFORE, Spheres
 
-# What a scan's prior-free range is a multiple of (config scans.<name>.prior_free_range).
-PRIOR_FREE_SCALES = {"p_y_mpa": "p_Y/E*", "k_mpa_per_nm": "k·Δx/E*"}
-
-
-# The order a scan's values run in, each starting from the one before: -1 from the largest
-# value down, +1 from the smallest up; per parameter, the order that took fewer CG
-# iterations on the virtual PS and PMMA-4mm spheres (benchmarks/bench_scan_warm_start.py;
-# docs/study.md §1, "Warm-started values").
-SCAN_CHAIN_ORDER = {"p_y_mpa": -1, "k_mpa_per_nm": +1}
+# A scan's values run in its parameter's chain order (amontons.models), each starting from
+# the one before: per parameter, the order that took fewer CG iterations on the virtual PS
+# and PMMA-4mm spheres (benchmarks/bench_scan_warm_start.py; docs/study.md §1, "Warm-started
+# values").
 
 # AFM formats whose scan size the DAG reads from the header (amontons.io.pixel_probe).
 HEADER_SIZED_AFM = (".tif", ".tiff")
@@ -73,7 +70,7 @@ class Scenes:
                 continue
             if optics is not None and scene["optics"] != optics:
                 continue
-            if field is not None and (scene["model"] != "greenwood_tripp") != field:
+            if field is not None and (model_named(scene["model"]).kind == FIELD) != field:
                 continue
             names.append(name)
         return names
@@ -155,7 +152,7 @@ class Scenes:
         coverage = {}
         for scene in self.runnable(sphere):
             spec = self.scenes[scene]
-            if spec["model"] == "greenwood_tripp":
+            if model_named(spec["model"]).kind != FIELD:
                 continue  # mean-field: no window on the map
             frame = geometry.sphere_frame(spec, record)
             cut = geometry.frame_in_scan(scene, spec, frame, side_um * 1e-6)
@@ -206,9 +203,10 @@ class Scenes:
         for scan, spec in self.scans.items():
             if self.prior(sphere, scan) is None and scan in self.runnable_scans(sphere):
                 low, high = spec["prior_free_range"]
+                parameter = parameter_named(spec["parameter"])
                 lines.append(
-                    f"no {SCAN_COLUMNS[spec['parameter']]} in the sheet: scan {scan} runs over "
-                    f"its prior-free range ({PRIOR_FREE_SCALES[spec['parameter']]} {low:g} to "
+                    f"no {parameter.sheet_column} in the sheet: scan {scan} runs over "
+                    f"its prior-free range ({parameter.prior_free_scale} {low:g} to "
                     f"{high:g}, {spec['prior_free_steps']} values)"
                 )
         return lines
@@ -276,25 +274,27 @@ class Scenes:
     # scans
 
     def scans_of(self, parameter: str) -> list[str]:
-        """The running scans of ``parameter`` (p_y_mpa or k_mpa_per_nm)."""
+        """The running scans of ``parameter`` (a parameter's config key, amontons.models)."""
         return [name for name, spec in self.scans.items() if spec["parameter"] == parameter]
 
     def prior(self, sphere: str, scan: str) -> float | None:
         """The sheet's value a sphere's scan is centred on, or None (no prior)."""
-        return self.spheres.value(sphere, SCAN_COLUMNS[self.scans[scan]["parameter"]])
+        column = parameter_named(self.scans[scan]["parameter"]).sheet_column
+        return self.spheres.value(sphere, column)
 
     def prior_free_scale(self, sphere: str, scan: str) -> float:
         """The scale (in the parameter's config unit) that makes a scan's prior-free range
         dimensionless on a sphere: E* (MPa) for p_Y, E*/Δx (MPa/nm) for k, Δx the solver
         pixel of the scan's base scene on that sphere (amontons.config.geometry)."""
         spec = self.scans[scan]
+        parameter = parameter_named(spec["parameter"])
         base = self.scenes[spec["scene"]]
         frame = geometry.sphere_frame(base, self.spheres.row(sphere))
-        if spec["parameter"] == "p_y_mpa":
-            return frame.e_star_pa * 1e-6
+        if parameter.prior_free_pixel_power == 0:
+            return frame.e_star_pa * parameter.from_si
         window = geometry.window_m(spec["scene"], base, frame)
         pixel = geometry.solver_pixel_m(base, window)
-        return frame.e_star_pa / pixel * 1e-15
+        return frame.e_star_pa / pixel**parameter.prior_free_pixel_power * parameter.from_si
 
     def scan_params(self, sphere: str, scan: str) -> dict:
         """A scan's config as a scan job's params: the keys of the range its sphere is scanned
@@ -321,10 +321,14 @@ class Scenes:
         return [value_label(v) for v in values]
 
     def scan_chain(self, sphere: str, scan: str) -> list[str]:
-        """A scan's values in the order its job solves them (:data:`SCAN_CHAIN_ORDER`), each
-        starting from the one before (amontons.simulate.scan_start)."""
+        """A scan's values in the order its job solves them (its parameter's chain order,
+        amontons.models), each starting from the one before (amontons.simulate.scan_start)."""
         labels = sorted(self.scan_value_labels(sphere, scan), key=float)
-        return labels[::-1] if SCAN_CHAIN_ORDER[self.scans[scan]["parameter"]] < 0 else labels
+        return labels[::-1] if self.chain_order(scan) < 0 else labels
+
+    def chain_order(self, scan: str) -> int:
+        """+1 where a scan solves its values from the smallest up, -1 from the largest down."""
+        return parameter_named(self.scans[scan]["parameter"]).chain_order
 
     def scan_seed_scene(self, sphere: str, scan: str) -> str | None:
         """The scene whose pressures start a scan's first value (amontons.simulate.scan_start):
@@ -332,13 +336,13 @@ class Scenes:
         first running elastic scene on its map; None where it starts at the other end or the
         sphere runs no elastic scene. The elastic scene's comparison registers the sphere,
         which the scan waits for already: its fields cost the scan no wait."""
-        if SCAN_CHAIN_ORDER[self.scans[scan]["parameter"]] > 0:
+        if self.chain_order(scan) > 0:
             return None
         return self.sphere_elastic_scene(sphere)
 
     def sphere_elastic_scene(self, sphere: str) -> str | None:
         """The sphere's first running elastic scene on its map, or None."""
-        elastic = [s for s in self.runnable(sphere) if self.scenes[s]["model"] == "elastic"]
+        elastic = [s for s in self.runnable(sphere) if self.scenes[s]["model"] == ELASTIC.name]
         return elastic[0] if elastic else None
 
     def scan_seed_fields(self, wildcards) -> list[str]:

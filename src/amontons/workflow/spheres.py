@@ -38,12 +38,21 @@ from amontons.io.layout import (
     rheometer_files,
 )
 from amontons.io.pixel_probe import load_plane_count, states_pixel_size
+from amontons.models import CONTACT_HARDENING, with_parameter
 from amontons.workflow.failures import FailedJob
 from amontons.workflow.params import sorted_keys
 from amontons.workflow.paths import CONTACT_AREA, RunPaths
 
 # The sheet values a scene takes from its sphere.
-SCENE_COLUMNS = ("diameter_mm", "e_star_gpa", "loads", "hardness_mpa", "hardening_k_mpa_per_nm")
+SCENE_COLUMNS = (
+    "diameter_mm",
+    "e_star_gpa",
+    "loads",
+    *(m.parameter.sheet_column for m in with_parameter()),
+)
+# The sheet column of a virtual sphere's true contact-hardening coefficient, MPa/nm (the
+# virtual experiment's truth is contact hardening: docs/workflow.md).
+TRUE_HARDENING_COLUMN = CONTACT_HARDENING.parameter.sheet_column
 # A sphere's optional raw inputs (config/README.md, "Required and optional files"): without one,
 # exactly the outputs that read it, and what follows from them, are not made.
 REFLECTION, BEAD, ABSORBANCE, AFM_BEFORE, AFM_AFTER, RHEOMETER = (

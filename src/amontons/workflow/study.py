@@ -6,12 +6,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from amontons.models import CONTACT_HARDENING, ELASTIC, GREENWOOD_TRIPP
 from amontons.workflow import paths as files
 from amontons.workflow.paths import RunPaths, figure_files
 from amontons.workflow.scenes import Scenes
 from amontons.workflow.spheres import AFM_AFTER, RHEOMETER, Spheres
 
-K = "k_mpa_per_nm"
+# The scanned parameter of Figs. B.9 and B.11.
+K = CONTACT_HARDENING.parameter.key
 
 
 class Study:
@@ -43,16 +45,20 @@ class Study:
         """Fig. B.11's inputs: the elastic scene's rendered loads and registration, the
         Greenwood-Tripp solve and the k scan."""
         where = (wildcards.material, wildcards.sphere)
-        elastic = self.scenes.first("elastic", "microscope")
-        gt = self.scenes.first("greenwood_tripp")
+        elastic = self.scenes.first(ELASTIC.name, "microscope")
+        gt = self.scenes.first(GREENWOOD_TRIPP.name)
         return {
-            "elastic": {
+            ELASTIC.name: {
                 "rendered": self.paths.scene(files.RENDERED, *where, elastic),
                 "registration": self.paths.scene(files.REGISTRATION, *where, elastic),
             },
             "gt_solve": self.paths.scene(files.SOLVE, *where, gt),
             "k_scan": self.k_scan(wildcards),
         }
+
+    def load_series_elastic(self, wildcards) -> dict:
+        """Fig. B.11's elastic scene: its rendered loads and registration."""
+        return self.load_series_layout(wildcards)[ELASTIC.name]
 
     def _compared_files(self, material: str, sphere: str, scene: str) -> dict:
         """A scene's solve and, with optics, its comparison."""
@@ -125,8 +131,8 @@ class Study:
             if self.spheres.has(sphere, AFM_AFTER):
                 names.append("B9_flattening")
             runs = self.scenes.runnable(sphere)
-            elastic = self.scenes.first("elastic", "microscope")
-            gt = self.scenes.first("greenwood_tripp")
+            elastic = self.scenes.first(ELASTIC.name, "microscope")
+            gt = self.scenes.first(GREENWOOD_TRIPP.name)
             if elastic in runs and gt in runs:
                 names.append("B11_load_series")
         folder = self.paths.study(material, sphere)

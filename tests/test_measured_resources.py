@@ -1,11 +1,11 @@
-"""Cluster resources from measured runs (amontons.resources, workflow/resources.json)."""
+"""Cluster resources from measured runs (amontons.measured_resources, workflow/resources.json)."""
 
 import json
 from pathlib import Path
 
 import pytest
 
-from amontons.resources import (
+from amontons.measured_resources import (
     MIN_MEM_MB,
     MIN_RUNTIME_MIN,
     SAFETY,

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from amontons.fits import fit_power_law
+from amontons.power_law import fit_power_law
 
 
 def test_exact_power_law_is_recovered_to_round_off():

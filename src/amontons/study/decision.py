@@ -24,9 +24,12 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from amontons.models import ELASTIC as ELASTIC_MODEL
+
 __all__ = ["ELASTIC", "Decision", "decide"]
 
-ELASTIC = "elastic"
+# The model every scan's elastic end approaches (the decision's reference).
+ELASTIC = ELASTIC_MODEL.name
 
 
 @dataclass(frozen=True)

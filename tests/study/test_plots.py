@@ -12,10 +12,9 @@ import pytest  # noqa: E402
 from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.font_manager import FontProperties  # noqa: E402
 
-import amontons.plots  # noqa: E402
-import amontons.study_figures  # noqa: E402
-from amontons.plots import fit_titles, plot_scene_comparison, wrap_to_width  # noqa: E402
-from amontons.study_figures import (  # noqa: E402
+import amontons.study.figures  # noqa: E402
+import amontons.study.plots  # noqa: E402
+from amontons.study.figures import (  # noqa: E402
     Curve,
     MapPanel,
     plot_area_curves,
@@ -23,6 +22,7 @@ from amontons.study_figures import (  # noqa: E402
     plot_map_grid,
     plot_normalised_study,
 )
+from amontons.study.plots import fit_titles, plot_scene_comparison, wrap_to_width  # noqa: E402
 
 # The title of Fig. B.11 on the full run's PS sphere (issue 35), and a longer one.
 B11_TITLE = (
@@ -65,14 +65,14 @@ def overflowing_titles(fig) -> list[str]:
 def saved(monkeypatch):
     """Every figure the plotting functions save, kept after saving (closed, but drawable)."""
     figures = []
-    real = amontons.plots._save
+    real = amontons.study.plots.save_figure
 
     def keep(fig, paths):
         real(fig, paths)
         figures.append(fig)
 
-    monkeypatch.setattr(amontons.plots, "_save", keep)
-    monkeypatch.setattr(amontons.study_figures, "_save", keep)
+    monkeypatch.setattr(amontons.study.plots, "save_figure", keep)
+    monkeypatch.setattr(amontons.study.figures, "save_figure", keep)
     return figures
 
 

@@ -13,7 +13,7 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 from docutils.core import publish_parts  # noqa: E402
 
-from amontons.study_summary import (  # noqa: E402
+from amontons.study.summary import (  # noqa: E402
     ReportFigure,
     SummaryError,
     display_rows,

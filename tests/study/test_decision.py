@@ -4,8 +4,8 @@ decided', with the models the data cannot tell apart and why."""
 
 import pytest
 
-from amontons.study_decision import ELASTIC, decide
-from amontons.study_summary import decided_text
+from amontons.study.decision import ELASTIC, decide
+from amontons.study.summary import decided_text
 
 RISE_5 = 10.128  # F(1, 3) at 95 %: five loads
 

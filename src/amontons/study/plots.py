@@ -40,7 +40,7 @@ def plot_normalised_load_area(
     ax.set_ylabel(f"A / A({reference_load_mn:g} mN)")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 # Rounds of wrapping and layout fit_titles runs at most: a wrap makes a title taller and the
@@ -137,7 +137,7 @@ def _lay_out(fig, renderer) -> None:
 FIGURE_DPI = 150
 
 
-def _save(fig, paths: list[str]) -> None:
+def save_figure(fig, paths: list[str]) -> None:
     """Fit the titles (fit_titles), then write ``fig`` to each path (format from the
     extension), atomically, and close it."""
     fit_titles(fig)
@@ -186,7 +186,7 @@ def plot_psf_profile(
     ax.set_ylabel("intensity (counts)")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_absorbance(
@@ -213,7 +213,7 @@ def plot_absorbance(
     ax.set_ylabel("absorbance")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_edge_gap(
@@ -251,7 +251,7 @@ def plot_edge_gap(
     ax.set_ylabel("gap (nm)")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7, loc="lower right")
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_unmeasured(reason: str, title: str, paths: list[str]) -> None:
@@ -269,7 +269,7 @@ def plot_unmeasured(reason: str, title: str, paths: list[str]) -> None:
         transform=ax.transAxes,
     )
     ax.set_title(title, fontsize=9)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 # The widths (px at FIGURE_DPI) of the map panels below, 3 and 2.4 in: a map is drawn with no
@@ -311,7 +311,7 @@ def plot_topography(
         ax.set_xlabel("x (µm)")
     axes[0].set_ylabel("y (µm)")
     fig.suptitle(title, fontsize=9)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_amontons_deviation(
@@ -336,7 +336,7 @@ def plot_amontons_deviation(
             ax.plot(rows["normal_force_mn"] / reference_load_mn, rows[column], "o-", label=sphere)
         amontons_axes(ax, span, reference_load_mn, label, name, legend_size=7)
     fig.suptitle(title, fontsize=9)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def amontons_axes(ax, span, reference_load_mn: float, ylabel: str, title: str, legend_size):
@@ -399,14 +399,14 @@ def plot_contact_separation(
     axes[0, 0].set_ylabel("y (µm)", fontsize=7)
     axes[1, 0].set_ylabel("pixels", fontsize=7)
     fig.suptitle(title, fontsize=9)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_intensity_pressure(
     pressure_mpa: np.ndarray, intensity_counts: np.ndarray, fit, title: str, paths: list[str]
 ) -> None:
     """Appendix Fig. B.4: background-subtracted mean contact intensity versus mean contact
-    pressure F/A (log–log), the fitted power law (``fit``: amontons.fits.PowerLawFit with
+    pressure F/A (log–log), the fitted power law (``fit``: amontons.power_law.PowerLawFit with
     x_ref in Pa) and the appendix's square-root law through the fit at the middle pressure."""
     fig, ax = plt.subplots(figsize=(4.5, 3.5), constrained_layout=True)
     ax.plot(pressure_mpa, intensity_counts, "o", label="per load")
@@ -438,7 +438,7 @@ def plot_intensity_pressure(
     ax.set_ylabel("mean contact intensity (counts)")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_scene_comparison(
@@ -483,4 +483,4 @@ def plot_scene_comparison(
         ax.tick_params(labelsize=6)
     axes[0, 0].set_ylabel("y (µm)", fontsize=7)
     fig.suptitle(title + "\ngreen: measured Otsu edge, magenta: simulated", fontsize=8)
-    _save(fig, paths)
+    save_figure(fig, paths)

@@ -20,29 +20,24 @@ from pathlib import Path
 
 import pandas as pd
 
-from amontons.config.scenes import SCAN_MODELS
+from amontons.models import in_verdict_order, model_of_parameter, parameter_named, with_parameter
 from amontons.simulate.scan_record import (
     JUDGEMENT_COLUMNS,
     NOT_DECIDED,
     NOT_DECIDED_SOURCE,
-    PARAMETER_SYMBOLS,
     interval_text,
     is_bound,
     is_decided,
     significant,
+    symbol_and_unit,
 )
-from amontons.study_decision import Decision, decide
+from amontons.study.decision import Decision, decide
 
 # The models of the verdict, in the order the study discusses them (docs/study.md §4), and
 # how a reader names them.
-MODELS = {
-    "hardening": "contact hardening",
-    "elastic": "elastic",
-    "penetration_hardness": "penetration hardness",
-    "greenwood_tripp": "Greenwood–Tripp",
-}
+MODELS = {model.name: model.label for model in in_verdict_order()}
 # The scanned parameter of each plastic model.
-MODEL_PARAMETERS = {model: parameter for parameter, model in SCAN_MODELS.items()}
+MODEL_PARAMETERS = {model.name: model.parameter.key for model in with_parameter()}
 # The model-table columns the verdict reads.
 MODEL_TABLE_COLUMNS = (
     "sphere",
@@ -60,8 +55,6 @@ MODEL_TABLE_COLUMNS = (
     "area_ratio_largest",
     *JUDGEMENT_COLUMNS.values(),
 )
-# verdict.csv's column stem of a scanned parameter.
-PARAMETER_STEMS = {"k_mpa_per_nm": "k", "p_y_mpa": "p_y"}
 # The section of the summary and the report that names the spheres a failed job holds out.
 FAILED_TITLE = "Failed: held out of every table and figure"
 
@@ -134,7 +127,7 @@ def verdict_rows(table: pd.DataFrame, material: str, source: str) -> list[dict]:
             )
             row[f"{model}_source"] = None if chosen is None else chosen["source"]
         for model, parameter in MODEL_PARAMETERS.items():
-            stem = PARAMETER_STEMS[parameter]
+            stem = parameter_named(parameter).stem
             chosen = model_row(own, model)
             scanned = chosen is not None and chosen["source"].startswith("scan ")
             for column, key in (
@@ -156,11 +149,11 @@ def verdict_rows(table: pd.DataFrame, material: str, source: str) -> list[dict]:
 
 def model_decision(row: Mapping, own: pd.DataFrame) -> Decision:
     """The decision between the models a verdict row's scans judged
-    (:func:`amontons.study_decision.decide`), from their χ² columns (``own``: the sphere's
+    (:func:`amontons.study.decision.decide`), from their χ² columns (``own``: the sphere's
     model-table rows, for the quantile and the loads)."""
     best, elastic_end = {}, {}
     for model, parameter in MODEL_PARAMETERS.items():
-        stem = PARAMETER_STEMS[parameter]
+        stem = parameter_named(parameter).stem
         if _present(row[f"{stem}_chi2_best"]):
             best[model] = row[f"{stem}_chi2_best"]
             elastic_end[model] = row[f"{stem}_chi2_elastic_end"]
@@ -208,10 +201,14 @@ def model_text(row: Mapping, model: str) -> str:
 
 def parameter_text(row: Mapping, parameter: str) -> str:
     """A verdict row's cell for a scanned parameter: estimate, interval, grid's best."""
-    stem = PARAMETER_STEMS[parameter]
+    stem = parameter_named(parameter).stem
     estimate = row.get(f"{stem}_estimate")
     if not _present(estimate):
-        return NOT_DECIDED_SOURCE if _not_decided(row, SCAN_MODELS[parameter]) else "not scanned"
+        return (
+            NOT_DECIDED_SOURCE
+            if _not_decided(row, model_of_parameter(parameter).name)
+            else "not scanned"
+        )
     low, high = (_cell(row[f"{stem}_{end}"]) for end in ("low", "high"))
     grid = f"grid's best {significant(row[f'{stem}_grid_best'])}"
     if is_bound(low, high):
@@ -269,10 +266,10 @@ def display_rows(verdict: pd.DataFrame, confidence: float) -> list[list[str]]:
     ]
     for model, name in MODELS.items():
         parameter = MODEL_PARAMETERS.get(model)
-        at = "" if parameter is None else f" at the grid's best {PARAMETER_SYMBOLS[parameter][0]}"
+        at = "" if parameter is None else f" at the grid's best {parameter_named(parameter).symbol}"
         lines.append([f"{name}{at}", *(model_text(r, model) for r in records)])
     for parameter in MODEL_PARAMETERS.values():
-        symbol, unit = PARAMETER_SYMBOLS[parameter]
+        symbol, unit = parameter_named(parameter).symbol, parameter_named(parameter).unit
         lines.append(
             [
                 f"{symbol} (estimate, {unit}; {confidence:.0%} interval)",
@@ -406,9 +403,9 @@ def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
     """A scan's estimate with its interval and the grid's best (best.json); for a scan not
     decided, why."""
     if not is_decided(best):
-        symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+        symbol, unit = symbol_and_unit(best)
         return Headline(
-            f"{sphere}: {symbol} of {MODELS[_model_of(best['parameter'])]} ({unit})",
+            f"{sphere}: {symbol} of {model_of_parameter(best['parameter']).label} ({unit})",
             f"{NOT_DECIDED_SOURCE}: {best[NOT_DECIDED]}",
             f"`{path}`: {NOT_DECIDED}",
         )
@@ -418,7 +415,7 @@ def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
             "best_scan_value that states the scan's estimate (rerun it, snakemake "
             "--forcerun best_scan_value)"
         )
-    symbol, unit = PARAMETER_SYMBOLS[best["parameter"]]
+    symbol, unit = symbol_and_unit(best)
     low, high = best["interval"]
     edge = "; the grid's best is at the scan's end" if best["at_scan_edge"] else ""
     grid = f"grid's best {significant(best['grid_best'])}{edge}"
@@ -430,14 +427,10 @@ def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
             f"{interval_text(low, high)}; {grid})"
         )
     return Headline(
-        f"{sphere}: {symbol} of {MODELS[_model_of(best['parameter'])]} ({unit})",
+        f"{sphere}: {symbol} of {model_of_parameter(best['parameter']).label} ({unit})",
         value,
         f"`{path}`: estimate, interval, grid_best",
     )
-
-
-def _model_of(parameter: str) -> str:
-    return next(m for m, p in MODEL_PARAMETERS.items() if p == parameter)
 
 
 def model_headlines(row: Mapping, verdict_path: str, models_path: str) -> list[Headline]:

@@ -17,14 +17,18 @@ import pandas as pd  # noqa: E402
 
 from amontons.io.fields import read_load_series_settings  # noqa: E402
 from amontons.io.files import write_table  # noqa: E402
-from amontons.plots import (  # noqa: E402
+from amontons.models import CONTACT_HARDENING  # noqa: E402
+from amontons.simulate.grid import block_mean  # noqa: E402
+from amontons.study.plots import (  # noqa: E402
     FIGURE_DPI,
-    _save,
     amontons_axes,
     display_factor,
     plot_unmeasured,
+    save_figure,
 )
-from amontons.simulate.grid import block_mean  # noqa: E402
+
+# The figures' table column of the k scan's grid's best k (config units).
+BEST_K = f"best_{CONTACT_HARDENING.parameter.key}"
 
 
 @dataclass(frozen=True)
@@ -166,7 +170,7 @@ def plot_map_grid(
         f"{title} (each panel {side:.0f} µm wide; {_drawn_at(_GRID_PANEL_PX)})",
         fontsize=8,
     )
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_height_maps(panels: Sequence[MapPanel], title: str, paths: list[str]) -> None:
@@ -196,7 +200,7 @@ def plot_height_maps(panels: Sequence[MapPanel], title: str, paths: list[str]) -
         f"{title} (each panel {side:.1f} µm wide; {_drawn_at(_HEIGHT_PANEL_PX)})",
         fontsize=8,
     )
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 @dataclass(frozen=True)
@@ -243,7 +247,7 @@ def plot_area_curves(
     _plain_log_ticks(ax)
     ax.set_title(title, fontsize=8)
     ax.legend(fontsize=6)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def plot_normalised_study(
@@ -274,7 +278,7 @@ def plot_normalised_study(
     for ax in axes:
         _plain_log_ticks(ax)
     fig.suptitle(title, fontsize=9)
-    _save(fig, paths)
+    save_figure(fig, paths)
 
 
 def grid_best_path(rendered_paths: Sequence[str], best: dict) -> str:
@@ -290,6 +294,6 @@ def write_undecided_k_scan(
 ) -> None:
     """The table and the figure (Fig. B.9 or B.11) of a sphere whose k scan was not decided
     (best.json's ``not_decided``): why, in both, in place of a model that was not solved."""
-    table = pd.DataFrame([{"best_k_mpa_per_nm": None, "not_decided": best["not_decided"]}])
+    table = pd.DataFrame([{BEST_K: None, "not_decided": best["not_decided"]}])
     write_table(table_path, table)
     plot_unmeasured(best["not_decided"], f"{label}: the k scan was not decided", figure_paths)

@@ -1,0 +1,191 @@
+"""The contact models' records (amontons.models) hold their names: no model name, parameter
+key or sheet column is written as a literal in the package, the scripts or the rules outside
+the records (the configs, the docs and the tests may name them). The solver
+(amontons.contact) keeps its routes' own names and is not read. docs/contributing.md.
+
+A literal is a string constant (an f-string's text parts included; docstrings are docs) that
+is a one-word model name (``"hardening"``, ``"elastic"``; the same word in prose, "the
+elastic end", is physics), or in which a compound name or label appears as a whole token
+(``"penetration_hardness"``, ``"contact hardening"``, ``"Greenwood–Tripp"``), or a parameter
+key or sheet column appears at all (``"best_k_mpa_per_nm"``); but not
+``"elastic_displacement"`` or ``"hardening_sphere"`` (another name that begins with a
+model's)."""
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+import yaml
+
+from amontons import contact, models
+from amontons.config.schema import load_schema, with_models
+from amontons.contact.options import resolve_route
+from amontons.contact.routes import ROUTES
+
+REPO = Path(__file__).resolve().parents[1]
+RECORDS = REPO / "src" / "amontons" / "models.py"
+SOLVER = REPO / "src" / "amontons" / "contact"
+
+
+def _compound_words() -> set[str]:
+    """Names that count as a whole token anywhere in a literal: the models' names and
+    labels that are not one plain word (``penetration_hardness``, ``Greenwood–Tripp``)."""
+    names = {m.name for m in models.MODELS} | {m.label for m in models.MODELS}
+    return {name for name in names if not name.isalpha()}
+
+
+def _plain_words() -> set[str]:
+    """The models' names that are one plain word (``elastic``, ``hardening``): they count
+    where a literal is that word alone (a key, a name), not in prose ("the elastic end")."""
+    return {m.name for m in models.MODELS if m.name.isalpha()}
+
+
+def _inner_words() -> set[str]:
+    """Names that count inside a longer token too: the parameters' keys and sheet columns."""
+    return {
+        name
+        for m in models.with_parameter()
+        for name in (m.parameter.key, m.parameter.sheet_column)
+    }
+
+
+def named_in(text: str) -> list[str]:
+    """The model, label, parameter or sheet-column names ``text`` writes out."""
+    found = [word for word in _plain_words() if text.strip() == word]
+    for word in _compound_words():
+        if re.search(rf"(?<![\w]){re.escape(word)}(?![\w])", text, flags=re.IGNORECASE):
+            found.append(word)
+    for word in _inner_words():
+        if re.search(rf"(?<![A-Za-z0-9]){re.escape(word)}(?![A-Za-z0-9])", text):
+            found.append(word)
+    return sorted(found)
+
+
+def _docstrings(tree: ast.AST) -> set[int]:
+    """The ids of the docstring constants of a module, class or function."""
+    ids = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                ids.add(id(body[0].value))
+    return ids
+
+
+def python_literals(source: str) -> list[tuple[int, str]]:
+    """(line, text) of every string constant of a Python source but its docstrings."""
+    tree = ast.parse(source)
+    skip = _docstrings(tree)
+    return [
+        (node.lineno, node.value)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in skip
+    ]
+
+
+_SMK_STRING = re.compile(r"""("(?:[^"\\\n]|\\.)*"|'(?:[^'\\\n]|\\.)*')""")
+
+
+def rule_literals(source: str) -> list[tuple[int, str]]:
+    """(line, text) of every one-line string of a rule file, its comments left out."""
+    out = []
+    for number, line in enumerate(source.splitlines(), 1):
+        code = line.split("#", 1)[0] if not line.lstrip().startswith("#") else ""
+        out += [(number, match[1:-1]) for match in _SMK_STRING.findall(code)]
+    return out
+
+
+def _code_files() -> list[Path]:
+    files = [p for p in (REPO / "src" / "amontons").rglob("*.py") if SOLVER not in p.parents]
+    files += sorted((REPO / "scripts").glob("*.py"))
+    files += sorted((REPO / "workflow" / "rules").glob("*.smk")) + [REPO / "Snakefile"]
+    return [p for p in files if p != RECORDS]
+
+
+def literal_names(path: Path) -> list[str]:
+    """Each literal of ``path`` that writes out a model's name, as 'path:line: names'."""
+    source = path.read_text()
+    literals = python_literals(source) if path.suffix == ".py" else rule_literals(source)
+    return [
+        f"{path.relative_to(REPO)}:{line}: {', '.join(found)}"
+        for line, text in literals
+        if (found := named_in(text))
+    ]
+
+
+def test_no_model_name_is_written_outside_its_record():
+    found = [hit for path in _code_files() for hit in literal_names(path)]
+    assert found == [], "model names outside amontons.models:\n" + "\n".join(found)
+
+
+@pytest.mark.parametrize(
+    "planted",
+    [
+        'MODEL = "hardening"\n',
+        'COLUMN = f"best_{x}" if x else "best_k_mpa_per_nm"\n',
+        'label = f"{sphere}: Greenwood–Tripp area"\n',
+        'rows = {"elastic": [], "x": []}\n',
+        'prior = row.get("hardness_mpa")\n',
+    ],
+)
+def test_a_planted_literal_is_found(tmp_path, planted):
+    path = tmp_path / "planted.py"
+    path.write_text('"""A module whose docstring may say hardening."""\n' + planted)
+    assert literal_names_at(path)
+
+
+def test_a_docstring_or_a_longer_name_is_not_a_literal(tmp_path):
+    path = tmp_path / "clean.py"
+    path.write_text(
+        '"""Contact hardening and penetration_hardness, in words."""\n'
+        'FIELD = "elastic_displacement"\nPROBLEM = "hardening_sphere"\n'
+    )
+    assert literal_names_at(path) == []
+
+
+def test_a_rule_files_strings_are_read_and_its_comments_are_not():
+    source = (
+        'rule a:\n    # the "elastic" scene\n    input:\n        x=lambda wc: f(wc)["elastic"],\n'
+    )
+    assert [named_in(text) for _, text in rule_literals(source)] == [["elastic"]]
+
+
+def literal_names_at(path: Path) -> list[str]:
+    """:func:`literal_names` of a file anywhere (the planted ones live outside the repo)."""
+    literals = python_literals(path.read_text())
+    return [f"{line}: {found}" for line, text in literals if (found := named_in(text))]
+
+
+def _schema_enum(schema: dict, *keys: str) -> list:
+    node = schema
+    for key in keys:
+        node = node[key]
+    return node["enum"]
+
+
+def test_the_schemas_allowed_models_and_parameters_come_from_the_records():
+    schema = with_models(load_schema(REPO / "workflow" / "schemas" / "config.schema.yaml"))
+    scene = schema["properties"]["scenes"]["additionalProperties"]
+    scan = schema["properties"]["scans"]["additionalProperties"]
+    assert _schema_enum(scene["properties"], "model") == list(models.model_names())
+    assert _schema_enum(scan["properties"], "parameter") == list(models.parameter_keys())
+    for key in models.parameter_keys():
+        assert key in scene["properties"] and key in scene["required"]
+
+
+def test_the_shipped_config_runs_every_model_it_names_from_a_record():
+    config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    named = {scene["model"] for scene in config["scenes"].values()}
+    assert named <= set(models.model_names())
+    assert {scan["parameter"] for scan in config["scans"].values()} <= set(models.parameter_keys())
+
+
+def test_each_law_and_route_a_record_names_is_the_solvers():
+    for model in models.MODELS:
+        if model.law is None:
+            continue
+        law = getattr(contact, model.law)(1.0)
+        assert resolve_route(law, None) == model.route
+        assert model.route in ROUTES
+    assert models.ELASTIC.route in ROUTES
