@@ -40,6 +40,30 @@ def _common_window_m(problem, study: dict, record: dict | None) -> float:
     return common_window_factor(study) * diameter
 
 
+def _problem(problem_name: str, setting, study: dict, levelled_path: str | None, record: dict):
+    """The problem at ``setting``: the periodic surface, or the rough sphere's levelled map."""
+    _, geometry = problem_kind(problem_name)
+    if geometry == "flat_periodic":
+        return periodic_problem(setting, study["periodic"])
+    levelled = load_levelled_map(levelled_path)
+    return sphere_problem(problem_name, setting, levelled, record, levelled_path)
+
+
+def _per_load(results, rendered_um2) -> list[dict]:
+    """Each load's row of the summary: true and rendered area (µm²) and the solver's cost."""
+    return [
+        {
+            "load_mn": r.load * 1e3,
+            "area_um2": r.area * 1e12,
+            "rendered_area_um2": area,
+            "iterations": int(r.iterations),
+            "convolutions": float(r.info.convolutions),
+            "solve_s": float(r.info.wall_time_s),
+        }
+        for r, area in zip(results, rendered_um2, strict=True)
+    ]
+
+
 def main(
     problem_name: str,
     setting_name: str,
@@ -53,12 +77,7 @@ def main(
     summary_path: str,
 ) -> None:
     setting = settings_by_name(problem_name, study)[setting_name]
-    _, geometry = problem_kind(problem_name)
-    if geometry == "flat_periodic":
-        problem = periodic_problem(setting, study["periodic"])
-    else:
-        levelled = load_levelled_map(levelled_path)
-        problem = sphere_problem(problem_name, setting, levelled, record, levelled_path)
+    problem = _problem(problem_name, setting, study, levelled_path, record)
     log.info(
         "%s at %s: %d² grid of %.1f nm, window %.1f µm",
         problem_name,
@@ -80,17 +99,7 @@ def main(
         psf_fwhm_m=read_json(psf_path)["fwhm_nm"]["estimate"] * 1e-9,
         otsu=otsu,
     )
-    per_load = [
-        {
-            "load_mn": r.load * 1e3,
-            "area_um2": r.area * 1e12,
-            "rendered_area_um2": area,
-            "iterations": int(r.iterations),
-            "convolutions": float(r.info.convolutions),
-            "solve_s": float(r.info.wall_time_s),
-        }
-        for r, area in zip(results, rendered, strict=True)
-    ]
+    per_load = _per_load(results, rendered)
     summary = {
         "problem": problem_name,
         "setting": setting_name,

@@ -547,3 +547,59 @@ def test_no_compiled_kernel_reads_a_name_from_another_module():
     assert PACKAGE / "contact" / "kernels.py" in modules
     found = [hit for path in modules for hit in _foreign_names_in_kernels(path)]
     assert found == []
+
+
+LONGEST_FUNCTION = 80  # lines, the def's first to its last, its docstring aside
+
+
+def _docstring_lines(node: ast.AST) -> int:
+    body = getattr(node, "body", [])
+    first = body[0] if body else None
+    is_docstring = (
+        isinstance(first, ast.Expr)
+        and isinstance(first.value, ast.Constant)
+        and isinstance(first.value.value, str)
+    )
+    return first.end_lineno - first.lineno + 1 if is_docstring else 0
+
+
+def _says_why_longer(node: ast.AST, lines: list[str]) -> bool:
+    """A numba kernel may be longer where a comment above it says why (one fused loop is
+    faster than the named steps: docs/contributing.md)."""
+    jitted = any("jit" in ast.unparse(d) for d in node.decorator_list)
+    top = min([d.lineno for d in node.decorator_list] + [node.lineno])
+    above = lines[top - 2] if top >= 2 else ""
+    return jitted and above.lstrip().startswith("#") and "longer" in above
+
+
+def long_functions(source: str, where: str) -> list[str]:
+    """'where:line name (n lines)' of every function of ``source`` over LONGEST_FUNCTION."""
+    lines = source.splitlines()
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            n = node.end_lineno - node.lineno + 1 - _docstring_lines(node)
+            if n > LONGEST_FUNCTION and not _says_why_longer(node, lines):
+                found.append(f"{where}:{node.lineno} {node.name} ({n} lines)")
+    return found
+
+
+def test_the_length_check_finds_a_long_function_and_skips_docstrings():
+    body = "".join(f"    x{i} = {i}\n" for i in range(LONGEST_FUNCTION))
+    assert long_functions(f"def f():\n{body}", "here") == ["here:1 f (81 lines)"]
+    docstring = '    """' + "\n" * 30 + '    """\n'
+    short = "".join(f"    x{i} = {i}\n" for i in range(LONGEST_FUNCTION - 1))
+    assert long_functions(f"def g():\n{docstring}{short}", "here") == []
+    kernel = f"# longer: one fused loop\n@numba.njit\ndef k():\n{body}"
+    assert long_functions(kernel, "here") == []
+
+
+def test_no_function_in_the_library_or_the_scripts_is_over_80_lines():
+    """A function does one thing; past ~80 lines it is usually two (docs/contributing.md)."""
+    files = sorted(PACKAGE.rglob("*.py")) + sorted((REPO / "scripts").glob("*.py"))
+    found = [
+        hit
+        for path in files
+        for hit in long_functions(path.read_text(), str(path.relative_to(REPO)))
+    ]
+    assert found == []

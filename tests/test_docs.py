@@ -120,3 +120,14 @@ def test_the_changelog_agrees_with_pyprojects_version():
         assert all(version > v for v in released) or version == released[0]
     else:
         assert version == released[0]
+
+
+def test_the_readmes_job_count_is_the_full_runs():
+    """The README's count of `make reproduce`'s jobs is the full config's DAG: the record
+    tests/workflow/test_dag_unchanged.py holds to a dry run of config/config.yaml."""
+    text = PAGES[0].read_text(encoding="utf-8")
+    block = text.split("make reproduce", 1)[1].split("make test", 1)[0]
+    claimed = [int(n) for n in re.findall(r"(\d+) jobs", block)]
+    record = REPO / "tests" / "workflow" / "dags" / "config.jsonl"
+    jobs = len(record.read_text(encoding="utf-8").splitlines())
+    assert claimed and all(n == jobs for n in claimed), (claimed, jobs)

@@ -114,7 +114,7 @@ def timing_points(config: Mapping) -> dict[str, tuple[str, float]]:
     points = {}
     for model in timed():
         key = model.timing_ratio
-        for value in spec[key]:
+        for value in spec.get(key, ()):
             points[f"{model.name}_{key[0]}{value:g}"] = (model.name, float(value))
     return points
 

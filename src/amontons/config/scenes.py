@@ -42,7 +42,7 @@ def sheet_prior(scene: Mapping) -> tuple[str, str] | None:
     parameter = model_named(scene["model"]).parameter
     if parameter is None or scene["surface"] == "synthetic":
         return None
-    return None if scene[parameter.key] is not None else (parameter.key, parameter.sheet_column)
+    return None if scene.get(parameter.key) is not None else (parameter.key, parameter.sheet_column)
 
 
 def _check_one_scene(name: str, scene: Mapping, spheres: Mapping[str, dict], source: str):

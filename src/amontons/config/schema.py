@@ -49,10 +49,8 @@ def with_models(schema: dict) -> dict:
         properties["scans"]["additionalProperties"]["properties"]["parameter"]["enum"] = list(
             parameter_keys()
         )
-        for parameter in parameters:
+        for parameter in parameters:  # optional where the schema does not require it: null
             scene["properties"].setdefault(parameter.key, _parameter_property(parameter))
-            if parameter.key not in scene["required"]:
-                scene["required"].append(parameter.key)
     elif "sphere" in properties:
         for parameter in parameters:
             properties.setdefault(parameter.sheet_column, _sheet_column_property(parameter))

@@ -316,6 +316,145 @@ def _edge_radii(contact_radius_m, n_half_profiles: int) -> np.ndarray:
     return radii
 
 
+def _checked_image(reflection, edge_model: str, shape_radius_m: float | None) -> np.ndarray:
+    """The reflection image as a 2-D float array (counts), once it and the edge model pass.
+
+    Checked before anything is computed so that a wrong call fails with its own reason, not
+    with whatever the profile loop would stumble over.
+    """
+    image = np.asarray(reflection, dtype=float)
+    if image.ndim != 2:
+        raise NewtonRingError(f"reflection image has shape {image.shape}; expected 2-D")
+    if edge_model not in EDGE_MODELS:
+        raise NewtonRingError(f"edge_model '{edge_model}'; expected one of {EDGE_MODELS}")
+    if edge_model == SHEET_RADIUS and not (shape_radius_m and shape_radius_m > 0):
+        raise NewtonRingError(
+            f"edge model '{SHEET_RADIUS}' needs the sheet's Hertz radius (shape_radius_m > 0); "
+            f"got {shape_radius_m!r}"
+        )
+    return image
+
+
+def _centre_inside(image: np.ndarray, centre_px: tuple[float, float]) -> tuple[float, float]:
+    """The contact centre (row, col) in px, refused when it lies outside the image."""
+    row, col = centre_px
+    if not (0 <= row <= image.shape[0] - 1 and 0 <= col <= image.shape[1] - 1):
+        raise NewtonRingError(
+            f"contact centre (row {row:g}, col {col:g}) px lies outside the {image.shape} "
+            "reflection image"
+        )
+    return row, col
+
+
+def _ring_prominence(
+    image: np.ndarray, prominence_fraction: float, min_prominence_sd: float
+) -> float:
+    """Least prominence (counts) of a maximum that counts as a ring: ``prominence_fraction``
+    of the 2–98 % intensity range or ``min_prominence_sd`` noise sds, whichever is larger."""
+    low, high = np.percentile(image, [2, 98])
+    if not high > low:
+        # no intensity range, no prominence threshold: round-off of the smoothing would
+        # otherwise pass for ring maxima
+        raise NewtonRingError(
+            f"reflection image is uniform ({low:g} counts over 96 % of its pixels); expected "
+            "Newton rings around the contact"
+        )
+    return max(prominence_fraction * (high - low), min_prominence_sd * robust_noise_sd(image))
+
+
+def _read_half_profiles(
+    smoothed: np.ndarray,
+    centre_px: tuple[float, float],
+    angles: np.ndarray,
+    edge_radii: np.ndarray,
+    pixel_m: float,
+    settings: dict,
+) -> tuple[list[HalfProfile], list[str], list[str]]:
+    """Every ray's half-profile (angles in rad, radii and pixel in m), or why it was refused:
+    (profiles, other refusals, missed-ring refusals), in the order of ``angles``.
+
+    Missed rings are kept apart because their count decides whether the image's ring
+    numbering can be trusted at all (:func:`_drop_missed_ring_profiles`).
+    """
+    profiles, rejected, missed = [], [], []
+    for angle, edge in zip(angles, edge_radii, strict=True):
+        try:
+            profiles.append(_half_profile(smoothed, centre_px, angle, pixel_m, edge, settings))
+        except MissedRingError as error:
+            missed.append(str(error))
+        except NewtonRingError as error:
+            rejected.append(str(error))
+    return profiles, rejected, missed
+
+
+def _drop_missed_ring_profiles(
+    profiles: list[HalfProfile], rejected: list[str], missed: list[str], n_half_profiles: int
+) -> tuple[list[HalfProfile], list[str]]:
+    """The profiles still trusted once rings were missed, and all refusals with reasons.
+
+    Refuses the image when more than :data:`MAX_MISSED_FRACTION` of its half-profiles
+    missed a ring.
+    """
+    if len(missed) > MAX_MISSED_FRACTION * n_half_profiles:
+        raise NewtonRingError(
+            f"{len(missed)} of {n_half_profiles} half-profiles missed a ring (more than "
+            f"{MAX_MISSED_FRACTION:.0%}): the ring orders of this image are not safe; first: "
+            f"{missed[0]}"
+        )
+    rejected = rejected + missed
+    if missed:
+        # The spacing test needs three rings; once it has caught a missed ring elsewhere,
+        # a two-ring profile may be misnumbered in the same way without showing it.
+        unchecked = [p for p in profiles if p.ring_r_m.size < 3]
+        profiles = [p for p in profiles if p.ring_r_m.size >= 3]
+        rejected += [
+            f"profile at {np.degrees(p.angle_rad):.1f}°: {p.ring_r_m.size} rings cannot show a "
+            "missed ring, and other profiles missed one"
+            for p in unchecked
+        ]
+    return profiles, rejected
+
+
+def _check_enough_accepted(
+    profiles: list[HalfProfile],
+    rejected: list[str],
+    n_half_profiles: int,
+    min_accepted_fraction: float,
+) -> None:
+    """Refuse the image when fewer than ``min_accepted_fraction`` of its half-profiles (and
+    fewer than two, the least an sd needs) remain; the message names the first refusal."""
+    if len(profiles) < max(2, min_accepted_fraction * n_half_profiles):
+        raise NewtonRingError(
+            f"{len(rejected)} of {n_half_profiles} half-profiles refused (at least "
+            f"{min_accepted_fraction:.0%} must have usable rings); first: {rejected[0]}"
+        )
+
+
+def _edge_gap_result(
+    profiles: list[HalfProfile],
+    rejected: list[str],
+    edge_model: str,
+    shape_radius_m: float | None,
+    wavelength_m: float,
+    n_medium: float,
+) -> NewtonRingGap:
+    """Extrapolate the accepted profiles to their edges and gather the gaps (m) with them."""
+    edges, shape_radius = extrapolate_to_edges(profiles, edge_model, shape_radius_m)
+    profiles = [replace(p, edge_gap_m=float(g)) for p, g in zip(profiles, edges, strict=True)]
+    return NewtonRingGap(
+        edge_gap_mean_m=float(edges.mean()),
+        edge_gap_sd_m=float(edges.std(ddof=1)),
+        edge_gaps_m=edges,
+        angles_rad=np.array([p.angle_rad for p in profiles]),
+        first_ring_gap_m=float(ring_gap(0, wavelength_m, n_medium)),
+        edge_radii_m=np.array([p.edge_radius_m for p in profiles]),
+        edge_model=edge_model,
+        half_profiles=tuple(profiles),
+        rejected=tuple(rejected),
+        shape_radius_m=shape_radius,
+    )
+
+
 def newton_ring_gap(
     reflection: np.ndarray,
     pixel_m: float,
@@ -363,36 +502,12 @@ def newton_ring_gap(
     of the half-profiles have enough, correctly ordered rings outside their contact edge
     (the message names the first refused profile's reason).
     """
-    image = np.asarray(reflection, dtype=float)
-    if image.ndim != 2:
-        raise NewtonRingError(f"reflection image has shape {image.shape}; expected 2-D")
-    if edge_model not in EDGE_MODELS:
-        raise NewtonRingError(f"edge_model '{edge_model}'; expected one of {EDGE_MODELS}")
-    if edge_model == SHEET_RADIUS and not (shape_radius_m and shape_radius_m > 0):
-        raise NewtonRingError(
-            f"edge model '{SHEET_RADIUS}' needs the sheet's Hertz radius (shape_radius_m > 0); "
-            f"got {shape_radius_m!r}"
-        )
-    row, col = centre_px
-    if not (0 <= row <= image.shape[0] - 1 and 0 <= col <= image.shape[1] - 1):
-        raise NewtonRingError(
-            f"contact centre (row {row:g}, col {col:g}) px lies outside the {image.shape} "
-            "reflection image"
-        )
+    image = _checked_image(reflection, edge_model, shape_radius_m)
+    row, col = _centre_inside(image, centre_px)
     angles = half_profile_angles(n_profiles)
     edge_radii = _edge_radii(contact_radius_m, angles.size)
-    low, high = np.percentile(image, [2, 98])
-    if not high > low:
-        # no intensity range, no prominence threshold: round-off of the smoothing would
-        # otherwise pass for ring maxima
-        raise NewtonRingError(
-            f"reflection image is uniform ({low:g} counts over 96 % of its pixels); expected "
-            "Newton rings around the contact"
-        )
     settings = {
-        "prominence": max(
-            prominence_fraction * (high - low), min_prominence_sd * robust_noise_sd(image)
-        ),
+        "prominence": _ring_prominence(image, prominence_fraction, min_prominence_sd),
         "max_rings": max_rings,
         "edge_model": edge_model,
         "step_px": step_px,
@@ -403,47 +518,9 @@ def newton_ring_gap(
     # Noise is independent per pixel while the rings are tens of pixels wide: smoothing by a
     # pixel removes most of the noise and leaves the ring maxima where they are.
     smoothed = gaussian_filter(image, smooth_px, mode="nearest") if smooth_px > 0 else image
-    profiles, rejected, missed = [], [], []
-    for angle, edge in zip(angles, edge_radii, strict=True):
-        try:
-            profiles.append(_half_profile(smoothed, (row, col), angle, pixel_m, edge, settings))
-        except MissedRingError as error:
-            missed.append(str(error))
-        except NewtonRingError as error:
-            rejected.append(str(error))
-    if len(missed) > MAX_MISSED_FRACTION * angles.size:
-        raise NewtonRingError(
-            f"{len(missed)} of {angles.size} half-profiles missed a ring (more than "
-            f"{MAX_MISSED_FRACTION:.0%}): the ring orders of this image are not safe; first: "
-            f"{missed[0]}"
-        )
-    rejected += missed
-    if missed:
-        # The spacing test needs three rings; once it has caught a missed ring elsewhere,
-        # a two-ring profile may be misnumbered in the same way without showing it.
-        unchecked = [p for p in profiles if p.ring_r_m.size < 3]
-        profiles = [p for p in profiles if p.ring_r_m.size >= 3]
-        rejected += [
-            f"profile at {np.degrees(p.angle_rad):.1f}°: {p.ring_r_m.size} rings cannot show a "
-            "missed ring, and other profiles missed one"
-            for p in unchecked
-        ]
-    if len(profiles) < max(2, min_accepted_fraction * angles.size):
-        raise NewtonRingError(
-            f"{len(rejected)} of {angles.size} half-profiles refused (at least "
-            f"{min_accepted_fraction:.0%} must have usable rings); first: {rejected[0]}"
-        )
-    edges, shape_radius = extrapolate_to_edges(profiles, edge_model, shape_radius_m)
-    profiles = [replace(p, edge_gap_m=float(g)) for p, g in zip(profiles, edges, strict=True)]
-    return NewtonRingGap(
-        edge_gap_mean_m=float(edges.mean()),
-        edge_gap_sd_m=float(edges.std(ddof=1)),
-        edge_gaps_m=edges,
-        angles_rad=np.array([p.angle_rad for p in profiles]),
-        first_ring_gap_m=float(ring_gap(0, wavelength_m, n_medium)),
-        edge_radii_m=np.array([p.edge_radius_m for p in profiles]),
-        edge_model=edge_model,
-        half_profiles=tuple(profiles),
-        rejected=tuple(rejected),
-        shape_radius_m=shape_radius,
+    profiles, rejected, missed = _read_half_profiles(
+        smoothed, (row, col), angles, edge_radii, pixel_m, settings
     )
+    profiles, rejected = _drop_missed_ring_profiles(profiles, rejected, missed, angles.size)
+    _check_enough_accepted(profiles, rejected, angles.size, min_accepted_fraction)
+    return _edge_gap_result(profiles, rejected, edge_model, shape_radius_m, wavelength_m, n_medium)

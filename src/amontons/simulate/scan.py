@@ -16,8 +16,9 @@ the load-area law are fitted together. Two values within ``TIE`` of the same D (
 areas no longer depend on its parameter) are told apart by the IoU of the masks at the
 largest load.
 
-Each value is a job of its own (docs/study.md §1): this module holds what one value needs, the
-base scene's config at the value and the criterion D. Judging the scan from its values is
+A sphere's scan is one job that solves its values one after another (docs/study.md §1;
+:mod:`amontons.simulate.scan_job`): this module holds what one value needs, the base scene's
+config at the value and the criterion D. Judging the scan from its values is
 :mod:`amontons.simulate.scan_best`; reading and wording its best.json,
 :mod:`amontons.simulate.scan_record`.
 """

@@ -17,9 +17,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
-from amontons import contact
 from amontons.config import geometry
-from amontons.contact import ContactHardening, PenetrationHardness
+from amontons.contact import ContactHardening, PenetrationHardness, laws
 from amontons.models import UnknownModelError, model_named, model_names, with_parameter
 
 INCREMENTS = {"local": "local", "volume_conserving": "volume"}
@@ -81,7 +80,7 @@ class Scene:
         model = model_named(self.model)
         if model.law is None:
             return None
-        law = getattr(contact, model.law)
+        law = getattr(laws, model.law)
         value = getattr(self, model.parameter.scene_field)
         return law(value, increment=INCREMENTS[self.increment], alpha=self.alpha)
 

@@ -18,7 +18,8 @@ PENETRATION_HARDNESS = models.PENETRATION_HARDNESS.name
 HARDENING = models.CONTACT_HARDENING.name
 # each plastic model's scanned parameter (config ``scans``)
 PARAMETER_OF = {m.name: m.parameter.key for m in models.with_parameter()}
-TRUTH_MODELS = (ELASTIC, PENETRATION_HARDNESS, HARDENING)
+# the models a truth can be: those solved on a grid (amontons.models.FIELD)
+TRUTH_MODELS = tuple(m.name for m in models.MODELS if m.kind == models.FIELD)
 # how far a truth's areas lie from the other models' against the study's model error: beyond
 # it, below it, or an elastic truth (which every plastic model approaches at its elastic end)
 CLEAR = "clear"

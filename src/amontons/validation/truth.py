@@ -18,8 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from amontons import contact
-from amontons.contact import FreeBoundaryError, solve_load_series
+from amontons.contact import FreeBoundaryError, laws, solve_load_series
 from amontons.contact.surfaces import sphere as sphere_cap
 from amontons.measure.area import ContactArea, OtsuSettings, otsu_contact_area
 from amontons.models import model_named
@@ -80,7 +79,7 @@ def law_of(model: str, value: float | None):
     record = model_named(model)
     if record.law is None:
         return None
-    return getattr(contact, record.law)(value * record.parameter.to_si)
+    return getattr(laws, record.law)(value * record.parameter.to_si)
 
 
 def truth_law(truth: Truth):

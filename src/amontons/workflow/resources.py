@@ -86,7 +86,7 @@ class SolveResources:
             frame = geometry.sphere_frame(spec, row)
             slope = None  # the map's slope is known only once it is levelled
             law = {
-                p.key: spec[p.key] or row.get(p.sheet_column)
+                p.key: spec.get(p.key) or row.get(p.sheet_column)
                 for p in (m.parameter for m in with_parameter())
             }
         if scan is not None:
