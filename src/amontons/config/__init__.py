@@ -2,7 +2,8 @@
 can act on (config/README.md): one module per concern.
 
 - :mod:`~amontons.config.errors`: :class:`ConfigError`;
-- :mod:`~amontons.config.schema`: JSON Schema validation, every violation named;
+- :mod:`~amontons.config.schema`: JSON Schema validation, every violation named (and
+  :mod:`~amontons.config.reference`, config/README.md's key tables rendered from the schemas);
 - :mod:`~amontons.config.sheet`: the sample sheet, read and checked;
 - :mod:`~amontons.config.scenes`: scenes, presets, scans and curvature pairs;
 - :mod:`~amontons.config.geometry`: a scene's window and grid in SI, shared with the simulation;
