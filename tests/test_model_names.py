@@ -19,10 +19,14 @@ import pytest
 import yaml
 
 from amontons import models
+from amontons.accuracy.timing import plastic_ratio
+from amontons.config.scenes import sheet_prior
 from amontons.config.schema import load_schema, with_models
 from amontons.contact import laws
 from amontons.contact.options import resolve_route
 from amontons.contact.routes import ROUTES
+from amontons.simulate.scan import scene_config_at
+from amontons.simulate.scene import scene_for_sphere
 
 REPO = Path(__file__).resolve().parents[1]
 RECORDS = REPO / "src" / "amontons" / "models.py"
@@ -190,3 +194,72 @@ def test_each_law_and_route_a_record_names_is_the_solvers():
         assert resolve_route(law, None) == model.route
         assert model.route in ROUTES
     assert models.ELASTIC.route in ROUTES
+
+
+PLANTED = models.ContactModel(
+    name="capped_hardness",
+    label="capped hardness",
+    law="PenetrationHardness",
+    route="bounded",
+    kind=models.FIELD,
+    parameter=models.Parameter(
+        key="cap_mpa",
+        symbol="p_c",
+        unit="MPa",
+        to_si=1e6,
+        scene_field="p_y_pa",  # a new law's own Scene field is the trace's fourth file
+        law_field="p_y",
+        sheet_column="cap_mpa_prior",
+        stem="cap",
+        prior_free_scale="p_c/E*",
+        prior_free_pixel_power=0,
+        chain_order=-1,
+        description="A planted cap pressure, MPa",
+    ),
+    timing_ratio=None,
+    verdict_rank=4,
+)
+
+PROBE = {
+    "surface": "afm_before",
+    "geometry": "sphere",
+    "model": PLANTED.name,
+    "loads": "measured",
+    "pixel_nm": 256.0,
+    "window_factor": 1.5,
+    "side_px": None,
+    "max_side_px": 512,
+    "tol": 1.0e-6,
+    "optics": "none",
+    "rendering": "emission",
+    "confinement_floor_mpa": 0.0,
+    "increment": "local",
+    "alpha": 1.0,
+}
+
+
+def test_a_planted_record_is_all_the_pipeline_needs_of_a_new_model(monkeypatch):
+    """docs/contributing.md's trace, its pipeline part checked in-process: with one record
+    more in MODELS (its law one the solver has, its Scene field one a Scene has), the config
+    schema allows the model and its scan parameter, a scene takes the parameter from the
+    sheet's column where its own is null and solves with the record's law, a scan sets it,
+    and the timing model gives it the elastic count."""
+    monkeypatch.setattr(models, "MODELS", (*models.MODELS, PLANTED))
+    schema = load_schema(REPO / "workflow" / "schemas" / "config.schema.yaml")
+    scene_schema = schema["properties"]["scenes"]["additionalProperties"]
+    assert PLANTED.name in scene_schema["properties"]["model"]["enum"]
+    assert "cap_mpa" in scene_schema["properties"]
+    scan_schema = schema["properties"]["scans"]["additionalProperties"]["properties"]
+    assert "cap_mpa" in scan_schema["parameter"]["enum"]
+    sheet = load_schema(REPO / "workflow" / "schemas" / "materials.schema.yaml")
+    assert "cap_mpa_prior" in sheet["properties"]
+
+    record = {"diameter_mm": 1.0, "e_star_gpa": 3.5, "loads": [10.0, 20.0, 40.0]}
+    record["cap_mpa_prior"] = 80.0
+    assert sheet_prior({**PROBE, "cap_mpa": None}) == ("cap_mpa", "cap_mpa_prior")
+    scene = scene_for_sphere("probe", {**PROBE, "cap_mpa": None}, "PS", record)
+    assert isinstance(scene.plasticity, laws.PenetrationHardness)
+    assert scene.plasticity.p_y == pytest.approx(80e6, rel=1e-12)
+    assert scene.to_record()["cap_mpa"] == pytest.approx(80.0, rel=1e-12)
+    assert scene_config_at({**PROBE, "cap_mpa": None}, "cap_mpa", 120.0)["cap_mpa"] == 120.0
+    assert plastic_ratio(PLANTED.name, pixel_m=1e-7, e_star_pa=3.5e9, p_y_pa=8e7) is None
