@@ -63,7 +63,7 @@ def prepare(run_dir: Path, sphere: str, scan: str, out: Path) -> None:
     config = yaml.safe_load(Path("config/config.yaml").read_text())
     run = WorkflowRun.from_config(config, REPO / "workflow", "config/config.yaml")
     spheres, scenes, paths = run.spheres, run.scenes, run.paths
-    material = spheres.material_of(sphere)
+    material = spheres.rows.material_of(sphere)
     base_scene = scenes.scans[scan]["scene"]
     wildcards = SimpleNamespace(material=material, sphere=sphere, scan=scan)
     registration_scene = scenes.registration_scene(sphere, scan)

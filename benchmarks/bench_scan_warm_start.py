@@ -225,7 +225,7 @@ def main() -> None:
     args = parser.parse_args()
     config = yaml.safe_load(args.configfile.read_text())
     run = WorkflowRun.from_config(config, REPO / "workflow", str(args.configfile))
-    material = run.spheres.material_of(args.sphere)
+    material = run.spheres.rows.material_of(args.sphere)
     path = run.paths.measured(LEVELLED_MAP, material, args.sphere)
     levelled = load_levelled_map(path)
     print(f"# {__doc__.splitlines()[0]}")

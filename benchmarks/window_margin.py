@@ -37,7 +37,7 @@ from amontons.config.sheet import read_sample_sheet
 from amontons.contact import FreeBoundaryError
 from amontons.physics.hertz import contact_radius
 from amontons.simulate.surface import load_levelled_map
-from amontons.workflow.spheres import SCENE_COLUMNS
+from amontons.workflow.sheet_rows import SCENE_COLUMNS
 
 REPO = Path(__file__).resolve().parents[1]
 PROBLEMS = ("elastic_sphere", "hardening_sphere")

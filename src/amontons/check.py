@@ -30,10 +30,11 @@ from amontons.io.ptu import read_ptu_header
 from amontons.io.rheometer_files import read_rheometer_file, reader_label
 from amontons.io.tiff import read_tiff
 from amontons.simulate.scan_grid import MIN_LOADS
+from amontons.workflow.optional_inputs import AFM_AFTER, AFM_BEFORE, RHEOMETER
 from amontons.workflow.params import image_choice
 from amontons.workflow.run import WorkflowRun
 from amontons.workflow.scenes import outside_scan_lines
-from amontons.workflow.spheres import AFM_AFTER, AFM_BEFORE, RHEOMETER, Spheres
+from amontons.workflow.spheres import Spheres
 
 # The workflow folder of a clone or an editable install (schemas, measured resources).
 WORKFLOW_DIR = Path(__file__).resolve().parents[2] / "workflow"
@@ -129,14 +130,14 @@ def fluorescence_files(
     load, or for a file holding every load, that file once per load, with the load (mN) and
     the plane it is read from (``plane``, e.g. 'series 2'). RawDataError where the folder
     does not match the sheet's loads."""
-    images = spheres.per_load_inputs(sphere, "fluorescence")
-    plane_loads = spheres.plane_loads(sphere)
+    images = spheres.files.per_load_inputs(sphere, "fluorescence")
+    plane_loads = spheres.series.plane_loads(sphere)
     if plane_loads is None:
         read = confocal_reader(choice, sheet_pixel_nm)
         return [describe_file(path, read, sheet_pixel_nm) for path in images]
-    axis = spheres.load_series["axis"]
+    axis = spheres.series.config["axis"]
     records = []
-    for load in spheres.loads_mn(sphere):
+    for load in spheres.rows.loads_mn(sphere):
         plane = LoadPlane(axis, tuple(plane_loads), load)
         read = confocal_reader(replace(choice, load=plane), sheet_pixel_nm)
         record = describe_file(images[0], read, sheet_pixel_nm)
@@ -155,32 +156,32 @@ def sphere_files(
     reader that takes each, among our CSV and ``rheometer_maps``), and the errors that would
     stop the run before any job."""
     files, errors = [], []
-    fluorescence_pixel = spheres.value(sphere, "fluorescence_pixel_nm")
+    fluorescence_pixel = spheres.rows.value(sphere, "fluorescence_pixel_nm")
     image = confocal_reader(choices[0], fluorescence_pixel)
-    afm_pixel = spheres.value(sphere, "afm_pixel_nm")
+    afm_pixel = spheres.rows.value(sphere, "afm_pixel_nm")
     try:
         files += fluorescence_files(spheres, sphere, choices[0], fluorescence_pixel)
     except RawDataError as error:
         errors.append(str(error))
-    if spheres.has(sphere, RHEOMETER):
+    if spheres.inputs.has(sphere, RHEOMETER):
         try:
             files += [
                 describe_file(path, rheometer_reader(rheometer_maps), None)
-                for path in spheres.per_load_inputs(sphere, "rheometer")
+                for path in spheres.files.per_load_inputs(sphere, "rheometer")
             ]
         except RawDataError as error:
-            files.append({"path": f"{spheres.raw_dir(sphere)}/rheometer", "error": str(error)})
+            files.append({"path": f"{spheres.rows.raw_dir(sphere)}/rheometer", "error": str(error)})
     singles = [
         (
-            spheres.reflection_image(sphere),
+            spheres.files.reflection_image(sphere),
             confocal_reader(choices[1], fluorescence_pixel),
             fluorescence_pixel,
         ),
-        (spheres.bead_image(sphere), image, fluorescence_pixel),
-        (spheres.absorbance_spectrum(sphere), _absorbance, None),
+        (spheres.files.bead_image(sphere), image, fluorescence_pixel),
+        (spheres.files.absorbance_spectrum(sphere), _absorbance, None),
     ]
     try:
-        flim = spheres.flim_path(sphere)
+        flim = spheres.files.flim_path(sphere)
     except RawDataError as error:  # a flim.tif and a flim.ptu
         flim = None
         errors.append(str(error))
@@ -188,8 +189,10 @@ def sphere_files(
         singles.append((flim, flim_reader(flim), fluorescence_pixel))
     files += [describe_file(p, read, pixel) for p, read, pixel in singles if Path(p).is_file()]
     for stem in (AFM_BEFORE, AFM_AFTER):
-        if spheres.has(sphere, stem):
-            files.append(describe_file(spheres.afm_path(sphere, stem), _height_map, afm_pixel))
+        if spheres.inputs.has(sphere, stem):
+            files.append(
+                describe_file(spheres.files.afm_path(sphere, stem), _height_map, afm_pixel)
+            )
     return files, errors
 
 
@@ -203,30 +206,32 @@ def scan_side_um(files: list[dict], afm_before: str) -> float | None:
 
 def sphere_plan(run: WorkflowRun, sphere: str) -> dict:
     """What the run makes of one sphere and what it cannot, and why."""
-    material = run.spheres.material_of(sphere)
+    material = run.spheres.rows.material_of(sphere)
     folder = f"{run.paths.results}/{material}/{sphere}/"
     outputs = [p for p in run.targets.material([material]) if p.startswith(folder)]
     record = {
         "sphere": sphere,
         "material": material,
-        "data": "virtual experiment" if run.spheres.is_synthetic(sphere) else "measured",
-        "folder": run.spheres.raw_dir(sphere),
-        "loads_mn": run.spheres.loads_mn(sphere),
+        "data": "virtual experiment" if run.spheres.rows.is_synthetic(sphere) else "measured",
+        "folder": run.spheres.rows.raw_dir(sphere),
+        "loads_mn": run.spheres.rows.loads_mn(sphere),
         "outputs": outputs,
-        "left_out": run.spheres.left_out(sphere) + run.scenes.left_out(sphere),
-        "failed": run.spheres.failed_lines(sphere),
+        "left_out": run.spheres.inputs.left_out(sphere) + run.scenes.left_out(sphere),
+        "failed": run.spheres.hold_outs.failed_lines(sphere),
         "files": [],
         "errors": [],
     }
-    if not run.spheres.is_synthetic(sphere):
+    if not run.spheres.rows.is_synthetic(sphere):
         choices = tuple(
             ImageChoice(**image_choice(run.config, reflection)) for reflection in (False, True)
         )
-        maps = export_maps(run.spheres.rheometer_export(sphere, run.config.get("rheometer_export")))
+        maps = export_maps(
+            run.spheres.files.rheometer_export(sphere, run.config.get("rheometer_export"))
+        )
         record["files"], record["errors"] = sphere_files(run.spheres, sphere, choices, maps)
     side_um = None
-    if run.spheres.has(sphere, AFM_BEFORE):
-        side_um = scan_side_um(record["files"], run.spheres.afm_path(sphere, AFM_BEFORE))
+    if run.spheres.inputs.has(sphere, AFM_BEFORE):
+        side_um = scan_side_um(record["files"], run.spheres.files.afm_path(sphere, AFM_BEFORE))
     record["scan_side_um"] = side_um
     record["scenes"] = {} if side_um is None else run.scenes.scan_coverage(sphere, side_um)
     record["undecided_scans"] = undecided_scans(run, sphere, record["scenes"])

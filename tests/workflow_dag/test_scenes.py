@@ -25,7 +25,7 @@ def test_only_microscope_scenes_deliver_a_comparison(small):
     without = scenes.names(surface="afm_before", optics="none")
     assert with_optics and without
     sphere = next(iter(small.spheres))
-    material = small.spheres.material_of(sphere)
+    material = small.spheres.rows.material_of(sphere)
     assert scenes.sphere_scene_outputs(material, sphere, without[0]) == []
     outputs = scenes.sphere_scene_outputs(material, sphere, with_optics[0])
     names = sorted(path.rsplit("/", 1)[1] for path in outputs)
@@ -37,7 +37,7 @@ def test_a_spheres_scenes_are_fitted_in_one_file_reading_renders_only_with_optic
     reads its solve and, with optics only, its rendered areas."""
     scenes = small.scenes
     sphere = next(iter(small.spheres))
-    material = small.spheres.material_of(sphere)
+    material = small.spheres.rows.material_of(sphere)
     layout = scenes.fit_layout(material, sphere)
     assert list(layout) == scenes.runnable(sphere) and len(layout) > 1
     for name, inputs in layout.items():
@@ -67,7 +67,9 @@ def test_a_scan_has_one_point_per_value_around_the_sheets_prior(small):
         labels = scenes.scan_value_labels(sphere, scan)
         assert labels == [value_label(v) for v in expected]
         assert len(labels) == spec["steps"]
-        wildcards = _wildcards(material=small.spheres.material_of(sphere), sphere=sphere, scan=scan)
+        wildcards = _wildcards(
+            material=small.spheres.rows.material_of(sphere), sphere=sphere, scan=scan
+        )
         points = scenes.scan_points(wildcards)
         assert [p.split("/")[-2] for p in points] == labels
 
@@ -78,7 +80,7 @@ def test_a_scans_values_run_as_one_chain_each_from_the_one_before(small):
     inside the job's output folder, where best_scan_value reads the results."""
     scenes = small.scenes
     sphere = next(iter(small.spheres))
-    material = small.spheres.material_of(sphere)
+    material = small.spheres.rows.material_of(sphere)
     for scan, spec in scenes.scans.items():
         wildcards = _wildcards(material=material, sphere=sphere, scan=scan)
         chain = scenes.scan_chain(sphere, scan)
@@ -101,7 +103,7 @@ def test_a_chain_from_the_elastic_end_starts_from_the_spheres_elastic_solve(smal
     sphere, and the scan's own registration waits for it: the seed adds no wait."""
     scenes = small.scenes
     sphere = next(iter(small.spheres))
-    material = small.spheres.material_of(sphere)
+    material = small.spheres.rows.material_of(sphere)
     elastic = [s for s in scenes.runnable(sphere) if scenes.scenes[s]["model"] == "elastic"]
     assert elastic and scenes.sphere_registration_scene(sphere) == elastic[0]
     for scan, spec in scenes.scans.items():
@@ -142,7 +144,7 @@ def test_without_scans_there_is_no_scan_and_no_study_output(make_run):
 
 def test_the_study_figures_of_a_sphere_follow_its_scans_and_scenes(small):
     sphere = next(iter(small.spheres))
-    material = small.spheres.material_of(sphere)
+    material = small.spheres.rows.material_of(sphere)
     names = {
         p.rsplit("/", 1)[1].split(".")[0] for p in small.study.sphere_figures(material, sphere)
     }
@@ -155,14 +157,16 @@ def test_the_study_figures_of_a_sphere_follow_its_scans_and_scenes(small):
 def test_a_material_target_holds_lifetime_only_where_a_flim_map_exists(small):
     targets = small.targets.material(small.materials)
     for sphere in small.spheres:
-        lifetime = small.paths.measured("lifetime.json", small.spheres.material_of(sphere), sphere)
-        assert (lifetime in targets) == small.spheres.has_flim(sphere)
+        lifetime = small.paths.measured(
+            "lifetime.json", small.spheres.rows.material_of(sphere), sphere
+        )
+        assert (lifetime in targets) == small.spheres.files.has_flim(sphere)
     assert len(targets) == len(set(targets))
 
 
 def test_a_measurement_of_a_sphere_under_another_material_is_refused(small):
     sphere = next(iter(small.spheres))
-    others = [m for m in small.materials if m != small.spheres.material_of(sphere)]
+    others = [m for m in small.materials if m != small.spheres.rows.material_of(sphere)]
     with pytest.raises(ValueError, match=f"sphere '{sphere}' is"):
         small.targets.measured(others[0], sphere, "psf.json")
 

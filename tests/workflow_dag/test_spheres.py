@@ -9,19 +9,19 @@ from amontons.config import ConfigError
 from amontons.io.confocal_writers import write_confocal
 from amontons.io.layout import RawDataError
 from amontons.io.tiff import write_image
-from amontons.workflow.params import image_choice
-from amontons.workflow.paths import RunPaths
-from amontons.workflow.run import check_rheometer_exports
-from amontons.workflow.spheres import (
+from amontons.workflow.optional_inputs import (
     ABSORBANCE,
     AFM_AFTER,
     AFM_BEFORE,
     BEAD,
     REFLECTION,
     RHEOMETER,
-    Spheres,
-    names_pattern,
 )
+from amontons.workflow.params import image_choice
+from amontons.workflow.paths import RunPaths
+from amontons.workflow.run import check_rheometer_exports
+from amontons.workflow.spheres import Spheres
+from amontons.workflow.wildcards import names_pattern
 
 RECORD = {
     "material": "PS",
@@ -47,10 +47,28 @@ def _spheres(tmp_path, **measured_files):
     return Spheres(records, RunPaths("small")), folder
 
 
+def test_the_parts_share_one_sheet_and_the_rules_names_are_the_parts_answers(tmp_path):
+    """Spheres composes its parts over one SheetRows; each name the rule files call on
+    SPHERES beyond the selection (of, materials_with, held_out) is a part's, answered
+    alike."""
+    spheres, _ = _spheres(tmp_path, **_complete_folder(tmp_path))
+    parts = [spheres.series, spheres.files, spheres.pixels, spheres.inputs, spheres.hold_outs]
+    assert all(part.rows is spheres.rows for part in parts)
+    assert spheres.files.series is spheres.series
+    forwarded = {name for name in vars(Spheres) if not name.startswith("_")}
+    forwarded -= {"of", "materials_with", "held_out"}
+    for name in sorted(forwarded):
+        assert [p for p in [spheres.rows, *parts] if hasattr(p, name)], name
+    for sphere in ("syn", "lab"):
+        assert spheres.bead_image(sphere) == spheres.files.bead_image(sphere)
+        assert spheres.missing(sphere) is spheres.inputs.missing(sphere)
+        assert spheres.scene_record(sphere) == spheres.rows.scene_record(sphere)
+
+
 def test_synthetic_raw_data_lie_in_the_runs_virtual_experiment(tmp_path):
     spheres, folder = _spheres(tmp_path)
-    assert spheres.raw_dir("syn") == "resources/synthetic/small/syn"
-    assert spheres.raw_dir("lab") == str(folder)
+    assert spheres.rows.raw_dir("syn") == "resources/synthetic/small/syn"
+    assert spheres.rows.raw_dir("lab") == str(folder)
     assert spheres.per_load_inputs("syn", "fluorescence") == (
         "resources/synthetic/small/syn/fluorescence"
     )
@@ -72,11 +90,11 @@ def test_an_afm_map_is_named_by_the_format_present_else_by_its_tiff(tmp_path):
 
 def test_flim_where_the_sheet_asks_or_the_folder_holds_it(tmp_path):
     spheres, _ = _spheres(tmp_path)
-    assert spheres.has_flim("syn") and not spheres.has_flim("lab")
+    assert spheres.files.has_flim("syn") and not spheres.files.has_flim("lab")
     assert spheres.synthetic_pattern(with_flim=True) == "syn"
     assert spheres.synthetic_pattern(with_flim=False) == "(?!)"
     with_map, _ = _spheres(tmp_path / "2", **{"flim.tif": ""})
-    assert with_map.has_flim("lab")
+    assert with_map.files.has_flim("lab")
 
 
 def test_data_label_says_synthetic_if_any_sphere_is(tmp_path):
@@ -116,7 +134,7 @@ def test_a_missing_optional_file_is_found_and_named(tmp_path, remove, kind):
     assert list(spheres.missing("lab")) == [kind]
     assert remove.split(".")[0] in spheres.missing("lab")[kind]
     assert spheres.missing("syn") == {}  # the virtual experiment writes every file
-    (line,) = spheres.left_out("lab")
+    (line,) = spheres.inputs.left_out("lab")
     assert "will not be made" in line
 
 
@@ -134,8 +152,8 @@ def test_a_shared_bead_image_stands_for_the_spheres_own(tmp_path):
     spheres, folder = _spheres(tmp_path, **files)
     shared = tmp_path / "shared_bead.tif"
     shared.write_text("")
-    spheres.records["lab"]["bead_file"] = str(shared)
-    spheres._missing.clear()
+    spheres.rows.records["lab"]["bead_file"] = str(shared)
+    spheres.inputs._missing.clear()
     assert spheres.bead_image("lab") == str(shared)
     assert spheres.missing("lab") == {}
 
@@ -144,13 +162,13 @@ def test_without_a_bead_the_psf_is_the_stand_in_or_none(tmp_path):
     files = _complete_folder(tmp_path)
     del files["bead.tif"]
     spheres, _ = _spheres(tmp_path, **files)
-    assert spheres.psf_source("lab") is None and not spheres.can_render("lab")
-    assert spheres.can_simulate("lab")
-    assert "no microscope scene" in spheres.left_out("lab")[0]
-    stand_in = Spheres(spheres.records, RunPaths("small"), psf_stand_in=True)
-    assert stand_in.psf_source("lab") == "stand_in" and stand_in.can_render("lab")
+    assert spheres.inputs.psf_source("lab") is None and not spheres.inputs.can_render("lab")
+    assert spheres.inputs.can_simulate("lab")
+    assert "no microscope scene" in spheres.inputs.left_out("lab")[0]
+    stand_in = Spheres(spheres.rows.records, RunPaths("small"), psf_stand_in=True)
+    assert stand_in.inputs.psf_source("lab") == "stand_in" and stand_in.inputs.can_render("lab")
     assert stand_in.psf_pattern("stand_in") == "lab"
-    assert "optics.psf.stand_in" in stand_in.left_out("lab")[0]
+    assert "optics.psf.stand_in" in stand_in.inputs.left_out("lab")[0]
 
 
 def test_confocal_images_are_found_by_any_accepted_suffix(tmp_path):
@@ -188,13 +206,13 @@ def test_images_without_a_pixel_and_no_sheet_pixel_stop_the_run_naming_sphere_an
     for load in (10, 20):
         write_confocal(folder / f"fluorescence/{load}.tif", untagged, 200e-9, "ome_tiff")
     tifffile.imwrite(folder / "fluorescence/40.tif", untagged)  # no resolution tags
-    spheres.check_pixel_sizes()  # the sheet gives the pixel
-    del spheres.records["lab"]["fluorescence_pixel_nm"]
+    spheres.pixels.check()  # the sheet gives the pixel
+    del spheres.rows.records["lab"]["fluorescence_pixel_nm"]
     message = rf"no fluorescence_pixel_nm in the sheet: sphere lab: {folder}/fluorescence/40\.tif;"
     with pytest.raises(RawDataError, match=message):
-        spheres.check_pixel_sizes()
+        spheres.pixels.check()
     write_confocal(folder / "fluorescence/40.tif", untagged, 200e-9, "tif")
-    spheres.check_pixel_sizes()  # every image states its own
+    spheres.pixels.check()  # every image states its own
     assert spheres.image_pixel_inputs("lab") == ["results/small/PS/lab/measure/contact_area.csv"]
     assert spheres.image_pixel_inputs("syn") == []
 
@@ -209,22 +227,22 @@ def test_a_flim_file_without_a_pixel_stops_the_run_like_any_image(tmp_path, name
     image = np.ones((8, 8), np.uint16)
     for load in (10, 20, 40):
         write_confocal(folder / f"fluorescence/{load}.tif", image, 200e-9, "ome_tiff")
-    del spheres.records["lab"]["fluorescence_pixel_nm"]
+    del spheres.rows.records["lab"]["fluorescence_pixel_nm"]
     flim = folder / name
     if name == "flim.ptu":
         histograms = np.ones((8, 8, 16), np.uint16)
         ptufile.imwrite(flim, histograms, 25e-9, 16e-12, pixel_resolution=0.2)
     else:
         write_image(flim, np.full((8, 8), 1.5), 200e-9)
-    assert spheres.images_without_pixel("lab") == []
-    spheres.check_pixel_sizes()  # the file states its pixel: the sheet may stay blank
+    assert spheres.pixels.images_without_pixel("lab") == []
+    spheres.pixels.check()  # the file states its pixel: the sheet may stay blank
     if name == "flim.ptu":
         ptufile.imwrite(flim, histograms, 25e-9, 16e-12, tags={"ImgHdr_PixResol": 0.0})
     else:
         tifffile.imwrite(flim, np.full((8, 8), 1.5))
-    assert spheres.images_without_pixel("lab") == [str(flim)]
+    assert spheres.pixels.images_without_pixel("lab") == [str(flim)]
     with pytest.raises(RawDataError, match=rf"sphere lab: {flim};"):
-        spheres.check_pixel_sizes()
+        spheres.pixels.check()
 
 
 # A measured sphere whose one file holds every load (config optics.images.load_series), as
@@ -268,7 +286,7 @@ def _series_spheres(tmp_path, load_series=FRAMES_IN_ORDER, pixel_um=0.2, per_loa
 def test_the_one_file_is_every_fluorescence_jobs_input_and_the_param_maps_its_planes(tmp_path):
     spheres, lab = _series_spheres(tmp_path)
     series = str(lab / "fluorescence.ome.tif")
-    assert spheres.load_series_file("lab") == series
+    assert spheres.series.file("lab") == series
     assert spheres.per_load_inputs("lab", "fluorescence") == [series]
     assert spheres.reflection_fluorescence("lab") == series
     assert spheres.fluorescence_choice("lab", IMAGES) == {
@@ -276,18 +294,18 @@ def test_the_one_file_is_every_fluorescence_jobs_input_and_the_param_maps_its_pl
         "load_series": {"axis": "frames", "plane_loads_mn": [10.0, 20.0, 40.0]},
     }
     # the pixel comes from the file: no sheet pixel needed, none missing
-    assert spheres.images_without_pixel("lab") == []
-    spheres.check_pixel_sizes()
+    assert spheres.pixels.images_without_pixel("lab") == []
+    spheres.pixels.check()
 
 
 def test_per_load_and_synthetic_spheres_keep_their_inputs_and_params(tmp_path):
     """Their jobs' inputs and params are those of a run without load-series files, so none of
     them re-runs."""
     spheres, _ = _series_spheres(tmp_path)
-    assert spheres.load_series_file("old") is None and spheres.load_series_file("syn") is None
+    assert spheres.series.file("old") is None and spheres.series.file("syn") is None
     for sphere in ("old", "syn"):
         assert spheres.fluorescence_choice(sphere, IMAGES) == IMAGES
-        assert spheres.plane_loads(sphere) is None
+        assert spheres.series.plane_loads(sphere) is None
     old = spheres.per_load_inputs("old", "fluorescence")
     assert old == [str(tmp_path / "old" / "fluorescence" / f"{f}.tif") for f in (10, 20, 40)]
     assert spheres.per_load_inputs("syn", "fluorescence").endswith("syn/fluorescence")
@@ -325,9 +343,9 @@ def test_a_load_series_file_without_its_config_is_not_guessed(tmp_path):
 def test_a_load_series_file_without_a_pixel_stops_the_run_like_any_image(tmp_path):
     spheres, lab = _series_spheres(tmp_path, pixel_um=None)
     with pytest.raises(RawDataError, match=rf"sphere lab: {lab}/fluorescence\.ome\.tif"):
-        spheres.check_pixel_sizes()
-    spheres.records["lab"]["fluorescence_pixel_nm"] = 200
-    spheres.check_pixel_sizes()
+        spheres.pixels.check()
+    spheres.rows.records["lab"]["fluorescence_pixel_nm"] = 200
+    spheres.pixels.check()
 
 
 @pytest.mark.parametrize(("axis", "choice"), [("frames", {"frames": 0}), ("series", {"series": 1})])
@@ -346,7 +364,7 @@ def test_the_config_accepts_a_mapping_and_the_rules_images_stay_as_they_were(mak
         config["optics"]["images"]["load_series"] = {"axis": "series", "planes": [0, 2, 1]}
 
     run = make_run(edit=edit)
-    assert run.spheres.load_series == {"axis": "series", "planes": [0, 2, 1]}
+    assert run.spheres.series.config == {"axis": "series", "planes": [0, 2, 1]}
     assert "load_series" not in image_choice(run.config)
 
     def bad(config):
@@ -358,17 +376,17 @@ def test_the_config_accepts_a_mapping_and_the_rules_images_stay_as_they_were(mak
 
 def test_a_load_series_file_with_a_plane_too_many_stops_the_run_naming_sphere_and_file(tmp_path):
     spheres, lab = _series_spheres(tmp_path, {"axis": "frames", "planes": "in_load_order"})
-    spheres.check_load_series_files()  # three frames, three loads
-    spheres.records["lab"]["loads"] = [10.0, 20.0]
+    spheres.series.check()  # three frames, three loads
+    spheres.rows.records["lab"]["loads"] = [10.0, 20.0]
     message = (
         rf"sphere lab: {lab}/fluorescence\.ome\.tif: it holds 3 frames \(its header says\), "
         r"but .* sheet's 2 loads \[10\.0, 20\.0\] mN along its frames, one each; expected exactly 2"
     )
     with pytest.raises(RawDataError, match=message):
-        spheres.check_load_series_files()
-    spheres.load_series["axis"] = "series"  # one series: as many as one load needs, not two
+        spheres.series.check()
+    spheres.series.config["axis"] = "series"  # one series: as many as one load needs, not two
     with pytest.raises(RawDataError, match=r"it holds 1 series \(its header says\)"):
-        spheres.check_load_series_files()
+        spheres.series.check()
 
 
 # Two programs' export maps (config rheometer_export), as a lab with two rheometers has them.
@@ -391,12 +409,12 @@ def test_a_sheet_row_may_name_the_export_map_of_its_spheres_files(tmp_path):
     param); a sphere whose row names none gets every map, matched to each file by its
     header; a single map passes as it is, whatever the row says."""
     spheres, _ = _spheres(tmp_path)
-    spheres.records["lab"]["rheometer_export"] = "trios"
+    spheres.rows.records["lab"]["rheometer_export"] = "trios"
     assert spheres.rheometer_export("lab", TWO_MAPS) == {"trios": TWO_MAPS["trios"]}
     assert spheres.rheometer_export("syn", TWO_MAPS) == TWO_MAPS
     assert spheres.rheometer_export("syn", None) is None
     single = TWO_MAPS["trios"]
-    spheres.records["lab"]["rheometer_export"] = "export"
+    spheres.rows.records["lab"]["rheometer_export"] = "export"
     assert spheres.rheometer_export("lab", single) == single
     check_rheometer_exports(TWO_MAPS, {"lab": {"rheometer_export": "trios"}}, "mine.yaml")
     check_rheometer_exports(single, {"lab": {"rheometer_export": "export"}}, "mine.yaml")

@@ -47,8 +47,10 @@ from amontons.workflow.paths import (
 from amontons.workflow.resources import scan_solves
 from amontons.workflow.accuracy import TIMING_POINT
 from amontons.workflow.run import WorkflowRun
-from amontons.workflow.spheres import RHEOMETER, TRUE_HARDENING_COLUMN, names_pattern
+from amontons.workflow.optional_inputs import RHEOMETER
+from amontons.workflow.sheet_rows import TRUE_HARDENING_COLUMN
 from amontons.workflow.validation import validation_cases
+from amontons.workflow.wildcards import names_pattern
 
 CONFIG_SOURCE = ", ".join(
     str(f) for f in (workflow.overwrite_configfiles or ["config/config.yaml"])

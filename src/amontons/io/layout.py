@@ -126,7 +126,7 @@ def load_of(path: Path) -> float | None:
 
 def folder_files(folder: str | Path) -> list[str]:
     """Every file below a sphere's raw-data folder, sorted (none where it is not there): what
-    the stamp of its data covers (amontons.workflow.spheres.Spheres.data_stamp)."""
+    the stamp of its data covers (amontons.workflow.data_stamp)."""
     return sorted(os.path.join(root, name) for root, _, names in os.walk(folder) for name in names)
 
 

@@ -1,9 +1,9 @@
 """Whether an image's file (confocal, FLIM map or photons) states its pixel size, and how
 large a TIFF AFM scan is, read from the header alone with the standard library: the workflow
-asks these when it builds the DAG (amontons.workflow.spheres, amontons.workflow.scenes), so
-that a measured sphere whose images carry no pixel size, and whose sheet row gives none, stops
-the run before any job, naming the sphere and the file, and so that the dry run says which
-loads a scene will leave outside a small scan.
+asks these when it builds the DAG (amontons.workflow.pixel_sizes, amontons.workflow.load_series,
+amontons.workflow.scenes), so that a measured sphere whose images carry no pixel size, and
+whose sheet row gives none, stops the run before any job, naming the sphere and the file, and
+so that the dry run says which loads a scene will leave outside a small scan.
 
 The readers (amontons.io.confocal, amontons.io.tiff) take the pixel from the same places:
 

@@ -153,12 +153,13 @@ def fluorescence_planes(
     """Where each load's fluorescence image is, in the order of ``loads_mn`` (mN): the file
     and the plane of it.
 
-    ``images`` is a rule's ``images`` param (amontons.workflow.spheres.Spheres.image_params):
-    the keyword arguments of ImageChoice, and for a sphere whose one file holds every load,
-    ``load_series`` ({axis, plane_loads_mn}: the load axis and the load of each plane). Then
-    ``given`` is that one file and each load gets its plane; else ``given`` is one file per
-    load, or the virtual experiment's folder (amontons.io.layout.per_load_files). Raises
-    RawDataError naming the file for a load that is none of its planes'.
+    ``images`` is a rule's ``images`` param
+    (amontons.workflow.load_series.LoadSeries.fluorescence_choice): the keyword arguments of
+    ImageChoice, and for a sphere whose one file holds every load, ``load_series`` ({axis,
+    plane_loads_mn}: the load axis and the load of each plane). Then ``given`` is that one
+    file and each load gets its plane; else ``given`` is one file per load, or the virtual
+    experiment's folder (amontons.io.layout.per_load_files). Raises RawDataError naming the
+    file for a load that is none of its planes'.
     """
     images = dict(images)
     series = images.pop("load_series", None)

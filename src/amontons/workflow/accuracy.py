@@ -30,7 +30,7 @@ class AccuracyStudy:
         self.paths = paths
 
     def _measured(self, name: str) -> str:
-        return self.paths.measured(name, self.spheres.material_of(self.sphere), self.sphere)
+        return self.paths.measured(name, self.spheres.rows.material_of(self.sphere), self.sphere)
 
     def levelled_map(self) -> str:
         """The levelled AFM map of the study's sphere."""
@@ -46,7 +46,7 @@ class AccuracyStudy:
 
     def sphere_record(self) -> dict:
         """The sheet values a problem takes from the study's sphere, and its name."""
-        return {**self.spheres.scene_record(self.sphere), "sphere": self.sphere}
+        return {**self.spheres.rows.scene_record(self.sphere), "sphere": self.sphere}
 
     def files(self, name: str) -> list[str]:
         """``name`` of every problem at every setting (the reference included)."""

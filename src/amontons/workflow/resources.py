@@ -82,7 +82,7 @@ class SolveResources:
             slope = spec["synthetic"].get("rms_slope")
             law = spec
         else:
-            row = self.spheres.row(sphere)
+            row = self.spheres.rows.row(sphere)
             frame = geometry.sphere_frame(spec, row)
             slope = None  # the map's slope is known only once it is levelled
             law = {

@@ -28,11 +28,13 @@ from amontons.config.sheet import (
 from amontons.io.export_map import ExportMapError, export_maps
 from amontons.io.layout import IMAGE_FORMATS, load_axis_conflict
 from amontons.workflow.accuracy import AccuracyStudy
+from amontons.workflow.data_stamp import data_stamp
 from amontons.workflow.ledger import read_held_out
 from amontons.workflow.paths import RunPaths
+from amontons.workflow.raw_files import SHEET_EXPORT_COLUMN
 from amontons.workflow.resources import SolveResources
 from amontons.workflow.scenes import Scenes
-from amontons.workflow.spheres import SHEET_EXPORT_COLUMN, Spheres
+from amontons.workflow.spheres import Spheres
 from amontons.workflow.study import Study
 from amontons.workflow.summary import Summary
 from amontons.workflow.targets import Targets
@@ -95,7 +97,7 @@ def check_load_series(images: Mapping, source: str) -> None:
     """optics.images.load_series takes over the choice along its axis (series or frames):
     that choice must keep its default, as a file of one plane per load has no other plane to
     pick (amontons.io.layout.load_axis_conflict). Each sphere's planes are checked against
-    its loads when the DAG looks at its folder (amontons.workflow.spheres)."""
+    its loads when the DAG looks at its folder (amontons.workflow.load_series)."""
     series = images["load_series"]
     if series is None:
         return
@@ -123,18 +125,18 @@ class WorkflowRun:
         return list(self.config["materials"])
 
     def left_out(self) -> list[str]:
-        """Per sphere, what its data do not allow and why (amontons.workflow.spheres)."""
+        """Per sphere, what its data do not allow and why (amontons.workflow.optional_inputs)."""
         return [
-            f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
+            f"sphere {sphere} ({self.spheres.rows.material_of(sphere)}): {line}"
             for sphere in self.spheres
-            for line in self.spheres.left_out(sphere) + self.scenes.left_out(sphere)
+            for line in self.spheres.inputs.left_out(sphere) + self.scenes.left_out(sphere)
         ]
 
     def outside_scan(self) -> list[str]:
         """Per measured sphere whose AFM scan's size its header gives, the loads each scene
         will leave outside the scan (amontons.workflow.scenes)."""
         return [
-            f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
+            f"sphere {sphere} ({self.spheres.rows.material_of(sphere)}): {line}"
             for sphere in self.spheres
             for line in self.scenes.predicted_outside_scan(sphere)
         ]
@@ -143,14 +145,14 @@ class WorkflowRun:
         """Per sphere held out by an earlier run's failure, each failed job and what the
         sphere is held out of (amontons.workflow.ledger)."""
         return [
-            f"sphere {sphere} ({self.spheres.material_of(sphere)}): {line}"
+            f"sphere {sphere} ({self.spheres.rows.material_of(sphere)}): {line}"
             for sphere in self.spheres.held_out
-            for line in self.spheres.failed_lines(sphere)
+            for line in self.spheres.hold_outs.failed_lines(sphere)
         ]
 
     def data_stamp(self, sphere: str) -> str:
         """The stamp of a sphere's data under this run's config (amontons.workflow.ledger)."""
-        return self.spheres.data_stamp(sphere, config_digest(self.config))
+        return data_stamp(self.spheres.rows, sphere, config_digest(self.config))
 
     @classmethod
     def from_config(
@@ -176,11 +178,11 @@ class WorkflowRun:
             synthetic_images=IMAGE_FORMATS[config["virtual_experiment"]["formats"]["images"]],
             load_series=config["optics"]["images"]["load_series"],
         )
-        spheres.check_pixel_sizes()
-        spheres.check_load_series_files(config["optics"]["images"]["series"])
+        spheres.pixels.check()
+        spheres.series.check(config["optics"]["images"]["series"])
         digest = config_digest(config)
-        spheres.hold_out(
-            read_held_out(paths, spheres, lambda sphere: spheres.data_stamp(sphere, digest))
+        spheres.hold_outs.hold_out(
+            read_held_out(paths, spheres, lambda sphere: data_stamp(spheres.rows, sphere, digest))
         )
         scenes = Scenes(config, spheres, paths)
         study = Study(config, spheres, scenes, paths)

@@ -14,9 +14,10 @@ from amontons.io.pixel_probe import tiff_scan_side_m
 from amontons.models import ELASTIC, FIELD, model_named, parameter_named
 from amontons.simulate.scan_grid import scan_values, value_label
 from amontons.workflow import paths as files
+from amontons.workflow.optional_inputs import AFM_BEFORE
 from amontons.workflow.params import sorted_keys
 from amontons.workflow.paths import FilesInFolder, RunPaths
-from amontons.workflow.spheres import AFM_BEFORE, Spheres
+from amontons.workflow.spheres import Spheres
 
 # A scan's values run in its parameter's chain order (amontons.models), each starting from
 # the one before: per parameter, the order that took fewer CG iterations on the virtual PS
@@ -100,7 +101,7 @@ class Scenes:
         """(key, sheet column) where ``scene`` takes its model parameter from a sheet cell that
         ``sphere`` leaves empty; None where it has what it needs."""
         needs = sheet_prior(self.scenes[scene])
-        if needs is None or self.spheres.row(sphere).get(needs[1]) is not None:
+        if needs is None or self.spheres.rows.row(sphere).get(needs[1]) is not None:
             return None
         return needs
 
@@ -111,8 +112,8 @@ class Scenes:
         return [
             scene
             for scene in self.afm_scenes()
-            if self.spheres.can_simulate(sphere)
-            and (not self.has_optics(scene) or self.spheres.can_render(sphere))
+            if self.spheres.inputs.can_simulate(sphere)
+            and (not self.has_optics(scene) or self.spheres.inputs.can_render(sphere))
             and self.missing_prior(sphere, scene) is None
         ]
 
@@ -148,7 +149,7 @@ class Scenes:
         an AFM scan of ``side_um`` and those left out (``outside_scan``), with the apex taken
         at the scan's centre. The run fits the apex; one off centre holds a smaller window, so
         the run may leave out more (amontons.simulate.surface.afm_scene)."""
-        record = self.spheres.scene_record(sphere)
+        record = self.spheres.rows.scene_record(sphere)
         coverage = {}
         for scene in self.runnable(sphere):
             spec = self.scenes[scene]
@@ -167,12 +168,12 @@ class Scenes:
         """The shorter side (µm) of a measured sphere's AFM scan where its header gives it
         cheaply (a TIFF: amontons.io.pixel_probe; the sheet's afm_pixel_nm where the file
         states no pixel); None otherwise, the job then reading the scan."""
-        if self.spheres.is_synthetic(sphere) or not self.spheres.can_simulate(sphere):
+        if self.spheres.rows.is_synthetic(sphere) or not self.spheres.inputs.can_simulate(sphere):
             return None
-        path = self.spheres.afm_path(sphere, AFM_BEFORE)
+        path = self.spheres.files.afm_path(sphere, AFM_BEFORE)
         if not path.lower().endswith(HEADER_SIZED_AFM):
             return None
-        sheet_nm = self.spheres.value(sphere, "afm_pixel_nm")
+        sheet_nm = self.spheres.rows.value(sphere, "afm_pixel_nm")
         side_m = tiff_scan_side_m(path, None if sheet_nm is None else sheet_nm * 1e-9)
         return None if side_m is None else side_m * 1e6
 
@@ -195,7 +196,7 @@ class Scenes:
         lines = []
         for scene in self.afm_scenes():
             needs = self.missing_prior(sphere, scene)
-            if needs is not None and self.spheres.can_simulate(sphere):
+            if needs is not None and self.spheres.inputs.can_simulate(sphere):
                 lines.append(
                     f"no {needs[1]} in the sheet: scene {scene} ({needs[0]} null, at the "
                     "sheet's value) will not be made"
@@ -280,7 +281,7 @@ class Scenes:
     def prior(self, sphere: str, scan: str) -> float | None:
         """The sheet's value a sphere's scan is centred on, or None (no prior)."""
         column = parameter_named(self.scans[scan]["parameter"]).sheet_column
-        return self.spheres.value(sphere, column)
+        return self.spheres.rows.value(sphere, column)
 
     def prior_free_scale(self, sphere: str, scan: str) -> float:
         """The scale (in the parameter's config unit) that makes a scan's prior-free range
@@ -289,7 +290,7 @@ class Scenes:
         spec = self.scans[scan]
         parameter = parameter_named(spec["parameter"])
         base = self.scenes[spec["scene"]]
-        frame = geometry.sphere_frame(base, self.spheres.row(sphere))
+        frame = geometry.sphere_frame(base, self.spheres.rows.row(sphere))
         if parameter.prior_free_pixel_power == 0:
             return frame.e_star_pa * parameter.from_si
         window = geometry.window_m(spec["scene"], base, frame)

@@ -8,9 +8,10 @@ from collections.abc import Mapping
 
 from amontons.models import CONTACT_HARDENING, ELASTIC, GREENWOOD_TRIPP
 from amontons.workflow import paths as files
+from amontons.workflow.optional_inputs import AFM_AFTER, RHEOMETER
 from amontons.workflow.paths import RunPaths, figure_files
 from amontons.workflow.scenes import Scenes
-from amontons.workflow.spheres import AFM_AFTER, RHEOMETER, Spheres
+from amontons.workflow.spheres import Spheres
 
 # The scanned parameter of Figs. B.9 and B.11.
 K = CONTACT_HARDENING.parameter.key
@@ -128,7 +129,7 @@ class Study:
         if self.scenes.runnable_scans(sphere):
             names += ["B8_scans", files.B12_FIGURE]
         if self.scenes.scans_of(K) and self.scenes.runnable_scans(sphere):
-            if self.spheres.has(sphere, AFM_AFTER):
+            if self.spheres.inputs.has(sphere, AFM_AFTER):
                 names.append("B9_flattening")
             runs = self.scenes.runnable(sphere)
             elastic = self.scenes.first(ELASTIC.name, "microscope")

@@ -7,9 +7,10 @@ summary lists what each sphere's data did not allow, and why."""
 from __future__ import annotations
 
 from amontons.workflow import paths as files
+from amontons.workflow.optional_inputs import RHEOMETER
 from amontons.workflow.paths import RunPaths
 from amontons.workflow.scenes import Scenes
-from amontons.workflow.spheres import RHEOMETER, Spheres
+from amontons.workflow.spheres import Spheres
 from amontons.workflow.study import Study
 
 

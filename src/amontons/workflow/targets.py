@@ -5,17 +5,17 @@ from the scenes, scans and study of the run."""
 from __future__ import annotations
 
 from amontons.workflow import paths as files
-from amontons.workflow.paths import RunPaths, figure_files
-from amontons.workflow.scenes import Scenes
-from amontons.workflow.spheres import (
+from amontons.workflow.optional_inputs import (
     ABSORBANCE,
     AFM_AFTER,
     AFM_BEFORE,
     BEAD,
     REFLECTION,
     RHEOMETER,
-    Spheres,
 )
+from amontons.workflow.paths import RunPaths, figure_files
+from amontons.workflow.scenes import Scenes
+from amontons.workflow.spheres import Spheres
 from amontons.workflow.study import Study
 
 # Per-sphere results of each stage, by the optional input each needs (None: only the
@@ -54,9 +54,9 @@ class Targets:
 
     def measured(self, material: str, sphere: str, name: str) -> str:
         """A measurement of one sphere, checking that the sphere is of ``material``."""
-        if self.spheres.material_of(sphere) != material:
+        if self.spheres.rows.material_of(sphere) != material:
             raise ValueError(
-                f"sphere {sphere!r} is {self.spheres.material_of(sphere)}, not {material}"
+                f"sphere {sphere!r} is {self.spheres.rows.material_of(sphere)}, not {material}"
             )
         return self.paths.measured(name, material, sphere)
 
@@ -92,7 +92,7 @@ class Targets:
                 for needs, names in OPTICS_RESULTS.items():
                     if self._has(sphere, needs):
                         out += [self.measured(material, sphere, name) for name in names]
-                if self.spheres.has_flim(sphere):
+                if self.spheres.files.has_flim(sphere):
                     out.append(self.measured(material, sphere, files.LIFETIME))
         return out
 
@@ -100,8 +100,8 @@ class Targets:
         if needs is None:
             return True
         if needs == PSF_NEEDED:
-            return self.spheres.psf_source(sphere) is not None
-        return self.spheres.has(sphere, needs)
+            return self.spheres.inputs.psf_source(sphere) is not None
+        return self.spheres.inputs.has(sphere, needs)
 
     def friction_spheres(self, material: str) -> list[str]:
         """The spheres of ``material`` whose friction was measured."""
@@ -121,7 +121,7 @@ class Targets:
             self.measured(m, s, name)
             for m in materials
             for s in self.spheres.of(m, having=AFM_BEFORE)
-            if self.spheres.has(s, AFM_AFTER)
+            if self.spheres.inputs.has(s, AFM_AFTER)
             for name in SURFACE_RESULTS
         ]
 
@@ -143,7 +143,7 @@ class Targets:
         return [
             path
             for sphere, jobs in self.spheres.held_out.items()
-            if self.spheres.material_of(sphere) in materials
+            if self.spheres.rows.material_of(sphere) in materials
             for job in jobs
             for path in job.output_files
         ]
@@ -169,5 +169,5 @@ class Targets:
         return [
             f"{self.paths.synthetic_sphere(s)}/{files.TRUTH}"
             for s in self.spheres
-            if self.spheres.is_synthetic(s)
+            if self.spheres.rows.is_synthetic(s)
         ]
