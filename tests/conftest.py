@@ -24,31 +24,22 @@ def sheet_schema() -> dict:
     return load_schema(REPO / "workflow" / "schemas" / "materials.schema.yaml")
 
 
-# Test modules (or classes: pytest-xdist's --dist loadscope runs a class as a unit of its own)
-# that start Snakemake runs of minutes, first: under pytest-xdist (``make test``, one unit per
-# worker at a time) the longest runs then start at once on different workers, and the many
-# short unit tests fill the gaps at the end. The first makes the session's small-data run
-# (tests/workflow/conftest.py), the next two run their own spheres from the small data's
-# virtual experiment meanwhile.
+# Test modules that start Snakemake runs of minutes, first: under pytest-xdist (``make test``,
+# --dist loadscope, one module per worker at a time) the longest runs then start at once on
+# different workers, and the many short unit tests fill the gaps at the end. The first makes
+# the session's small-data run (tests/workflow/conftest.py), the second runs its own spheres
+# from the small data's virtual experiment meanwhile.
 LONG_RUNS_FIRST = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
     "tests/workflow/test_no_prior.py",
-    "tests/workflow/test_own_data.py::TestScanOnCutScans",
-    "tests/workflow/test_own_data.py::TestCorruptFile",
     "tests/workflow/test_executor.py",
     "tests/workflow/test_instrument_route.py",
     "tests/workflow/test_workflow.py",
 )
 
 
-def _unit(nodeid: str) -> str:
-    """The unit pytest-xdist's loadscope schedules a test in: its class, else its module."""
-    parts = nodeid.split("::")
-    return "::".join(parts[:2]) if len(parts) > 2 else parts[0]
-
-
 def pytest_collection_modifyitems(config, items):
-    """The units of LONG_RUNS_FIRST first, in that order; the rest as collected."""
-    rank = {unit: i for i, unit in enumerate(LONG_RUNS_FIRST)}
-    items.sort(key=lambda item: rank.get(_unit(item.nodeid), len(rank)))
+    """The modules of LONG_RUNS_FIRST first, in that order; the rest as collected."""
+    rank = {path: i for i, path in enumerate(LONG_RUNS_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))

@@ -379,72 +379,63 @@ def _spheres_in(project, table: str) -> set[str]:
     return set(pd.read_csv(project / "results" / SMALL / "PS" / table)["sphere"])
 
 
-class TestCorruptFile:
-    """A run of its own, apart from the lab run: a class of its own, so that make test's
-    workers (pytest-xdist --dist loadscope: a class is a unit) can run it beside the
-    module's other tests."""
+def test_one_corrupt_file_stops_only_its_sphere_until_it_is_fixed(small_data, tmp_path):
+    """Two spheres, one with a truncated fluorescence image: every output of the other is
+    made, and the run exits non-zero naming the file. A rerun makes PS's tables and the
+    summary without the failed sphere, marked failed, and still exits non-zero; once the file
+    is fixed, the next run puts the sphere back and exits 0 (amontons.workflow.ledger)."""
+    project = _project(tmp_path, small_data, {COMPLETE: [], "PS-corrupt": []})
+    image = tmp_path / "lab" / "PS-corrupt" / "fluorescence" / "100.tif"
+    intact = image.read_bytes()
+    image.write_bytes(intact[:2000])
+    run = _snakemake(project, "--cores", "2")
+    assert run.returncode != 0
+    assert str(image) in run.stderr
+    check = _check(project)
+    plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
+    for path in plans[COMPLETE]["outputs"]:
+        assert (project / path).is_file(), path
+    errors = [f["error"] for f in plans["PS-corrupt"]["files"] if "error" in f]
+    assert errors and str(image) in errors[0]
+    # the check reads the run's record too: the next run holds the sphere out
+    assert plans[COMPLETE]["failed"] == [] and str(image) in plans["PS-corrupt"]["failed"][0]
+    # the failure, per sphere, with its error, in the run's record and at the end of its log
+    record = project / "results" / SMALL / "failed_jobs.csv"
+    failed = pd.read_csv(record)
+    assert set(failed["sphere"]) == {"PS-corrupt"} and set(failed["material"]) == {"PS"}
+    assert failed["error"].str.contains(str(image), regex=False).all()
+    assert all((project / log).is_file() for log in failed["log"])
+    assert f"sphere PS-corrupt (PS): {failed['rule'].iloc[0]} failed:" in run.stderr
+    # PS's tables read every sphere, so this run could not make them; it says what a rerun does
+    summary = project / "results" / SMALL / "summary.md"
+    assert not (project / "results" / SMALL / "PS" / "load_area.csv").exists()
+    assert "run again to make PS's tables, figures, summary and report without PS-corrupt" in (
+        run.stderr
+    )
 
-    def test_one_corrupt_file_stops_only_its_sphere_until_it_is_fixed(self, small_data, tmp_path):
-        """Two spheres, one with a truncated fluorescence image: every output of the other is
-        made, and the run exits non-zero naming the file. A rerun makes PS's tables and the
-        summary without the failed sphere, marked failed, and still exits non-zero; once the file
-        is fixed, the next run puts the sphere back and exits 0 (amontons.workflow.ledger)."""
-        project = _project(tmp_path, small_data, {COMPLETE: [], "PS-corrupt": []})
-        image = tmp_path / "lab" / "PS-corrupt" / "fluorescence" / "100.tif"
-        intact = image.read_bytes()
-        image.write_bytes(intact[:2000])
-        run = _snakemake(project, "--cores", "2")
-        assert run.returncode != 0
-        assert str(image) in run.stderr
-        check = _check(project)
-        plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
-        for path in plans[COMPLETE]["outputs"]:
-            assert (project / path).is_file(), path
-        errors = [f["error"] for f in plans["PS-corrupt"]["files"] if "error" in f]
-        assert errors and str(image) in errors[0]
-        # the check reads the run's record too: the next run holds the sphere out
-        assert plans[COMPLETE]["failed"] == [] and str(image) in plans["PS-corrupt"]["failed"][0]
-        # the failure, per sphere, with its error, in the run's record and at the end of its log
-        record = project / "results" / SMALL / "failed_jobs.csv"
-        failed = pd.read_csv(record)
-        assert set(failed["sphere"]) == {"PS-corrupt"} and set(failed["material"]) == {"PS"}
-        assert failed["error"].str.contains(str(image), regex=False).all()
-        assert all((project / log).is_file() for log in failed["log"])
-        assert f"sphere PS-corrupt (PS): {failed['rule'].iloc[0]} failed:" in run.stderr
-        # PS's tables read every sphere, so this run could not make them; it says what a rerun does
-        summary = project / "results" / SMALL / "summary.md"
-        assert not (project / "results" / SMALL / "PS" / "load_area.csv").exists()
-        assert "run again to make PS's tables, figures, summary and report without PS-corrupt" in (
-            run.stderr
-        )
+    rerun = _snakemake(project, "--cores", "2")
+    assert rerun.returncode != 0  # the failed jobs ran again, and failed again
+    assert "sphere PS-corrupt (PS): failed in an earlier run: " in rerun.stderr
+    assert _spheres_in(project, "load_area.csv") == _spheres_in(project, "scenes.csv") == {COMPLETE}
+    text = summary.read_text()
+    held = text[text.index("## Failed: held out of every table and figure") :]
+    assert "sphere PS-corrupt (PS): failed in an earlier run: measure_contact_area: " in held
+    assert str(image) in held
+    assert set(pd.read_csv(record)["sphere"]) == {"PS-corrupt"}
 
-        rerun = _snakemake(project, "--cores", "2")
-        assert rerun.returncode != 0  # the failed jobs ran again, and failed again
-        assert "sphere PS-corrupt (PS): failed in an earlier run: " in rerun.stderr
-        assert (
-            _spheres_in(project, "load_area.csv")
-            == _spheres_in(project, "scenes.csv")
-            == {COMPLETE}
-        )
-        text = summary.read_text()
-        held = text[text.index("## Failed: held out of every table and figure") :]
-        assert "sphere PS-corrupt (PS): failed in an earlier run: measure_contact_area: " in held
-        assert str(image) in held
-        assert set(pd.read_csv(record)["sphere"]) == {"PS-corrupt"}
-
-        image.write_bytes(intact)  # the file fixed: the sphere's data stamp changes
-        fixed = _snakemake(project, "--cores", "2")
-        assert fixed.returncode == 0, fixed.stderr[-3000:]
-        assert (
-            _spheres_in(project, "load_area.csv")
-            == _spheres_in(project, "scenes.csv")
-            == {
-                COMPLETE,
-                "PS-corrupt",
-            }
-        )
-        assert "Failed" not in summary.read_text()
-        assert not record.exists()
+    image.write_bytes(intact)  # the file fixed: the sphere's data stamp changes
+    fixed = _snakemake(project, "--cores", "2")
+    assert fixed.returncode == 0, fixed.stderr[-3000:]
+    assert (
+        _spheres_in(project, "load_area.csv")
+        == _spheres_in(project, "scenes.csv")
+        == {
+            COMPLETE,
+            "PS-corrupt",
+        }
+    )
+    assert "Failed" not in summary.read_text()
+    assert not record.exists()
 
 
 def _scene_record(project, sphere, name):
@@ -560,55 +551,48 @@ def test_the_check_and_the_dry_run_predict_the_loads_outside_the_scan(lab_run):
         assert said_clipped == (clipped is not None), sphere
 
 
-class TestScanOnCutScans:
-    """A run of its own, apart from the lab run: a class of its own, so that make test's
-    workers (pytest-xdist --dist loadscope: a class is a unit) can run it beside the
-    module's other tests."""
-
-    def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(self, small_data, tmp_path):
-        """The p_Y scan (three values, to keep it short) of the sphere whose AFM scan holds three
-        loads: every value is solved and compared on those three, the best value's fit is over
-        them, and best.json and the model table list 200 and 300 mN as outside_scan. Beside it,
-        a sphere whose scan holds no load's contact: its scan is not decided, an answer that
-        says why, and the run exits 0 (test_a_scan_with_nothing_to_judge_says_why)."""
-        project = _project(
-            tmp_path, small_data, {"PS-cutscan": [], "PS-noload": [], "PS-twoloads": []}
-        )
-        path = project / "config" / "test.yaml"
-        config = yaml.safe_load(path.read_text())
-        config.update(run_scenes=["penetration_hardness"], run_scans=["p_y"])
-        config["scans"] = {"p_y": {"steps": 3}}
-        path.write_text(yaml.safe_dump(config))
-        check = _check(project)
-        run = _snakemake(project, "--cores", "2")
-        assert run.returncode == 0, run.stderr[-3000:]
-        scan = project / "results" / SMALL / "PS" / "PS-cutscan" / "scans" / "p_y"
-        best = json.loads((scan / "best.json").read_text())
-        assert [row["load_mn"] for row in best["outside_scan"]] == [200.0, 300.0]
-        assert [row["load_mn"] for row in best["best_loads"]] == pytest.approx([25, 50, 100])
-        points = pd.read_csv(scan / "scan.csv")
-        # a value soft enough that its contact leaves the window is recorded, never judged; the
-        # values refinement added (issue 65) are solved on the same loads
-        judged = points[~points["contact_leaves_window"]]
-        grid = points[~points["refined"]]
-        assert len(grid) == 3 and len(judged) >= 2 and judged["log_area_distance"].notna().all()
-        assert sorted(points[points["refined"]]["value"]) == sorted(best["refined_values"])
-        for value in judged["value"]:
-            point = json.loads((scan / "values" / f"{value:g}" / "scan_point.json").read_text())
-            assert [row["load_mn"] for row in point["loads"]] == pytest.approx([25, 50, 100])
-        models = pd.read_csv(project / "results" / SMALL / "PS" / "models.csv")
-        cut = models[models["sphere"] == "PS-cutscan"]
-        assert set(cut["left_out"]) == {"outside_scan: 200, 300 mN"}
-        _a_scan_with_nothing_to_judge_says_why(project, models)
-        _a_scan_with_too_few_loads_says_why(project, models)
-        # the data check said so before the run, and of those spheres only
-        plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
-        assert list(plans["PS-noload"]["undecided_scans"]) == ["p_y"]
-        assert plans["PS-twoloads"]["undecided_scans"]["p_y"] == (
-            "scan p_y: not decided (its scene penetration_hardness keeps 2 loads inside the AFM "
-            "scan, 25, 50 mN; the criterion needs at least 3)"
-        )
-        assert plans["PS-cutscan"]["undecided_scans"] == {}
+def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
+    """The p_Y scan (three values, to keep it short) of the sphere whose AFM scan holds three
+    loads: every value is solved and compared on those three, the best value's fit is over
+    them, and best.json and the model table list 200 and 300 mN as outside_scan. Beside it,
+    a sphere whose scan holds no load's contact: its scan is not decided, an answer that
+    says why, and the run exits 0 (test_a_scan_with_nothing_to_judge_says_why)."""
+    project = _project(tmp_path, small_data, {"PS-cutscan": [], "PS-noload": [], "PS-twoloads": []})
+    path = project / "config" / "test.yaml"
+    config = yaml.safe_load(path.read_text())
+    config.update(run_scenes=["penetration_hardness"], run_scans=["p_y"])
+    config["scans"] = {"p_y": {"steps": 3}}
+    path.write_text(yaml.safe_dump(config))
+    check = _check(project)
+    run = _snakemake(project, "--cores", "2")
+    assert run.returncode == 0, run.stderr[-3000:]
+    scan = project / "results" / SMALL / "PS" / "PS-cutscan" / "scans" / "p_y"
+    best = json.loads((scan / "best.json").read_text())
+    assert [row["load_mn"] for row in best["outside_scan"]] == [200.0, 300.0]
+    assert [row["load_mn"] for row in best["best_loads"]] == pytest.approx([25, 50, 100])
+    points = pd.read_csv(scan / "scan.csv")
+    # a value soft enough that its contact leaves the window is recorded, never judged; the
+    # values refinement added (issue 65) are solved on the same loads
+    judged = points[~points["contact_leaves_window"]]
+    grid = points[~points["refined"]]
+    assert len(grid) == 3 and len(judged) >= 2 and judged["log_area_distance"].notna().all()
+    assert sorted(points[points["refined"]]["value"]) == sorted(best["refined_values"])
+    for value in judged["value"]:
+        point = json.loads((scan / "values" / f"{value:g}" / "scan_point.json").read_text())
+        assert [row["load_mn"] for row in point["loads"]] == pytest.approx([25, 50, 100])
+    models = pd.read_csv(project / "results" / SMALL / "PS" / "models.csv")
+    cut = models[models["sphere"] == "PS-cutscan"]
+    assert set(cut["left_out"]) == {"outside_scan: 200, 300 mN"}
+    _a_scan_with_nothing_to_judge_says_why(project, models)
+    _a_scan_with_too_few_loads_says_why(project, models)
+    # the data check said so before the run, and of those spheres only
+    plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
+    assert list(plans["PS-noload"]["undecided_scans"]) == ["p_y"]
+    assert plans["PS-twoloads"]["undecided_scans"]["p_y"] == (
+        "scan p_y: not decided (its scene penetration_hardness keeps 2 loads inside the AFM "
+        "scan, 25, 50 mN; the criterion needs at least 3)"
+    )
+    assert plans["PS-cutscan"]["undecided_scans"] == {}
 
 
 def _a_scan_with_too_few_loads_says_why(project, models):
