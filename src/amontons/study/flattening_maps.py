@@ -92,28 +92,18 @@ def flattening_panels(topo, window, last: Mapping, solver_pixel_m: float, best: 
     afm_um = topo.pixel_m * 1e6
     name = CONTACT_HARDENING.name
     panels = [
-        MapPanel(
-            topo.before.roughness[window] * 1e9,
-            _title("a) AFM before", depth),
-            core,
-            centre,
-            pixel_um=afm_um,
-        ),
-        MapPanel(
-            topo.after.roughness[window] * 1e9,
-            _title("b) AFM after", depth),
-            core,
-            centre,
-            pixel_um=afm_um,
-        ),
+        MapPanel(scan.roughness[window] * 1e9, _title(title, depth), core, centre, pixel_um=afm_um)
+        for scan, title in ((topo.before, "a) AFM before"), (topo.after, "b) AFM after"))
+    ]
+    panels.append(
         MapPanel(
             deformed * 1e9,
             _title(f"c) {name}, {grid_best_label(best)}", model.depth),
             model.core,
             model.centre,
             pixel_um=solver_pixel_m * 1e6,
-        ),
-    ]
+        )
+    )
     rows = [measured.describe("measured (after - before)"), model.describe(f"{name} model (h_pl)")]
     return panels, rows
 

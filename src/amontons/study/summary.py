@@ -269,7 +269,8 @@ def display_rows(verdict: pd.DataFrame, confidence: float) -> list[list[str]]:
         at = "" if parameter is None else f" at the grid's best {parameter_named(parameter).symbol}"
         lines.append([f"{name}{at}", *(model_text(r, model) for r in records)])
     for parameter in MODEL_PARAMETERS.values():
-        symbol, unit = parameter_named(parameter).symbol, parameter_named(parameter).unit
+        own = parameter_named(parameter)
+        symbol, unit = own.symbol, own.unit
         lines.append(
             [
                 f"{symbol} (estimate, {unit}; {confidence:.0%} interval)",
