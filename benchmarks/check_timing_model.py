@@ -40,7 +40,7 @@ def solver_jobs(results: Path) -> pd.DataFrame:
     for path in sorted(results.rglob("scenes/*/solve.json")):
         solve = json.loads(path.read_text())
         if "side_px" not in solve or "wall_time_s" not in solve:
-            continue  # Greenwood-Tripp: no grid
+            continue  # Greenwood–Tripp: no grid
         scenes[(path.parents[2], solve["scene"])] = solve
         law = (solve.get("p_y_mpa"), solve.get("k_mpa_per_nm"))
         rows.append(_row("scene", solve, *law, solve["wall_time_s"], None))

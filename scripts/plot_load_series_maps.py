@@ -1,5 +1,5 @@
 """Rule plot_load_series_maps: appendix Figs. 5.2 and B.11 for one sphere
-(amontons.study.load_series_maps): reads the measured images, the Greenwood-Tripp solve and the
+(amontons.study.load_series_maps): reads the measured images, the Greenwood–Tripp solve and the
 elastic scene's and the k scan's rendered series, and writes the figure and its table."""
 
 import logging

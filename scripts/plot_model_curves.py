@@ -1,6 +1,6 @@
 """Rule plot_model_curves: appendix Fig. B.12 for one sphere. The measured contact area
 against load (symbols) with every model's curve: each scene (rendered Otsu area where it has
-optics, else the solver's real area: Greenwood-Tripp) and each scan's best value, with the
+optics, else the solver's real area: Greenwood–Tripp) and each scan's best value, with the
 power-law fit's exponent and its interval in the legend and the fit's 95 % band. A scan's
 curve is the model at the grid's best value, named as such; the title gives the scans'
 estimates with their intervals."""

@@ -1,4 +1,4 @@
-"""Rule simulate_greenwood_tripp: a Greenwood-Tripp scene's real contact area per load, from the
+"""Rule simulate_greenwood_tripp: a Greenwood–Tripp scene's real contact area per load, from the
 roughness statistics of the sphere's levelled AFM map."""
 
 import logging

@@ -99,6 +99,8 @@ def test_greenwood_tripps_panel_is_its_radial_fraction_about_the_map_centre(seri
 def test_the_hardening_row_names_the_grid_best_it_shows():
     titles = row_titles({"grid_best": 4.47})
     assert titles[3].endswith("k = 4.47 MPa/nm") and titles[2] == ELASTIC.label
+    # every model row is named as the model table and the verdict name it (its record's label)
+    assert titles[1].splitlines()[0] == "Greenwood–Tripp" == GREENWOOD_TRIPP.label
 
 
 def test_the_figure_and_its_table_are_written(series, tmp_path, monkeypatch):

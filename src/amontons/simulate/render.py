@@ -104,7 +104,7 @@ def render_load_series(
 def area_fraction_map(
     r_um: np.ndarray, area_fraction: np.ndarray, shape, centre_px, pixel_m: float
 ) -> np.ndarray:
-    """A mean-field model's real-area fraction φ(r) (radii in µm, e.g. Greenwood-Tripp's
+    """A mean-field model's real-area fraction φ(r) (radii in µm, e.g. Greenwood–Tripp's
     annulus mid-radii) on an image grid of ``shape`` about ``centre_px`` (row, col): the map a
     model without asperity geometry gives. Zero beyond its last radius."""
     rows, cols = np.indices(shape, dtype=float)

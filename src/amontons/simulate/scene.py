@@ -76,7 +76,7 @@ class Scene:
 
     @property
     def plasticity(self) -> PenetrationHardness | ContactHardening | None:
-        """The plasticity law, None for an elastic (or Greenwood-Tripp) scene: no plastic loop."""
+        """The plasticity law, None for an elastic (or Greenwood–Tripp) scene: no plastic loop."""
         model = model_named(self.model)
         if model.law is None:
             return None

@@ -7,7 +7,7 @@ scene no Hockney padding. A contact that reaches the window edge raises the solv
 FreeBoundaryError; a solve that does not converge raises ConvergenceError: never a silent
 result.
 
-Greenwood-Tripp (appendix B.2.1) is the mean-field model of the same sphere: it takes the
+Greenwood–Tripp (appendix B.2.1) is the mean-field model of the same sphere: it takes the
 roughness statistics of the map (σ = h_rms, β = 1/h''_rms) and returns an axisymmetric
 nominal pressure and area fraction, not a map (docs/models.md §2.5).
 """
@@ -144,7 +144,7 @@ def solve_on_clipped_window(
 def greenwood_tripp_scene(
     scene: Scene, h_rms_m: float, curvature_rms_per_m: float, eta_sigma_beta: float = 0.05
 ) -> list[dict]:
-    """Greenwood-Tripp real contact area (µm²) per load of the scene's sphere, and its radial
+    """Greenwood–Tripp real contact area (µm²) per load of the scene's sphere, and its radial
     profile of the real-area fraction (annulus mid-radii, µm), with the
     asperity closure of docs/models.md §2.5 (σ = h_rms, β = 1/h''_rms, ησβ = 0.05)."""
     model = AsperityModel.from_roughness(h_rms_m, curvature_rms_per_m, eta_sigma_beta)

@@ -118,7 +118,7 @@ def row_titles(best: Mapping) -> list[str]:
     parameter = CONTACT_HARDENING.parameter
     return [
         EXPERIMENT,
-        "Greenwood-Tripp\n(area fraction)",
+        f"{GREENWOOD_TRIPP.label}\n(area fraction)",
         ELASTIC.label,
         f"{CONTACT_HARDENING.name}\ngrid's best\n{parameter.symbol} = "
         f"{significant(best['grid_best'])} {parameter.unit}",

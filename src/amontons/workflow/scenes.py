@@ -61,7 +61,7 @@ class Scenes:
 
     def names(self, surface=None, model=None, optics=None, field=None) -> list[str]:
         """Names of the scenes with the given surface, model and optics; ``field``: True for
-        the scenes whose solver gives fields (every model but Greenwood-Tripp), False for GT.
+        the scenes whose solver gives fields (every model but Greenwood–Tripp), False for GT.
         """
         names = []
         for name, scene in self.scenes.items():

@@ -44,7 +44,7 @@ class Study:
 
     def load_series_layout(self, wildcards) -> dict:
         """Fig. B.11's inputs: the elastic scene's rendered loads and registration, the
-        Greenwood-Tripp solve and the k scan."""
+        Greenwood–Tripp solve and the k scan."""
         where = (wildcards.material, wildcards.sphere)
         elastic = self.scenes.first(ELASTIC.name, "microscope")
         gt = self.scenes.first(GREENWOOD_TRIPP.name)
