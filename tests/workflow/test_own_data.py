@@ -80,6 +80,9 @@ PSF_DEPENDENT = {
 # The stand-in PSF of the sphere without a bead image: another FWHM than the bead gives, so
 # that its renderings differ from the complete sphere's and show where the PSF came from.
 STAND_IN = {"fwhm_nm": 500.0, "fwhm_se_nm": 25.0}
+# The rules that measure a sphere's raw files (and level its AFM maps): what a project that
+# goes on from the lab run's does not run again for a sphere the lab run measured.
+MEASURING = ("measure_", "level_", "fit_load_area", "check_hertz")
 
 
 def _apex_px(heights: np.ndarray) -> tuple[float, float]:
@@ -180,6 +183,39 @@ def _project(tmp_path, small_data, spheres: dict[str, list[str]]) -> Path:
     )
     path.write_text(yaml.safe_dump(config))
     return project
+
+
+def _continued(lab_project: Path, tmp_path, small_data, kept: list[str], new: list[str]) -> Path:
+    """A project that goes on from the lab run's (``lab_project``): its config, Snakemake's
+    records, and the results and logs of the spheres ``kept``, whose rows keep naming the lab
+    run's folders; its sheet is theirs and the rows of ``new``, fresh copies of the virtual PS
+    sphere (_lab_sphere) in this test's lab. What the lab run made of the kept spheres is not
+    made again, as in a lab's project whose sheet gains a sphere."""
+    project = tmp_path / "project"
+    shutil.copytree(lab_project / "config", project / "config")
+    shutil.copytree(lab_project / ".snakemake", project / ".snakemake",
+                    ignore=shutil.ignore_patterns("log"))  # fmt: skip
+    for sphere in kept:
+        for folder in ("results", "logs"):
+            part = Path(folder) / SMALL / "PS" / sphere
+            shutil.copytree(lab_project / part, project / part)
+    sheet = pd.read_csv(project / "config" / "own.tsv", sep="\t", dtype=str)
+    ps = sheet[sheet["sphere"] == COMPLETE]
+    rows = [sheet[sheet["sphere"].isin(kept)]] + [
+        _sheet_row(ps, name, _lab_sphere(small_data, tmp_path / "lab", name, [])) for name in new
+    ]
+    pd.concat(rows).to_csv(project / "config" / "own.tsv", sep="\t", index=False)
+    return project
+
+
+def _jobs_of(run: subprocess.CompletedProcess, sphere: str) -> set[str]:
+    """The rules of the jobs that ``run`` (Snakemake's log of them) ran for ``sphere``."""
+    blocks = re.split(r"\n(?=(?:local)?rule \w+:)", run.stdout + run.stderr)
+    return {
+        re.match(r"(?:local)?rule (\w+):", block)[1]
+        for block in blocks
+        if re.search(rf"wildcards: .*\bsphere={re.escape(sphere)}(?:,|$)", block, re.M)
+    }
 
 
 def _snakemake(project, *args):
@@ -379,17 +415,20 @@ def _spheres_in(project, table: str) -> set[str]:
     return set(pd.read_csv(project / "results" / SMALL / "PS" / table)["sphere"])
 
 
-def test_one_corrupt_file_stops_only_its_sphere_until_it_is_fixed(small_data, tmp_path):
+def test_one_corrupt_file_stops_only_its_sphere_until_it_is_fixed(lab_run, small_data, tmp_path):
     """Two spheres, one with a truncated fluorescence image: every output of the other is
     made, and the run exits non-zero naming the file. A rerun makes PS's tables and the
     summary without the failed sphere, marked failed, and still exits non-zero; once the file
-    is fixed, the next run puts the sphere back and exits 0 (amontons.workflow.ledger)."""
-    project = _project(tmp_path, small_data, {COMPLETE: [], "PS-corrupt": []})
+    is fixed, the next run puts the sphere back and exits 0 (amontons.workflow.ledger). The
+    project goes on from the lab run's (_continued): the complete sphere's outputs are that
+    run's, and no job of it runs again."""
+    project = _continued(lab_run[0], tmp_path, small_data, [COMPLETE], ["PS-corrupt"])
     image = tmp_path / "lab" / "PS-corrupt" / "fluorescence" / "100.tif"
     intact = image.read_bytes()
     image.write_bytes(intact[:2000])
     run = _snakemake(project, "--cores", "2")
     assert run.returncode != 0
+    assert _jobs_of(run, COMPLETE) == set() and _jobs_of(run, "PS-corrupt")
     assert str(image) in run.stderr
     check = _check(project)
     plans = {plan["sphere"]: plan for plan in json.loads(check.stdout)}
@@ -551,13 +590,15 @@ def test_the_check_and_the_dry_run_predict_the_loads_outside_the_scan(lab_run):
         assert said_clipped == (clipped is not None), sphere
 
 
-def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
+def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(lab_run, small_data, tmp_path):
     """The p_Y scan (three values, to keep it short) of the sphere whose AFM scan holds three
     loads: every value is solved and compared on those three, the best value's fit is over
     them, and best.json and the model table list 200 and 300 mN as outside_scan. Beside it,
     a sphere whose scan holds no load's contact: its scan is not decided, an answer that
-    says why, and the run exits 0 (test_a_scan_with_nothing_to_judge_says_why)."""
-    project = _project(tmp_path, small_data, {"PS-cutscan": [], "PS-noload": [], "PS-twoloads": []})
+    says why, and the run exits 0 (test_a_scan_with_nothing_to_judge_says_why). The project
+    goes on from the lab run's (_continued), with the scan switched on: the two cut spheres'
+    measurements are that run's, and only their new scene and scan run."""
+    project = _continued(lab_run[0], tmp_path, small_data, [*CUT_SCANS], [*TWO_LOAD_SCANS])
     path = project / "config" / "test.yaml"
     config = yaml.safe_load(path.read_text())
     config.update(run_scenes=["penetration_hardness"], run_scans=["p_y"])
@@ -566,6 +607,8 @@ def test_a_scan_on_a_cut_scan_judges_the_loads_it_holds(small_data, tmp_path):
     check = _check(project)
     run = _snakemake(project, "--cores", "2")
     assert run.returncode == 0, run.stderr[-3000:]
+    again = _jobs_of(run, "PS-cutscan")
+    assert "scan_scene" in again and not {r for r in again if r.startswith(MEASURING)}, again
     scan = project / "results" / SMALL / "PS" / "PS-cutscan" / "scans" / "p_y"
     best = json.loads((scan / "best.json").read_text())
     assert [row["load_mn"] for row in best["outside_scan"]] == [200.0, 300.0]
