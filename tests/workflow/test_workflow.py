@@ -15,8 +15,12 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from SurfaceTopography import Topography
 
+from amontons.io.layout import afm_file
 from amontons.io.tiff import read_image, write_image
+from amontons.measure.scan_lines import line_levelling_mode
+from amontons.measure.topography import measure_topography
 from amontons.simulate.scan_best import point_from_record
 from amontons.simulate.scan_criterion import Criterion, ModelError
 from amontons.simulate.scan_grid import value_label
@@ -522,33 +526,39 @@ def check_measurements_against_truth(project, material, sphere):
     )
 
 
-def test_own_afm_maps_in_vendor_formats_are_measured(small_data, small_run, tmp_path):
-    """A measured sphere whose AFM scans come as an ISO 25178 x3p file (before) and a
-    Gwyddion file (after), written from the virtual PS sphere's float TIFF scans: the topography
-    rule reads them through SurfaceTopography and gives the TIFF scans' numbers (to 1e-9
-    relative: the same float32 heights, the same pixel)."""
-    from SurfaceTopography import Topography
+def _topography_record(folder: Path) -> dict:
+    """The topography record of ``folder``'s AFM scans, found as the rules' inputs find them
+    (amontons.io.layout.afm_file) and measured with config/config.yaml's surface settings."""
+    surface = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["surface"]
+    return measure_topography(
+        afm_file(folder, "afm_before"),
+        afm_file(folder, "afm_after"),
+        None,
+        nan_policy=surface["afm_nan_policy"],
+        channel=surface["afm_channel"],
+        line_levelling=line_levelling_mode(surface["line_levelling"]),
+    ).to_record()
 
+
+def test_own_afm_maps_in_vendor_formats_are_measured(small_data, tmp_path):
+    """A measured sphere whose AFM scans come as an ISO 25178 x3p file (before) and a
+    Gwyddion file (after), written from the virtual PS sphere's float TIFF scans: the lookup
+    the rules' inputs use finds them, and the topography measurement reads them through
+    SurfaceTopography and gives the TIFF scans' numbers (to 1e-9 relative: the same float32
+    heights, the same pixel). In-process: which file a rule takes is the lookup's, what it
+    reads and measures is the library's (a Snakemake run of both rules gave the same)."""
+    synthetic = small_data / "resources" / "synthetic" / SMALL / "PS"
     own = tmp_path / "my_data" / "PS-afm"
-    shutil.copytree(small_data / "resources" / "synthetic" / SMALL / "PS", own)
+    own.mkdir(parents=True)
     for stem, writer in (("afm_before", "to_x3p"), ("afm_after", "to_gwy")):
-        scan = read_image(own / f"{stem}.tif", allow_nan=True)
+        scan = read_image(synthetic / f"{stem}.tif", allow_nan=True)
         ny, nx = scan.data.shape
         topography = Topography(
             scan.data.astype(float).T, (nx * scan.pixel_m, ny * scan.pixel_m), unit="m"
         )
         getattr(topography, writer)(str(own / f"{stem}.{writer[3:]}"))
-        (own / f"{stem}.tif").unlink()
-    shutil.copytree(REPO / "config", tmp_path / "config")
-    sheet = pd.read_csv(tmp_path / "config" / "materials.tsv", sep="\t", dtype=str)
-    row = sheet[sheet["sphere"] == "PS"].assign(sphere="PS-afm", data_source=str(own))
-    row.to_csv(tmp_path / "config" / "own.tsv", sep="\t", index=False)
-    _edit_config(tmp_path, lambda c: c.update(materials=["PS"], materials_sheet="config/own.tsv"))
-    target = "results/small/PS/PS-afm/measure/topography.json"
-    result = snakemake(tmp_path, target, "--cores", "2", "--configfile", "config/test.yaml")
-    assert result.returncode == 0, result.stderr[-3000:]
-    found = json.loads((tmp_path / target).read_text())
-    reference = json.loads(measured(small_run, "PS", "PS", "topography.json").read_text())
+    assert [afm_file(own, stem).suffix for stem in ("afm_before", "afm_after")] == [".x3p", ".gwy"]
+    found, reference = _topography_record(own), _topography_record(synthetic)
     assert found["channel"] == "Default" and reference["channel"] is None
     for scan in ("before", "after"):
         for key, value in reference[scan].items():
