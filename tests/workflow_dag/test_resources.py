@@ -20,11 +20,12 @@ def test_the_dag_sizes_each_solve_on_the_grid_the_simulation_solves_on(make_run,
             pairs = [(None, synthetic_scene(scene, spec), geometry.synthetic_frame(spec))]
         else:
             pairs = [
-                (s, scene_for_sphere(scene, spec, s, run.spheres.row(s)), None) for s in run.spheres
+                (s, scene_for_sphere(scene, spec, s, run.spheres.rows.row(s)), None)
+                for s in run.spheres
             ]
         for sphere, simulated, frame in pairs:
             if frame is None:
-                frame = geometry.sphere_frame(spec, run.spheres.row(sphere))
+                frame = geometry.sphere_frame(spec, run.spheres.rows.row(sphere))
             window = geometry.window_m(scene, spec, frame)
             assert window == simulated.window_m
             assert geometry.solver_pixel_m(spec, window) == simulated.pixel_m

@@ -62,7 +62,7 @@ def test_a_scan_has_one_point_per_value_around_the_sheets_prior(small):
     assert scenes.scans
     sphere = next(iter(small.spheres))
     for scan, spec in scenes.scans.items():
-        prior = small.spheres.row(sphere)[parameter_named(spec["parameter"]).sheet_column]
+        prior = small.spheres.rows.row(sphere)[parameter_named(spec["parameter"]).sheet_column]
         expected = scan_values(prior, spec["range_factor"], spec["steps"], spec["spacing"])
         labels = scenes.scan_value_labels(sphere, scan)
         assert labels == [value_label(v) for v in expected]

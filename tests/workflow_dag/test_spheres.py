@@ -47,29 +47,23 @@ def _spheres(tmp_path, **measured_files):
     return Spheres(records, RunPaths("small")), folder
 
 
-def test_the_parts_share_one_sheet_and_the_rules_names_are_the_parts_answers(tmp_path):
-    """Spheres composes its parts over one SheetRows; each name the rule files call on
-    SPHERES beyond the selection (of, materials_with, held_out) is a part's, answered
-    alike."""
+def test_the_parts_share_one_sheet_and_spheres_holds_only_the_selection(tmp_path):
+    """Spheres composes its parts over one SheetRows, and holds nothing of theirs: beyond
+    the parts, only the selection they share (of, materials_with, held_out); the rule files
+    and the library ask the parts."""
     spheres, _ = _spheres(tmp_path, **_complete_folder(tmp_path))
     parts = [spheres.series, spheres.files, spheres.pixels, spheres.inputs, spheres.hold_outs]
     assert all(part.rows is spheres.rows for part in parts)
     assert spheres.files.series is spheres.series
-    forwarded = {name for name in vars(Spheres) if not name.startswith("_")}
-    forwarded -= {"of", "materials_with", "held_out"}
-    for name in sorted(forwarded):
-        assert [p for p in [spheres.rows, *parts] if hasattr(p, name)], name
-    for sphere in ("syn", "lab"):
-        assert spheres.bead_image(sphere) == spheres.files.bead_image(sphere)
-        assert spheres.missing(sphere) is spheres.inputs.missing(sphere)
-        assert spheres.scene_record(sphere) == spheres.rows.scene_record(sphere)
+    own = {name for name in vars(Spheres) if not name.startswith("_")}
+    assert own == {"of", "materials_with", "held_out"}
 
 
 def test_synthetic_raw_data_lie_in_the_runs_virtual_experiment(tmp_path):
     spheres, folder = _spheres(tmp_path)
     assert spheres.rows.raw_dir("syn") == "resources/synthetic/small/syn"
     assert spheres.rows.raw_dir("lab") == str(folder)
-    assert spheres.per_load_inputs("syn", "fluorescence") == (
+    assert spheres.files.per_load_inputs("syn", "fluorescence") == (
         "resources/synthetic/small/syn/fluorescence"
     )
 
@@ -77,30 +71,30 @@ def test_synthetic_raw_data_lie_in_the_runs_virtual_experiment(tmp_path):
 def test_measured_images_are_matched_to_the_sheet_loads(tmp_path):
     images = {f"fluorescence/{load}mN.tif": "" for load in (10, 20, 40)}
     spheres, folder = _spheres(tmp_path, **images)
-    found = spheres.per_load_inputs("lab", "fluorescence")
+    found = spheres.files.per_load_inputs("lab", "fluorescence")
     assert found == [str(folder / f"fluorescence/{load}mN.tif") for load in (10, 20, 40)]
-    assert spheres.reflection_fluorescence("lab") == found[1]
+    assert spheres.files.reflection_fluorescence("lab") == found[1]
 
 
 def test_an_afm_map_is_named_by_the_format_present_else_by_its_tiff(tmp_path):
     spheres, folder = _spheres(tmp_path, **{"afm_before.npy": ""})
-    assert spheres.afm_path("lab", "afm_before") == str(folder / "afm_before.npy")
-    assert spheres.afm_path("lab", "afm_after") == f"{folder}/afm_after.tif"
+    assert spheres.files.afm_path("lab", "afm_before") == str(folder / "afm_before.npy")
+    assert spheres.files.afm_path("lab", "afm_after") == f"{folder}/afm_after.tif"
 
 
 def test_flim_where_the_sheet_asks_or_the_folder_holds_it(tmp_path):
     spheres, _ = _spheres(tmp_path)
     assert spheres.files.has_flim("syn") and not spheres.files.has_flim("lab")
-    assert spheres.synthetic_pattern(with_flim=True) == "syn"
-    assert spheres.synthetic_pattern(with_flim=False) == "(?!)"
+    assert spheres.files.synthetic_pattern(with_flim=True) == "syn"
+    assert spheres.files.synthetic_pattern(with_flim=False) == "(?!)"
     with_map, _ = _spheres(tmp_path / "2", **{"flim.tif": ""})
     assert with_map.files.has_flim("lab")
 
 
 def test_data_label_says_synthetic_if_any_sphere_is(tmp_path):
     spheres, _ = _spheres(tmp_path)
-    assert spheres.data_label(["syn", "lab"]) == "synthetic data"
-    assert spheres.data_label(["lab"]) == "measured data"
+    assert spheres.rows.data_label(["syn", "lab"]) == "synthetic data"
+    assert spheres.rows.data_label(["lab"]) == "measured data"
 
 
 @pytest.mark.parametrize(("names", "matches"), [(["a.b", "c"], "a.b|c"), ([], "(?!)")])
@@ -131,9 +125,9 @@ def test_a_missing_optional_file_is_found_and_named(tmp_path, remove, kind):
     files = _complete_folder(tmp_path)
     del files[remove]
     spheres, folder = _spheres(tmp_path, **files)
-    assert list(spheres.missing("lab")) == [kind]
-    assert remove.split(".")[0] in spheres.missing("lab")[kind]
-    assert spheres.missing("syn") == {}  # the virtual experiment writes every file
+    assert list(spheres.inputs.missing("lab")) == [kind]
+    assert remove.split(".")[0] in spheres.inputs.missing("lab")[kind]
+    assert spheres.inputs.missing("syn") == {}  # the virtual experiment writes every file
     (line,) = spheres.inputs.left_out("lab")
     assert "will not be made" in line
 
@@ -141,7 +135,7 @@ def test_a_missing_optional_file_is_found_and_named(tmp_path, remove, kind):
 def test_a_sphere_without_rheometer_folder_has_no_friction(tmp_path):
     files = {k: v for k, v in _complete_folder(tmp_path).items() if not k.startswith("rheometer")}
     spheres, _ = _spheres(tmp_path, **files)
-    assert list(spheres.missing("lab")) == [RHEOMETER]
+    assert list(spheres.inputs.missing("lab")) == [RHEOMETER]
     assert spheres.of("PS", having=RHEOMETER) == ["syn"]
     assert spheres.materials_with(["PS"], RHEOMETER) == ["PS"]
 
@@ -154,8 +148,8 @@ def test_a_shared_bead_image_stands_for_the_spheres_own(tmp_path):
     shared.write_text("")
     spheres.rows.records["lab"]["bead_file"] = str(shared)
     spheres.inputs._missing.clear()
-    assert spheres.bead_image("lab") == str(shared)
-    assert spheres.missing("lab") == {}
+    assert spheres.files.bead_image("lab") == str(shared)
+    assert spheres.inputs.missing("lab") == {}
 
 
 def test_without_a_bead_the_psf_is_the_stand_in_or_none(tmp_path):
@@ -167,7 +161,7 @@ def test_without_a_bead_the_psf_is_the_stand_in_or_none(tmp_path):
     assert "no microscope scene" in spheres.inputs.left_out("lab")[0]
     stand_in = Spheres(spheres.rows.records, RunPaths("small"), psf_stand_in=True)
     assert stand_in.inputs.psf_source("lab") == "stand_in" and stand_in.inputs.can_render("lab")
-    assert stand_in.psf_pattern("stand_in") == "lab"
+    assert stand_in.inputs.psf_pattern("stand_in") == "lab"
     assert "optics.psf.stand_in" in stand_in.inputs.left_out("lab")[0]
 
 
@@ -175,26 +169,30 @@ def test_confocal_images_are_found_by_any_accepted_suffix(tmp_path):
     files = {"fluorescence/10mN.ome.tif": "", "fluorescence/20.czi": "", "fluorescence/40.tif": ""}
     files |= {"reflection.czi": "", "bead.ome.tif": ""}
     spheres, folder = _spheres(tmp_path, **files)
-    assert spheres.per_load_inputs("lab", "fluorescence") == [
+    assert spheres.files.per_load_inputs("lab", "fluorescence") == [
         str(folder / name) for name in ("fluorescence/10mN.ome.tif", "fluorescence/20.czi",
                                         "fluorescence/40.tif")
     ]  # fmt: skip
-    assert spheres.reflection_image("lab") == str(folder / "reflection.czi")
-    assert spheres.bead_image("lab") == str(folder / "bead.ome.tif")
-    assert REFLECTION not in spheres.missing("lab") and BEAD not in spheres.missing("lab")
+    assert spheres.files.reflection_image("lab") == str(folder / "reflection.czi")
+    assert spheres.files.bead_image("lab") == str(folder / "bead.ome.tif")
+    assert REFLECTION not in spheres.inputs.missing("lab") and BEAD not in spheres.inputs.missing(
+        "lab"
+    )
 
 
 def test_the_virtual_experiments_images_are_named_by_its_format(tmp_path):
     spheres = Spheres({"syn": {**RECORD, "data_source": "synthetic"}}, RunPaths("full"),
                       synthetic_images=".ome.tif")  # fmt: skip
-    assert spheres.reflection_image("syn") == "resources/synthetic/full/syn/reflection.ome.tif"
-    assert spheres.bead_image("syn") == "resources/synthetic/full/syn/bead.ome.tif"
+    assert (
+        spheres.files.reflection_image("syn") == "resources/synthetic/full/syn/reflection.ome.tif"
+    )
+    assert spheres.files.bead_image("syn") == "resources/synthetic/full/syn/bead.ome.tif"
 
 
 def test_two_formats_of_one_image_stop_the_run_naming_both(tmp_path):
     spheres, folder = _spheres(tmp_path, **{"reflection.tif": "", "reflection.czi": ""})
     with pytest.raises(RawDataError, match=r"reflection\.tif, reflection\.czi; expected one"):
-        spheres.reflection_image("lab")
+        spheres.files.reflection_image("lab")
 
 
 def test_images_without_a_pixel_and_no_sheet_pixel_stop_the_run_naming_sphere_and_file(
@@ -213,8 +211,10 @@ def test_images_without_a_pixel_and_no_sheet_pixel_stop_the_run_naming_sphere_an
         spheres.pixels.check()
     write_confocal(folder / "fluorescence/40.tif", untagged, 200e-9, "tif")
     spheres.pixels.check()  # every image states its own
-    assert spheres.image_pixel_inputs("lab") == ["results/small/PS/lab/measure/contact_area.csv"]
-    assert spheres.image_pixel_inputs("syn") == []
+    assert spheres.pixels.image_pixel_inputs("lab") == [
+        "results/small/PS/lab/measure/contact_area.csv"
+    ]
+    assert spheres.pixels.image_pixel_inputs("syn") == []
 
 
 @pytest.mark.parametrize("name", ["flim.ptu", "flim.tif"])
@@ -287,9 +287,9 @@ def test_the_one_file_is_every_fluorescence_jobs_input_and_the_param_maps_its_pl
     spheres, lab = _series_spheres(tmp_path)
     series = str(lab / "fluorescence.ome.tif")
     assert spheres.series.file("lab") == series
-    assert spheres.per_load_inputs("lab", "fluorescence") == [series]
-    assert spheres.reflection_fluorescence("lab") == series
-    assert spheres.fluorescence_choice("lab", IMAGES) == {
+    assert spheres.files.per_load_inputs("lab", "fluorescence") == [series]
+    assert spheres.files.reflection_fluorescence("lab") == series
+    assert spheres.series.fluorescence_choice("lab", IMAGES) == {
         **IMAGES,
         "load_series": {"axis": "frames", "plane_loads_mn": [10.0, 20.0, 40.0]},
     }
@@ -304,16 +304,16 @@ def test_per_load_and_synthetic_spheres_keep_their_inputs_and_params(tmp_path):
     spheres, _ = _series_spheres(tmp_path)
     assert spheres.series.file("old") is None and spheres.series.file("syn") is None
     for sphere in ("old", "syn"):
-        assert spheres.fluorescence_choice(sphere, IMAGES) == IMAGES
+        assert spheres.series.fluorescence_choice(sphere, IMAGES) == IMAGES
         assert spheres.series.plane_loads(sphere) is None
-    old = spheres.per_load_inputs("old", "fluorescence")
+    old = spheres.files.per_load_inputs("old", "fluorescence")
     assert old == [str(tmp_path / "old" / "fluorescence" / f"{f}.tif") for f in (10, 20, 40)]
-    assert spheres.per_load_inputs("syn", "fluorescence").endswith("syn/fluorescence")
+    assert spheres.files.per_load_inputs("syn", "fluorescence").endswith("syn/fluorescence")
 
 
 def test_a_planes_list_gives_each_plane_its_load(tmp_path):
     spheres, _ = _series_spheres(tmp_path, {"axis": "series", "planes": [1, 2, 0]})
-    assert spheres.fluorescence_choice("lab", IMAGES)["load_series"] == {
+    assert spheres.series.fluorescence_choice("lab", IMAGES)["load_series"] == {
         "axis": "series",
         "plane_loads_mn": [40.0, 10.0, 20.0],
     }
@@ -322,22 +322,22 @@ def test_a_planes_list_gives_each_plane_its_load(tmp_path):
 def test_a_planes_list_that_does_not_fit_the_sheets_loads_stops_naming_the_sphere(tmp_path):
     spheres, _ = _series_spheres(tmp_path, {"axis": "series", "planes": [0, 1]})
     with pytest.raises(RawDataError, match=r"sphere lab: .*planes \[0, 1\] for the sheet's 3"):
-        spheres.fluorescence_choice("lab", IMAGES)
+        spheres.series.fluorescence_choice("lab", IMAGES)
 
 
 def test_a_folder_and_a_load_series_file_both_stop_the_run_naming_both(tmp_path):
     spheres, lab = _series_spheres(tmp_path, per_load=True)
     message = rf"sphere lab: both {lab}/fluorescence/ .* and {lab}/fluorescence\.ome\.tif"
     with pytest.raises(RawDataError, match=message):
-        spheres.per_load_inputs("lab", "fluorescence")
+        spheres.files.per_load_inputs("lab", "fluorescence")
 
 
 def test_a_load_series_file_without_its_config_is_not_guessed(tmp_path):
     spheres, lab = _series_spheres(tmp_path, load_series=None)
     message = rf"sphere lab: {lab}/fluorescence\.ome\.tif holds every load, but .*load_series"
     with pytest.raises(RawDataError, match=message):
-        spheres.per_load_inputs("lab", "fluorescence")
-    assert spheres.per_load_inputs("old", "fluorescence")  # a per-load sphere needs none
+        spheres.files.per_load_inputs("lab", "fluorescence")
+    assert spheres.files.per_load_inputs("old", "fluorescence")  # a per-load sphere needs none
 
 
 def test_a_load_series_file_without_a_pixel_stops_the_run_like_any_image(tmp_path):
@@ -410,12 +410,12 @@ def test_a_sheet_row_may_name_the_export_map_of_its_spheres_files(tmp_path):
     header; a single map passes as it is, whatever the row says."""
     spheres, _ = _spheres(tmp_path)
     spheres.rows.records["lab"]["rheometer_export"] = "trios"
-    assert spheres.rheometer_export("lab", TWO_MAPS) == {"trios": TWO_MAPS["trios"]}
-    assert spheres.rheometer_export("syn", TWO_MAPS) == TWO_MAPS
-    assert spheres.rheometer_export("syn", None) is None
+    assert spheres.files.rheometer_export("lab", TWO_MAPS) == {"trios": TWO_MAPS["trios"]}
+    assert spheres.files.rheometer_export("syn", TWO_MAPS) == TWO_MAPS
+    assert spheres.files.rheometer_export("syn", None) is None
     single = TWO_MAPS["trios"]
     spheres.rows.records["lab"]["rheometer_export"] = "export"
-    assert spheres.rheometer_export("lab", single) == single
+    assert spheres.files.rheometer_export("lab", single) == single
     check_rheometer_exports(TWO_MAPS, {"lab": {"rheometer_export": "trios"}}, "mine.yaml")
     check_rheometer_exports(single, {"lab": {"rheometer_export": "export"}}, "mine.yaml")
 

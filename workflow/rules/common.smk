@@ -96,20 +96,20 @@ ACCURACY_LOGS = PATHS.accuracy_logs
 
 # The selected spheres (amontons.workflow.spheres).
 SPHERES = RUN.spheres
-sphere_row = SPHERES.row
+sphere_row = SPHERES.rows.row
 spheres_of = SPHERES.of
-loads_mn = SPHERES.loads_mn
-sheet_value = SPHERES.value
-pixel_nm = SPHERES.pixel_nm
-raw_file = SPHERES.raw_file
-reflection_image = SPHERES.reflection_image
+loads_mn = SPHERES.rows.loads_mn
+sheet_value = SPHERES.rows.value
+pixel_nm = SPHERES.rows.pixel_nm
+raw_file = SPHERES.rows.raw_file
+reflection_image = SPHERES.files.reflection_image
 # The suffix of the virtual experiment's confocal images (virtual_experiment.formats.images).
-SYNTHETIC_IMAGE = SPHERES.synthetic_images
-afm_path = SPHERES.afm_path
-per_load_inputs = SPHERES.per_load_inputs
-reflection_fluorescence = SPHERES.reflection_fluorescence
-data_label = SPHERES.data_label
-scene_sphere_record = SPHERES.scene_record
+SYNTHETIC_IMAGE = SPHERES.files.synthetic_images
+afm_path = SPHERES.files.afm_path
+per_load_inputs = SPHERES.files.per_load_inputs
+reflection_fluorescence = SPHERES.files.reflection_fluorescence
+data_label = SPHERES.rows.data_label
+scene_sphere_record = SPHERES.rows.scene_record
 
 # Config slices as params (amontons.workflow.params).
 config_slice = partial(_config_slice, config)
@@ -130,7 +130,7 @@ IMAGES = image_choice(config)
 REFLECTION_IMAGES = image_choice(config, reflection=True)
 # A sphere's fluorescence plane choice: IMAGES, and which plane is which load where one file
 # holds them all (config/README.md, "A load series in one file").
-fluorescence_choice = partial(SPHERES.fluorescence_choice, images=IMAGES)
+fluorescence_choice = partial(SPHERES.series.fluorescence_choice, images=IMAGES)
 
 # Scenes, scans and the study (amontons.workflow.scenes, amontons.workflow.study).
 SCENES = RUN.scenes.scenes

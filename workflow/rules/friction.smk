@@ -19,12 +19,12 @@ rule measure_friction:
     params:
         loads_mn=lambda wc: loads_mn(wc.sphere),
         friction=config_slice("friction"),
-        export=lambda wc: SPHERES.rheometer_export(
+        export=lambda wc: SPHERES.files.rheometer_export(
             wc.sphere, config.get("rheometer_export")
         ),
         virtual_format=lambda wc: (
             config["virtual_experiment"]["formats"]["rheometer"]
-            if SPHERES.is_synthetic(wc.sphere)
+            if SPHERES.rows.is_synthetic(wc.sphere)
             else None
         ),
     script:

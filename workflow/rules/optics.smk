@@ -36,7 +36,7 @@ rule measure_contact_area:
 
 rule measure_psf:
     input:
-        bead=lambda wc: SPHERES.bead_image(wc.sphere),
+        bead=lambda wc: SPHERES.files.bead_image(wc.sphere),
     output:
         psf=f"{MEASURED}/{PSF}",
         png=report(
@@ -51,7 +51,7 @@ rule measure_psf:
     benchmark:
         f"{SPHERE_LOGS}/measure_psf.benchmark.tsv"
     wildcard_constraints:
-        sphere=SPHERES.psf_pattern("bead"),
+        sphere=SPHERES.inputs.psf_pattern("bead"),
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -82,7 +82,7 @@ rule stand_in_psf:
     benchmark:
         f"{SPHERE_LOGS}/stand_in_psf.benchmark.tsv"
     wildcard_constraints:
-        sphere=SPHERES.psf_pattern("stand_in"),
+        sphere=SPHERES.inputs.psf_pattern("stand_in"),
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -91,14 +91,14 @@ rule stand_in_psf:
         runtime=measured_runtime("stand_in_psf"),
     params:
         stand_in=config["optics"]["psf"].get("stand_in"),
-        looked_for=lambda wc: SPHERES.missing(wc.sphere)["bead"],
+        looked_for=lambda wc: SPHERES.inputs.missing(wc.sphere)["bead"],
     script:
         "../../scripts/stand_in_psf.py"
 
 
 rule measure_grafting_density:
     input:
-        absorbance=lambda wc: SPHERES.absorbance_spectrum(wc.sphere),
+        absorbance=lambda wc: SPHERES.files.absorbance_spectrum(wc.sphere),
     output:
         density=f"{MEASURED}/grafting_density.json",
         png=report(
@@ -199,7 +199,7 @@ rule measure_intensity_pressure:
 
 rule measure_lifetime:
     input:
-        flim=lambda wc: SPHERES.flim_path(wc.sphere),
+        flim=lambda wc: SPHERES.files.flim_path(wc.sphere),
     output:
         lifetime=f"{MEASURED}/{LIFETIME}",
     log:

@@ -112,7 +112,7 @@ rule render_scene:
     input:
         fields=rules.simulate_scene.output.fields,
         psf=rules.measure_psf.output.psf,
-        pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
+        pixel_table=lambda wc: SPHERES.pixels.image_pixel_inputs(wc.sphere),
     output:
         rendered=f"{SCENE}/{RENDERED}",
         table=f"{SCENE}/{RENDER_TABLE}",

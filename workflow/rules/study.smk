@@ -13,7 +13,7 @@ rule scan_scene:
         # the sphere's elastic solve: the chain's first value starts from its pressures
         seed=RUN.scenes.scan_seed_fields,
         fluorescence=lambda wc: per_load_inputs(wc.sphere, "fluorescence"),
-        pixel_table=lambda wc: SPHERES.image_pixel_inputs(wc.sphere),
+        pixel_table=lambda wc: SPHERES.pixels.image_pixel_inputs(wc.sphere),
     output:
         # every value's result and rendered fields, a folder per value (the grid's and the
         # refinement's)

@@ -18,7 +18,7 @@ rule generate_virtual_experiment:
     benchmark:
         f"{LOGS}/virtual_experiment/{{sphere}}.benchmark.tsv"
     wildcard_constraints:
-        sphere=SPHERES.synthetic_pattern(with_flim=False),
+        sphere=SPHERES.files.synthetic_pattern(with_flim=False),
     conda:
         "../envs/amontons.yaml"
     threads: 1
@@ -55,7 +55,7 @@ use rule generate_virtual_experiment as generate_virtual_experiment_with_flim wi
         flim=f"{SYNTHETIC_SPHERE}/flim.{config['virtual_experiment']['formats']['flim']}",
         truth=f"{SYNTHETIC_SPHERE}/{TRUTH}",
     wildcard_constraints:
-        sphere=SPHERES.synthetic_pattern(with_flim=True),
+        sphere=SPHERES.files.synthetic_pattern(with_flim=True),
 
 
 rule virtual_experiment:

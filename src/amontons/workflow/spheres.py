@@ -9,8 +9,8 @@
   (:mod:`~amontons.workflow.optional_inputs`),
 - those an earlier run's failure holds out (:mod:`~amontons.workflow.hold_outs`).
 
-The library asks the parts; the rule files (workflow/rules/*.smk) call the names below on
-``SPHERES``, each handed to the part that answers it.
+The library and the rule files (workflow/rules/*.smk) ask the parts (``SPHERES.files``,
+``SPHERES.rows``, ...); this class holds them and the selection the parts share.
 """
 
 from __future__ import annotations
@@ -83,72 +83,3 @@ class Spheres:
         """Those of ``materials`` with at least one sphere that has the optional input
         ``kind``."""
         return [m for m in materials if self.of(m, having=kind)]
-
-    # The rules' names (workflow/rules/*.smk), each answered by its part.
-
-    def row(self, sphere: str) -> dict:
-        return self.rows.row(sphere)
-
-    def is_synthetic(self, sphere: str) -> bool:
-        return self.rows.is_synthetic(sphere)
-
-    def loads_mn(self, sphere: str) -> list[float]:
-        return self.rows.loads_mn(sphere)
-
-    def value(self, sphere: str, column: str) -> float | None:
-        return self.rows.value(sphere, column)
-
-    def pixel_nm(self, sphere: str) -> float | None:
-        return self.rows.pixel_nm(sphere)
-
-    def scene_record(self, sphere: str) -> dict:
-        return self.rows.scene_record(sphere)
-
-    def data_label(self, spheres) -> str:
-        return self.rows.data_label(spheres)
-
-    def raw_file(self, sphere: str, name: str) -> str:
-        return self.rows.raw_file(sphere, name)
-
-    @property
-    def synthetic_images(self) -> str:
-        return self.files.synthetic_images
-
-    def per_load_inputs(self, sphere: str, kind: str) -> str | list[str]:
-        return self.files.per_load_inputs(sphere, kind)
-
-    def reflection_fluorescence(self, sphere: str) -> str:
-        return self.files.reflection_fluorescence(sphere)
-
-    def reflection_image(self, sphere: str) -> str:
-        return self.files.reflection_image(sphere)
-
-    def afm_path(self, sphere: str, stem: str) -> str:
-        return self.files.afm_path(sphere, stem)
-
-    def bead_image(self, sphere: str) -> str:
-        return self.files.bead_image(sphere)
-
-    def absorbance_spectrum(self, sphere: str) -> str:
-        return self.files.absorbance_spectrum(sphere)
-
-    def flim_path(self, sphere: str) -> str | None:
-        return self.files.flim_path(sphere)
-
-    def synthetic_pattern(self, with_flim: bool) -> str:
-        return self.files.synthetic_pattern(with_flim)
-
-    def rheometer_export(self, sphere: str, maps):
-        return self.files.rheometer_export(sphere, maps)
-
-    def fluorescence_choice(self, sphere: str, images: Mapping) -> dict:
-        return self.series.fluorescence_choice(sphere, images)
-
-    def image_pixel_inputs(self, sphere: str) -> list[str]:
-        return self.pixels.image_pixel_inputs(sphere)
-
-    def missing(self, sphere: str) -> dict[str, str]:
-        return self.inputs.missing(sphere)
-
-    def psf_pattern(self, source: str) -> str:
-        return self.inputs.psf_pattern(source)
