@@ -34,6 +34,8 @@ BIN = Path(sys.executable).parent
 FULL, SMALL = "full", "small"
 # The small run's overlay as the rerun test edits it (a copy of config/test.yaml).
 RERUN = "rerun.yaml"
+# How the AFM scans are read and levelled (config/config.yaml's surface section).
+SURFACE = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["surface"]
 
 
 def measured(project, material, sphere, name, run=SMALL):
@@ -529,14 +531,13 @@ def check_measurements_against_truth(project, material, sphere):
 def _topography_record(folder: Path) -> dict:
     """The topography record of ``folder``'s AFM scans, found as the rules' inputs find them
     (amontons.io.layout.afm_file) and measured with config/config.yaml's surface settings."""
-    surface = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["surface"]
     return measure_topography(
         afm_file(folder, "afm_before"),
         afm_file(folder, "afm_after"),
         None,
-        nan_policy=surface["afm_nan_policy"],
-        channel=surface["afm_channel"],
-        line_levelling=line_levelling_mode(surface["line_levelling"]),
+        nan_policy=SURFACE["afm_nan_policy"],
+        channel=SURFACE["afm_channel"],
+        line_levelling=line_levelling_mode(SURFACE["line_levelling"]),
     ).to_record()
 
 
