@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import time
 
+from amontons import models
 from amontons.measure.area import OtsuSettings
 from amontons.simulate.scan_criterion import TooFewLoads
-from amontons.validation.cases import ELASTIC, Case, Truth
+from amontons.validation.cases import Case, Truth
 from amontons.validation.study import CaseStudy, ScanAnswer, StudySettings, judge_case
 from amontons.validation.truth import Sphere, case_rng, grids_of, measure_truth
 
@@ -25,7 +26,7 @@ def holds_truth(answer: ScanAnswer, truth: Truth) -> bool | None:
     """Whether the scan's interval holds the truth (module docstring); None where the scan
     is of another plastic model than the truth's."""
     low, high = answer.best.scatter_low, answer.best.scatter_high
-    if truth.model == ELASTIC:
+    if truth.model == models.ELASTIC.name:
         return high is None
     if truth.model != answer.model:
         return None

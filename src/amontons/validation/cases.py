@@ -13,9 +13,6 @@ from dataclasses import dataclass
 
 from amontons import models
 
-ELASTIC = models.ELASTIC.name
-PENETRATION_HARDNESS = models.PENETRATION_HARDNESS.name
-HARDENING = models.CONTACT_HARDENING.name
 # each plastic model's scanned parameter (config ``scans``)
 PARAMETER_OF = {m.name: m.parameter.key for m in models.with_parameter()}
 # the models a truth can be: those solved on a grid (amontons.models.FIELD)
@@ -51,10 +48,10 @@ class Truth:
                 f"validation truth {self.name!r}: signal = {self.signal!r}; expected one of "
                 f"{SIGNALS}"
             )
-        if (self.value is None) != (self.model == ELASTIC):
+        if (self.value is None) != (self.model == models.ELASTIC.name):
             raise ValueError(
                 f"validation truth {self.name!r}: a {self.model} truth needs "
-                f"{'no value' if self.model == ELASTIC else PARAMETER_OF[self.model]}"
+                f"{'no value' if self.model == models.ELASTIC.name else PARAMETER_OF[self.model]}"
             )
 
     @property

@@ -20,6 +20,7 @@ import numpy as np
 
 from amontons.contact import FreeBoundaryError, solve_load_series
 from amontons.measure.area import OtsuSettings
+from amontons.models import with_parameter
 from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.model_error import model_error_of, psf_log_change, richardson_log_bias
 from amontons.simulate.render import render_load_series
@@ -30,11 +31,7 @@ from amontons.simulate.scan_grid import scan_values
 from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.surface import area_average
 from amontons.study.decision import Decision, decide
-from amontons.validation.cases import (
-    HARDENING,
-    PARAMETER_OF,
-    PENETRATION_HARDNESS,
-)
+from amontons.validation.cases import PARAMETER_OF
 from amontons.validation.truth import Measured, Sphere, law_of
 
 
@@ -249,5 +246,5 @@ def judge_case(study: CaseStudy) -> tuple[list[ScanAnswer], Decision]:
     show a contact at fewer loads than the criterion needs)."""
     if len(study.used) < 3:
         raise TooFewLoads(study.loads_mn)
-    answers = [run_scan(study, model) for model in (PENETRATION_HARDNESS, HARDENING)]
+    answers = [run_scan(study, model.name) for model in with_parameter()]
     return answers, decision_of(answers)

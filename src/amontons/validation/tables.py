@@ -18,13 +18,11 @@ from amontons.validation.case import NOT_DECIDED
 from amontons.validation.cases import (
     BELOW_MODEL_ERROR,
     CLEAR,
-    ELASTIC,
-    HARDENING,
     PARAMETER_OF,
-    PENETRATION_HARDNESS,
+    TRUTH_MODELS,
 )
 
-VERDICTS = (ELASTIC, PENETRATION_HARDNESS, HARDENING, NOT_DECIDED)
+VERDICTS = (*TRUTH_MODELS, NOT_DECIDED)
 # the study's targets (docs/study.md §7)
 MIN_COVERAGE = 0.90
 MIN_NAMED_TRUE = 0.90
