@@ -207,7 +207,6 @@ PLANTED = models.ContactModel(
         symbol="p_c",
         unit="MPa",
         to_si=1e6,
-        scene_field="p_y_pa",  # a new law's own Scene field is the trace's fourth file
         law_field="p_y",
         sheet_column="cap_mpa_prior",
         stem="cap",
@@ -240,7 +239,7 @@ PROBE = {
 
 def test_a_planted_record_is_all_the_pipeline_needs_of_a_new_model(monkeypatch):
     """docs/contributing.md's trace, its pipeline part checked in-process: with one record
-    more in MODELS (its law one the solver has, its Scene field one a Scene has), the config
+    more in MODELS (its law one the solver has), the config
     schema allows the model and its scan parameter, a scene takes the parameter from the
     sheet's column where its own is null and solves with the record's law, a scan sets it,
     and the timing model gives it the elastic count."""
@@ -262,4 +261,4 @@ def test_a_planted_record_is_all_the_pipeline_needs_of_a_new_model(monkeypatch):
     assert scene.plasticity.p_y == pytest.approx(80e6, rel=1e-12)
     assert scene.to_record()["cap_mpa"] == pytest.approx(80.0, rel=1e-12)
     assert scene_config_at({**PROBE, "cap_mpa": None}, "cap_mpa", 120.0)["cap_mpa"] == 120.0
-    assert plastic_ratio(PLANTED.name, pixel_m=1e-7, e_star_pa=3.5e9, p_y_pa=8e7) is None
+    assert plastic_ratio(PLANTED.name, pixel_m=1e-7, e_star_pa=3.5e9, parameter_si=8e7) is None

@@ -28,8 +28,8 @@ class Parameter:
 
     ``key``: its name in the config (scene and scan keys), in best.json and in the tables,
     unit in the name; ``symbol`` and ``unit``: how figures and tables write it; ``to_si``:
-    the factor from the config unit to SI; ``scene_field``: the SI field of
-    :class:`amontons.simulate.scene.Scene` that holds it; ``law_field``: the solver law's
+    the factor from the config unit to SI (a :class:`amontons.simulate.scene.Scene` holds
+    it in SI, as ``parameter_si``); ``law_field``: the solver law's
     attribute that holds it (SI, the law's first argument); ``sheet_column``: the sample
     sheet's column of its prior (config/materials.tsv); ``stem``: verdict.csv's column stem;
     ``prior_free_scale``: the dimensionless group a scan without a prior runs over
@@ -42,7 +42,6 @@ class Parameter:
     symbol: str
     unit: str
     to_si: float
-    scene_field: str
     law_field: str
     sheet_column: str
     stem: str
@@ -117,7 +116,6 @@ PENETRATION_HARDNESS = ContactModel(
         symbol="p_Y",
         unit="MPa",
         to_si=1e6,
-        scene_field="p_y_pa",
         law_field="p_y",
         sheet_column="hardness_mpa",
         stem="p_y",
@@ -140,7 +138,6 @@ CONTACT_HARDENING = ContactModel(
         symbol="k",
         unit="MPa/nm",
         to_si=1e15,
-        scene_field="k_pa_per_m",
         law_field="k",
         sheet_column="hardening_k_mpa_per_nm",
         stem="k",

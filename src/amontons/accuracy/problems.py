@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from amontons.accuracy.settings import Setting, problem_kind
-from amontons.accuracy.timing import law_at_ratio, plastic_ratio
+from amontons.accuracy.timing import parameter_at_ratio, plastic_ratio
 from amontons.contact import ContactResult, solve_load_series
 from amontons.contact.surfaces import self_affine
 from amontons.measured_resources import fft_points
@@ -92,14 +92,15 @@ def timing_problem(
     grid."""
     scene = _sphere_scene(f"timing:{model}", model, setting, levelled.pixel_m, record)
     indenter = afm_indenter(levelled, scene, source)
-    law = law_at_ratio(
+    parameter_si = parameter_at_ratio(
         model,
         ratio,
         pixel_m=scene.pixel_m,
         e_star_pa=scene.e_star_pa,
         slope_rms=indenter.solver_statistics["slope_rms"],
     )
-    return _sphere_problem(dataclasses.replace(scene, **law), indenter, levelled)
+    scene = dataclasses.replace(scene, parameter_si=parameter_si)
+    return _sphere_problem(scene, indenter, levelled)
 
 
 def _sphere_problem(scene: Scene, indenter, levelled: LevelledMap) -> Problem:
@@ -119,8 +120,7 @@ def _sphere_problem(scene: Scene, indenter, levelled: LevelledMap) -> Problem:
             scene.model,
             pixel_m=scene.pixel_m,
             e_star_pa=scene.e_star_pa,
-            k_pa_per_m=scene.k_pa_per_m,
-            p_y_pa=scene.p_y_pa,
+            parameter_si=scene.parameter_si,
             slope_rms=indenter.solver_statistics["slope_rms"],
         ),
     )

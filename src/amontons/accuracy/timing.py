@@ -73,34 +73,31 @@ def plastic_ratio(
     pixel_m: float,
     e_star_pa: float,
     slope_rms: float | None = None,
-    **law_si: float | None,
+    parameter_si: float | None = None,
 ) -> float | None:
     """The dimensionless ratio z of a solve under ``model`` (its record's timing ratio,
-    amontons.models), its parameter given as the Scene field of its SI value (``k_pa_per_m``,
-    ``p_y_pa``; others are ignored); None for a model without one, or where the parameter
-    or the slope is not known (the elastic limit)."""
+    amontons.models), its parameter in SI (hardening k Pa/m, penetration hardness p_Y Pa);
+    None for a model without one, or where the parameter or the slope is not known (the
+    elastic limit)."""
     record = model_named(model)
-    if record.timing_ratio is None:
-        return None
-    value = law_si.get(record.parameter.scene_field)
-    if not value:
+    if record.timing_ratio is None or not parameter_si:
         return None
     at = RATIOS[record.timing_ratio]
-    return at(value, pixel_m=pixel_m, e_star_pa=e_star_pa, slope_rms=slope_rms)
+    return at(parameter_si, pixel_m=pixel_m, e_star_pa=e_star_pa, slope_rms=slope_rms)
 
 
-def law_at_ratio(
+def parameter_at_ratio(
     model: str, ratio: float, *, pixel_m: float, e_star_pa: float, slope_rms: float
-) -> dict:
-    """The plastic law whose ratio is ``ratio``, as its Scene field: hardening
-    ``k_pa_per_m`` = s·πE*/(2Δx) (Pa/m), penetration hardness ``p_y_pa`` = y·E*·h'_rms/2 (Pa)."""
+) -> float:
+    """The parameter (SI) of the plastic law whose ratio is ``ratio``: hardening k =
+    s·πE*/(2Δx) (Pa/m), penetration hardness p_Y = y·E*·h'_rms/2 (Pa)."""
     record = model_named(model)
     if record.timing_ratio is None:
         raise ValueError(f"no plastic ratio for model {model!r}")
     unit = RATIOS[record.timing_ratio](
         1.0, pixel_m=pixel_m, e_star_pa=e_star_pa, slope_rms=slope_rms
     )
-    return {record.parameter.scene_field: ratio / unit}
+    return ratio / unit
 
 
 def convolutions_per_load(

@@ -59,8 +59,8 @@ class Scene:
     tol: float
     optics: str  # 'none' or 'microscope'
     rendering: str  # 'emission' or 'binary'
-    p_y_pa: float | None = None
-    k_pa_per_m: float | None = None
+    # the model's parameter (its record's Parameter) in SI; None for a model without one
+    parameter_si: float | None = None
     increment: str = "local"
     alpha: float = 1.0
     synthetic: SyntheticSurface | None = None
@@ -81,15 +81,15 @@ class Scene:
         if model.law is None:
             return None
         law = getattr(laws, model.law)
-        value = getattr(self, model.parameter.scene_field)
-        return law(value, increment=INCREMENTS[self.increment], alpha=self.alpha)
+        return law(self.parameter_si, increment=INCREMENTS[self.increment], alpha=self.alpha)
 
     def _parameters_record(self) -> dict:
-        """Every model parameter in config units (None where the scene has none)."""
+        """Every model's parameter in config units: the scene's own model's value, None for
+        the others' (and for a scene without one)."""
         out = {}
         for model in with_parameter():
-            value = getattr(self, model.parameter.scene_field)
-            out[model.parameter.key] = None if value is None else value * model.parameter.from_si
+            own = model.name == self.model and self.parameter_si is not None
+            out[model.parameter.key] = self.parameter_si * model.parameter.from_si if own else None
         return out
 
     def to_record(self) -> dict:
@@ -163,7 +163,7 @@ def _model_parameters(name: str, config: Mapping, record: Mapping) -> dict:
             raise SceneError(
                 f"scene {name}: {parameter.key} = {value * parameter.from_si:g}; expected > 0"
             )
-        out[parameter.scene_field] = value
+        out["parameter_si"] = value
     return out
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 from amontons.accuracy.timing import plastic_ratio, predict
 from amontons.config import geometry
 from amontons.measured_resources import JobResources, mem_mb_of, runtime_min
-from amontons.models import with_parameter
+from amontons.models import model_named, with_parameter
 from amontons.workflow.spheres import Spheres
 
 # A job's solves, one after the other, from its wildcards: each (scene, sphere or None for a
@@ -21,6 +21,13 @@ from amontons.workflow.spheres import Spheres
 SolvesOf = Callable[[object], list[tuple]]
 # config solver_backend -> what the solve rules add: their resources and their params
 GPU_BACKENDS = {"cupy": {"gpu": 1}}
+
+
+def _parameter_si(model: str, law: Mapping) -> float | None:
+    """The SI value of ``model``'s parameter among ``law``'s config values (parameter key ->
+    value in the config unit; 0 where it is missing); None for a model without one."""
+    parameter = model_named(model).parameter
+    return None if parameter is None else (law.get(parameter.key) or 0.0) * parameter.to_si
 
 
 class SolverBackend:
@@ -101,10 +108,7 @@ class SolveResources:
             spec["model"],
             pixel_m=pixel,
             e_star_pa=frame.e_star_pa,
-            **{
-                p.scene_field: (law.get(p.key) or 0.0) * p.to_si
-                for p in (m.parameter for m in with_parameter())
-            },
+            parameter_si=_parameter_si(spec["model"], law),
             slope_rms=slope,
         )
         return spec["model"], {
