@@ -1,11 +1,12 @@
 """The instrument-format route gives the same measurements as the TIFF/CSV route (issue 37).
 
-Two projects make the same virtual PS sphere (config/test.yaml, same seed): one writes it as
-plain TIFF and our CSV (the small run's formats), the other in the instruments' own formats of
-the full run (config/config.yaml: OME-TIFF images, PicoQuant PTU FLIM, a RheoCompass-style
-semicolon export read through the full run's column map). Each measures only what the formats
-reach: the contact areas per load, the PSF, the FLIM lifetimes and the friction. Each quantity
-is then held to the TIFF/CSV route with the tolerance its data allow (comments at each test).
+The small run (tests/workflow/conftest.py) makes the virtual PS sphere as plain TIFF and our
+CSV and measures it. A project of this module makes the same sphere (config/test.yaml, same
+seed) in the instruments' own formats of the full run (config/config.yaml: OME-TIFF images,
+PicoQuant PTU FLIM, a RheoCompass-style semicolon export read through the full run's column
+map) and measures only what the formats reach: the contact areas per load, the PSF, the FLIM
+lifetimes and the friction. Each quantity is then held to the small run's with the tolerance
+its data allow (comments at each test).
 """
 
 import json
@@ -51,53 +52,51 @@ LIFETIME_SE = 3.0
 FRICTION_RTOL = 1e-12
 
 
-def _project(root: Path, name: str, formats: dict | None) -> Path:
-    """A project folder from config/ whose test.yaml measures PS only, in ``formats`` (None:
-    test.yaml's own, TIFF and CSV) with the full run's export column map."""
-    project = root / name
+def _project(root: Path) -> Path:
+    """A project folder from config/ whose test.yaml measures PS only, in the full run's
+    formats, with its export column map."""
+    project = root / INSTRUMENT
     shutil.copytree(REPO / "config", project / "config")
     path = project / "config" / "test.yaml"
     config = yaml.safe_load(path.read_text())
     config["materials"] = [SPHERE]
-    if formats is not None:
-        config["virtual_experiment"]["formats"] = formats
-        config["rheometer_export"] = EXPORT
+    config["virtual_experiment"]["formats"] = FORMATS
+    config["rheometer_export"] = EXPORT
     path.write_text(yaml.safe_dump(config))
     return project
 
 
+def _route(project: Path, paths: RunPaths) -> dict[str, Path]:
+    """The folders of a project's measurements and of its virtual sphere's files."""
+    return {
+        "measured": project / paths.measured("", SPHERE, SPHERE),
+        "sphere": project / paths.synthetic_sphere(SPHERE),
+    }
+
+
 @pytest.fixture(scope="module")
-def routes(tmp_path_factory):
-    """Both projects after their measurement jobs (the virtual sphere and the four
-    measurements, no scenes or scans), run side by side on one core each."""
+def routes(request, tmp_path_factory):
+    """The instrument project after its measurement jobs (the virtual sphere and the four
+    measurements, no scenes or scans), beside the small run's PS sphere, which measures the
+    same sphere in TIFF and our CSV. The small run is asked for once this project's run is
+    done, so that the two run side by side."""
     assert FORMATS != {"images": "tif", "flim": "tif", "rheometer": "csv"}, FORMATS
-    root = tmp_path_factory.mktemp("routes")
-    projects = {PLAIN: _project(root, PLAIN, None), INSTRUMENT: _project(root, INSTRUMENT, FORMATS)}
-    run = yaml.safe_load((REPO / "config" / "test.yaml").read_text())["run"]
-    paths = RunPaths(run)
+    project = _project(tmp_path_factory.mktemp("routes"))
+    paths = RunPaths(yaml.safe_load((REPO / "config" / "test.yaml").read_text())["run"])
     targets = [paths.measured(name, SPHERE, SPHERE) for name in MEASURED]
     command = [sys.executable, "-m", "snakemake", "-s", str(REPO / "Snakefile")]
-    running = {
-        name: subprocess.Popen(
-            [*command, "-d", str(project), "--configfile", "config/test.yaml", "--cores", "1"]
-            + targets,
-            cwd=project,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        for name, project in projects.items()
-    }
-    for name, process in running.items():
-        _, stderr = process.communicate(timeout=1200)
-        assert process.returncode == 0, f"{name}: {stderr[-3000:]}"
-    return {
-        name: {
-            "measured": project / paths.measured("", SPHERE, SPHERE),
-            "sphere": project / paths.synthetic_sphere(SPHERE),
-        }
-        for name, project in projects.items()
-    }
+    run = subprocess.run(
+        [*command, "-d", str(project), "--configfile", "config/test.yaml", "--cores", "2"]
+        + targets,
+        cwd=project,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        timeout=1200,
+    )
+    assert run.returncode == 0, run.stderr[-3000:]
+    small_run = request.getfixturevalue("small_run")
+    return {PLAIN: _route(small_run, paths), INSTRUMENT: _route(project, paths)}
 
 
 def _text(routes, route: str, name: str) -> str:
