@@ -32,7 +32,6 @@ def sheet_schema() -> dict:
 LONG_RUNS_FIRST = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
-    "tests/workflow/test_no_prior.py",
     "tests/workflow/test_executor.py",
     "tests/workflow/test_instrument_route.py",
     "tests/workflow/test_workflow.py",

@@ -1,11 +1,13 @@
 """Own data as a lab has it (issues 36 and 52): spheres with a file missing, one bad sphere
 among good ones, rheometer files of two programs beside our own CSVs under one config, a
-FLIM PTU with the sheet's pixel left blank, scans smaller than the windows, and a scan with
-nothing to judge. Each sphere is a copy of the small run's virtual PS sphere in a measured
-folder, less or other than the file the case is about, so that every output it still makes
-can be compared with the complete copy's, made in the same run."""
+FLIM PTU with the sheet's pixel left blank, scans smaller than the windows, a scan with
+nothing to judge, and a sphere scanned without the sheet's priors. Each sphere is a copy of
+the small run's virtual PS sphere in a measured folder, less or other than the file the case
+is about, so that every output it still makes can be compared with the complete copy's, made
+in the same run."""
 
 import json
+import math
 import re
 import shutil
 import subprocess
@@ -218,8 +220,10 @@ def _jobs_of(run: subprocess.CompletedProcess, sphere: str) -> set[str]:
     }
 
 
-def _snakemake(project, *args):
-    command = [sys.executable, "-m", "snakemake", "-s", str(REPO / "Snakefile")]
+def _snakemake(project, *args, targets=()):
+    """Snakemake on ``project`` with the test config, ``targets`` (its default: all) and
+    ``args`` (the targets go before --configfile, which takes every word after it)."""
+    command = [sys.executable, "-m", "snakemake", "-s", str(REPO / "Snakefile"), *targets]
     return subprocess.run(
         [*command, "-d", str(project), "--configfile", "config/test.yaml", *args],
         cwd=project,
@@ -691,3 +695,69 @@ def _a_scan_with_nothing_to_judge_says_why(project, models):
     assert pd.notna(verdict.loc["PS-cutscan", "p_y_estimate"])
     summary = (project / "results" / SMALL / "summary.md").read_text()
     assert f"not decided: {best['not_decided']}" in summary
+
+
+# The sheet's priors of the plastic models (issue 36): the columns a lab leaves blank when it
+# does not know them.
+PRIORS = ("hardness_mpa", "hardening_k_mpa_per_nm")
+
+
+@pytest.fixture(scope="module")
+def no_prior_run(lab_run, small_data, tmp_path_factory):
+    """The lab's project gone on from (_continued) with the complete sphere's sheet row
+    without hardness_mpa and hardening_k_mpa_per_nm, and its scans run with the small
+    config's (target ``scans``: their best values, with the elastic scene the sphere
+    registers on, as the small run has it): a lab that measured a sphere, then scans it
+    without knowing its priors. Its measurements are the lab run's."""
+    tmp_path = tmp_path_factory.mktemp("no_prior")
+    project = _continued(lab_run[0], tmp_path, small_data, [COMPLETE], [])
+    sheet_path = project / "config" / "own.tsv"
+    sheet = pd.read_csv(sheet_path, sep="\t", dtype=str)
+    sheet.assign(**dict.fromkeys(PRIORS, "")).to_csv(sheet_path, sep="\t", index=False)
+    path = project / "config" / "test.yaml"
+    config = yaml.safe_load(path.read_text())
+    # Only what the tests read: the scans and the scenes whose prior is missing, with the
+    # small config's scenes and scans (the lab's widens the elastic window and runs none).
+    del config["scenes"]["elastic"], config["run_scans"]
+    config.update(run_scenes=["elastic", "penetration_hardness", "hardening"])
+    path.write_text(yaml.safe_dump(config))
+    run = _snakemake(project, "--cores", "2", targets=["scans"])
+    assert run.returncode == 0, run.stderr[-3000:]
+    return project, run
+
+
+def _best(project, sphere, scan) -> dict:
+    path = project / "results" / SMALL / "PS" / sphere / "scans" / scan / "best.json"
+    return json.loads(path.read_text())
+
+
+@pytest.mark.parametrize("scan", ["p_y", "k"])
+def test_a_scan_without_prior_finds_what_the_scan_about_the_prior_finds(
+    small_run, no_prior_run, scan
+):
+    """Its scans run over the prior-free ranges (docs/study.md, "Scans without a prior") and
+    find what the small run's PS scans about the sheet's values find, within one step of the
+    prior-free scan (a factor of its grid's ratio, 1.47 for p_Y and 1.78 for k by default):
+    the two scans judge the same images on different grids."""
+    project, _ = no_prior_run
+    free = pd.read_csv(project / "results" / SMALL / "PS" / COMPLETE / "scans" / scan / "scan.csv")
+    values = free[~free["refined"]]["value"].to_numpy()  # the grid's, not refinement's
+    step = math.log(values[1] / values[0])
+    config = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["scans"][scan]
+    assert len(values) == config["prior_free_steps"]
+    with_prior = _best(small_run, "PS", scan)["best"]
+    without = _best(project, COMPLETE, scan)["best"]
+    assert abs(math.log(without / with_prior)) <= step * (1 + 1e-9)
+
+
+def test_the_scenes_at_the_missing_prior_are_left_out_and_said(no_prior_run):
+    """The plastic scenes need the prior the sheet lacks: they are left out, and the run says
+    so; the scans run prior-free, on the lab run's measurements."""
+    project, run = no_prior_run
+    scenes = project / "results" / SMALL / "PS" / COMPLETE / "scenes"
+    assert (scenes / "elastic" / "comparison.csv").is_file()
+    assert not (scenes / "hardening").exists() and not (scenes / "penetration_hardness").exists()
+    assert "no hardening_k_mpa_per_nm in the sheet: scene hardening" in run.stderr
+    assert "scan k runs over its prior-free range" in run.stderr
+    again = _jobs_of(run, COMPLETE)
+    assert "scan_scene" in again and not {r for r in again if r.startswith(MEASURING)}, again
