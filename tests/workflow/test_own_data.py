@@ -23,6 +23,7 @@ from amontons.io.ptu import write_ptu_image
 from amontons.io.rheometer import read_rheometer_csv
 from amontons.io.rheometer_export_shapes import EXPORT_SHAPES, write_rheometer_export
 from amontons.io.tiff import read_image, write_image
+from amontons.models import with_parameter
 from amontons.virtual.flim import TcspcSettings, photon_histograms
 
 pytestmark = pytest.mark.workflow
@@ -697,9 +698,9 @@ def _a_scan_with_nothing_to_judge_says_why(project, models):
     assert f"not decided: {best['not_decided']}" in summary
 
 
-# The sheet's priors of the plastic models (issue 36): the columns a lab leaves blank when it
-# does not know them.
-PRIORS = ("hardness_mpa", "hardening_k_mpa_per_nm")
+# The sheet's priors of the plastic models (issue 36), as their records name them: the
+# columns a lab leaves blank when it does not know them.
+PRIORS = tuple(model.parameter.sheet_column for model in with_parameter())
 
 
 @pytest.fixture(scope="module")
