@@ -24,14 +24,29 @@ def sheet_schema() -> dict:
     return load_schema(REPO / "workflow" / "schemas" / "materials.schema.yaml")
 
 
-# Test modules that start Snakemake runs of minutes, first: under pytest-xdist (``make test``,
-# --dist loadscope, one module per worker at a time) the longest runs then start at once on
-# different workers, and the many short unit tests fill the gaps at the end. The first makes
-# the session's small-data run (tests/workflow/conftest.py), the second runs its own spheres
-# from the small data's virtual experiment meanwhile.
-LONG_RUNS_FIRST = (
+# The order in which `make test`'s processes (pytest-xdist, --dist loadscope: one module per
+# process at a time) take the modules; the rest follow as collected. make test compiles the
+# solver's kernels beside the tests, one core for about 75 s on a cold cache, and every solve
+# waits for it (amontons.contact.jit), the small data set's first.
+# - The two modules whose Snakemake runs take longest, first, on two processes: the first
+#   makes the session's small-data run (tests/workflow/conftest.py), the second runs its own
+#   spheres from the small data's virtual experiment meanwhile.
+# - Then modules that solve nothing, for the third process while the kernels compile (the
+#   other two wait for them): without them that core sat idle (issue 66).
+# - Then the shorter Snakemake runs, so that the many short unit tests fill the gaps at the
+#   end instead of a run of tens of seconds.
+MODULE_ORDER = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
+    "tests/simulate/test_register.py",
+    "tests/io/test_ptu.py",
+    "tests/measure/test_newton_rings.py",
+    "tests/study/test_plots.py",
+    "tests/virtual/test_instrument_formats.py",
+    "tests/test_map_resolution.py",
+    "tests/workflow/test_killed_run.py",
+    "tests/workflow/test_load_series_run.py",
+    "tests/workflow/test_dag_unchanged.py",
     "tests/workflow/test_executor.py",
     "tests/workflow/test_instrument_route.py",
     "tests/workflow/test_workflow.py",
@@ -39,6 +54,6 @@ LONG_RUNS_FIRST = (
 
 
 def pytest_collection_modifyitems(config, items):
-    """The modules of LONG_RUNS_FIRST first, in that order; the rest as collected."""
-    rank = {path: i for i, path in enumerate(LONG_RUNS_FIRST)}
+    """The modules of MODULE_ORDER first, in that order; the rest as collected."""
+    rank = {path: i for i, path in enumerate(MODULE_ORDER)}
     items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))
