@@ -23,7 +23,9 @@ $(BIN)/python:
 # the packages' modules, and every process of the tests would parse them anew: 10 s an import.
 # Letting Python write the bytecode of what is imported instead, with --no-compile, made the
 # install 33 s instead of some 65 and the suite slower by as much, its processes compiling
-# the same modules at once: make test 1244 s from a fresh clone, against 1213 to 1242 s.)
+# the same modules at once: make test 1244 s from a fresh clone, against 1213 to 1242 s.
+# Nor --no-compile then compileall on both cores: 33 + 24 s against 63 s, and compileall
+# fails on a Python 2 file that a dependency ships, which pip passes over.)
 $(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[test]"
 	touch $(STAMP)
