@@ -54,6 +54,11 @@ MODULE_ORDER = (
 
 
 def pytest_collection_modifyitems(config, items):
-    """The modules of MODULE_ORDER first, in that order; the rest as collected."""
+    """The modules of MODULE_ORDER first, in that order; the rest as collected. A module it
+    names that is not there stops the session: a renamed module would otherwise lose its
+    place in silence."""
+    gone = [path for path in MODULE_ORDER if not (REPO / path).is_file()]
+    if gone:
+        raise pytest.UsageError(f"tests/conftest.py: MODULE_ORDER names no such module: {gone}")
     rank = {path: i for i, path in enumerate(MODULE_ORDER)}
     items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))
