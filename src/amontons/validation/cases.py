@@ -48,10 +48,10 @@ class Truth:
                 f"validation truth {self.name!r}: signal = {self.signal!r}; expected one of "
                 f"{SIGNALS}"
             )
-        if (self.value is None) != (self.model == models.ELASTIC.name):
+        if (self.value is None) != (self.parameter is None):
             raise ValueError(
                 f"validation truth {self.name!r}: a {self.model} truth needs "
-                f"{'no value' if self.model == models.ELASTIC.name else PARAMETER_OF[self.model]}"
+                f"{self.parameter or 'no value'}"
             )
 
     @property

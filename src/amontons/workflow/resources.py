@@ -25,9 +25,10 @@ GPU_BACKENDS = {"cupy": {"gpu": 1}}
 
 def _parameter_si(model: str, law: Mapping) -> float | None:
     """The SI value of ``model``'s parameter among ``law``'s config values (parameter key ->
-    value in the config unit; 0 where it is missing); None for a model without one."""
+    value in the config unit); None for a model without one, or where it is missing or 0."""
     parameter = model_named(model).parameter
-    return None if parameter is None else (law.get(parameter.key) or 0.0) * parameter.to_si
+    value = None if parameter is None else law.get(parameter.key)
+    return value * parameter.to_si if value else None
 
 
 class SolverBackend:
