@@ -81,10 +81,12 @@ def _once(root: Path, name: str, make) -> None:
 
 
 def _snakemake(project: Path, *args: str, timeout: int) -> None:
-    """The deployed folder's Snakemake (its own Snakefile), as a user runs it there."""
+    """The deployed folder's Snakemake (its own Snakefile), as a user runs it there, with the
+    clone's profile named as docs/deploy.md says (Snakemake finds it only in the clone)."""
     start = time.perf_counter()
+    profile = ("--workflow-profile", str(REPO / "profiles" / "default"))
     result = subprocess.run(
-        [sys.executable, "-m", "snakemake", *args, "--configfile", CONFIG],
+        [sys.executable, "-m", "snakemake", *args, *profile, "--configfile", CONFIG],
         cwd=project,
         capture_output=True,
         text=True,
