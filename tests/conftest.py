@@ -35,6 +35,10 @@ def sheet_schema() -> dict:
 #   other two wait for them): without them that core sat idle (issue 66).
 # - Then the shorter Snakemake runs, so that the many short unit tests fill the gaps at the
 #   end instead of a run of tens of seconds.
+# - Then the three runs that go on from the lab's (the own-data module's), after the workflow
+#   tests: a process takes the next module once it has two tests or fewer left, so these wait
+#   in the queue for the processes that free when the two long runs end (not behind the
+#   executor test, which waits for the small run), and run side by side, the longest first.
 MODULE_ORDER = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
@@ -50,6 +54,9 @@ MODULE_ORDER = (
     "tests/workflow/test_executor.py",
     "tests/workflow/test_instrument_route.py",
     "tests/workflow/test_workflow.py",
+    "tests/workflow/test_scan_on_cut_scans.py",
+    "tests/workflow/test_corrupt_file.py",
+    "tests/workflow/test_no_prior.py",
 )
 
 

@@ -8,7 +8,9 @@ small data set (config/test.yaml: PS and glass) in two steps:
   load-series tests copy as "measured" spheres (about a minute);
 - ``small_run``: the whole run, the accuracy study and the reduced validation study in one
   Snakemake call, then its report; the workflow, deploy, report, accuracy, validation and
-  executor tests read what it made.
+  executor tests read what it made;
+- ``lab_run``: a lab's project made from the small data (lab.py), which the own-data tests
+  read and three other modules go on from.
 
 Under pytest-xdist (``make test`` runs the suite on every core) each worker process asks for
 these fixtures; the first to ask makes them under a file lock in the session's shared
@@ -28,6 +30,8 @@ import time
 from pathlib import Path
 
 import pytest
+
+from .lab import make_lab_run, read_lab_run
 
 REPO = Path(__file__).resolve().parents[2]
 RUN = "small"
@@ -132,3 +136,16 @@ def small_run(small_data, tmp_path_factory) -> Path:
 
     _once(root, "small_run", make)
     return small_data
+
+
+@pytest.fixture(scope="session")
+def lab_run(small_data, tmp_path_factory) -> tuple[Path, ...]:
+    """A lab's project (lab.py: copies of the small data's PS sphere, each lacking a file or
+    holding another format) after its dry run, the check and its run, once per session:
+    (project, dry run, check, run), the commands as subprocess.CompletedProcess. The own-data
+    module reads it; the corrupt-file, cut-scan and prior-free modules go on from it, each in
+    whichever test process is free once it is done, side by side."""
+    root = _shared_root(tmp_path_factory)
+    folder = root / "own_data"
+    _once(root, "lab_run", lambda: make_lab_run(small_data, folder))
+    return read_lab_run(folder)
