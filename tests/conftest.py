@@ -35,10 +35,12 @@ def sheet_schema() -> dict:
 #   other two wait for them): without them that core sat idle (issue 66).
 # - Then the shorter Snakemake runs, so that the many short unit tests fill the gaps at the
 #   end instead of a run of tens of seconds.
-# - Then the three runs that go on from the lab's (the own-data module's), after the workflow
-#   tests: a process takes the next module once it has two tests or fewer left, so these wait
-#   in the queue for the processes that free when the two long runs end (not behind the
-#   executor test, which waits for the small run), and run side by side, the longest first.
+# - The three runs that go on from the lab's (the own-data module's) in the queue when the two
+#   long runs end, for the processes those free, side by side. A process takes the next
+#   module as soon as it has two tests or fewer left: after the executor test (one test,
+#   which waits for the small run) comes a module of five, so that none of the three waits
+#   behind it, and each of the three (one test each but the last) is followed by a module of
+#   several tests that read the small run, so that no process takes two of them.
 MODULE_ORDER = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
@@ -53,10 +55,12 @@ MODULE_ORDER = (
     "tests/workflow/test_dag_unchanged.py",
     "tests/workflow/test_executor.py",
     "tests/workflow/test_instrument_route.py",
-    "tests/workflow/test_workflow.py",
     "tests/workflow/test_scan_on_cut_scans.py",
+    "tests/workflow/test_report.py",
     "tests/workflow/test_corrupt_file.py",
+    "tests/workflow/test_validation_run.py",
     "tests/workflow/test_no_prior.py",
+    "tests/workflow/test_workflow.py",
 )
 
 
