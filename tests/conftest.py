@@ -31,36 +31,61 @@ def sheet_schema() -> dict:
 # - The two modules whose Snakemake runs take longest, first, on two processes: the first
 #   makes the session's small-data run (tests/workflow/conftest.py), the second runs its own
 #   spheres from the small data's virtual experiment meanwhile.
-# - Then modules that solve nothing, for the third process while the kernels compile (the
-#   other two wait for them): without them that core sat idle (issue 66).
-# - Then the shorter Snakemake runs, so that the many short unit tests fill the gaps at the
-#   end instead of a run of tens of seconds.
-# - The three runs that go on from the lab's (the own-data module's) in the queue when the two
-#   long runs end, for the processes those free, side by side. A process takes the next
-#   module as soon as it has two tests or fewer left: after the executor test (one test,
-#   which waits for the small run) comes a module of five, so that none of the three waits
-#   behind it, and each of the three (one test each but the last) is followed by a module of
-#   several tests that read the small run, so that no process takes two of them.
+# - Then modules that solve nothing, for the third process while the kernels compile and the
+#   other two wait for them and for the small data set (without them that core sat idle).
+# - Then the short Snakemake runs and the workflow tests, whose first tests (dry runs) run
+#   beside the two long runs and whose others wait for the small run.
+# - Then the runs that go on from the lab's (the own-data module's), so that they are at the
+#   head of the queue when the two long runs end, for the processes those free, side by
+#   side; then the executor test and the instrument route, which read the small run; the
+#   unit tests last, to fill the gaps. A process takes the next module as soon as it has two
+#   tests or fewer left: each of the three (one test each but the last) is followed by a
+#   module of several tests that read the small run, so that no process takes two of them.
 MODULE_ORDER = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
+    # solve nothing: each was run on an empty numba cache and left it empty
     "tests/simulate/test_register.py",
     "tests/io/test_ptu.py",
     "tests/measure/test_newton_rings.py",
     "tests/study/test_plots.py",
     "tests/virtual/test_instrument_formats.py",
     "tests/test_map_resolution.py",
+    "tests/io/test_bad_files.py",
+    "tests/io/test_confocal.py",
+    "tests/io/test_rawdata.py",
+    "tests/io/test_rheometer_files.py",
+    "tests/io/test_rheometer_export.py",
+    "tests/io/test_heightmap.py",
+    "tests/io/test_pixel_probe.py",
+    "tests/io/test_tiff.py",
+    "tests/measure/test_area.py",
+    "tests/measure/test_grafting.py",
+    "tests/measure/test_psf.py",
+    "tests/measure/test_topography.py",
+    "tests/measure/test_hard_cases.py",
+    "tests/virtual/test_instrument_files.py",
+    "tests/workflow_dag/test_spheres.py",
+    "tests/workflow_dag/test_scenes.py",
+    "tests/study/test_summary.py",
+    "tests/test_docs.py",
+    "tests/test_architecture.py",
+    "tests/test_config.py",
+    "tests/test_config_reference.py",
+    "tests/test_model_names.py",
+    # short Snakemake runs
     "tests/workflow/test_killed_run.py",
     "tests/workflow/test_load_series_run.py",
     "tests/workflow/test_dag_unchanged.py",
-    "tests/workflow/test_executor.py",
-    "tests/workflow/test_instrument_route.py",
+    "tests/workflow/test_workflow.py",
+    # going on from the lab run, each followed by a module of several tests
     "tests/workflow/test_scan_on_cut_scans.py",
     "tests/workflow/test_report.py",
     "tests/workflow/test_corrupt_file.py",
     "tests/workflow/test_validation_run.py",
     "tests/workflow/test_no_prior.py",
-    "tests/workflow/test_workflow.py",
+    "tests/workflow/test_executor.py",
+    "tests/workflow/test_instrument_route.py",
 )
 
 
