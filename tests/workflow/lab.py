@@ -144,15 +144,15 @@ def sheet_row(ps: pd.DataFrame, name: str, folder: Path) -> pd.DataFrame:
     return row
 
 
-def lab_project(tmp_path, small_data, spheres: dict[str, list[str]]) -> Path:
-    """A project folder whose sheet lists ``spheres`` (name -> files removed), the PS row's
+def lab_project(folder: Path, small_data, spheres: dict[str, list[str]]) -> Path:
+    """``folder``/project, whose sheet lists ``spheres`` (name -> files removed), the PS row's
     values each, with two scenes (one rendered, one not) and no scans to keep the run short."""
-    project = tmp_path / "project"
+    project = folder / "project"
     shutil.copytree(REPO / "config", project / "config")
     sheet = pd.read_csv(project / "config" / "materials.tsv", sep="\t", dtype=str)
     ps = sheet[sheet["sphere"] == "PS"]
     rows = [
-        sheet_row(ps, name, lab_sphere(small_data, tmp_path / "lab", name, rm))
+        sheet_row(ps, name, lab_sphere(small_data, folder / "lab", name, rm))
         for name, rm in spheres.items()
     ]
     pd.concat(rows).to_csv(project / "config" / "own.tsv", sep="\t", index=False)
