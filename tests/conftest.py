@@ -35,12 +35,15 @@ def sheet_schema() -> dict:
 #   other two wait for them and for the small data set (without them that core sat idle).
 # - Then the short Snakemake runs and the workflow tests, whose first tests (dry runs) run
 #   beside the two long runs and whose others wait for the small run.
-# - Then the runs that go on from the lab's (the own-data module's), so that they are at the
-#   head of the queue when the two long runs end, for the processes those free, side by
-#   side; then the executor test and the instrument route, which read the small run; the
-#   unit tests last, to fill the gaps. A process takes the next module as soon as it has two
-#   tests or fewer left: each of the three (one test each but the last) is followed by a
-#   module of several tests that read the small run, so that no process takes two of them.
+# - Then the runs that wait for the two long ones, longest first (as their runs took under
+#   make test: the lab's continuations, the cluster executor, the prior-free scans; the
+#   instrument route's short one last), so that they are at the head of the queue when the
+#   two long runs end, for the processes those free, side by side; the unit tests last, to
+#   fill the gaps. A process takes the next module as soon as it has two tests or fewer
+#   left: each one-test module is followed by a module of several tests that read the small
+#   run, so that no process takes two long runs in a row. (With the executor test and the
+#   instrument route after the prior-free scans, one process ran the two one after the
+#   other, the suite's last 100 s.)
 MODULE_ORDER = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
@@ -78,13 +81,15 @@ MODULE_ORDER = (
     "tests/workflow/test_load_series_run.py",
     "tests/workflow/test_dag_unchanged.py",
     "tests/workflow/test_workflow.py",
-    # going on from the lab run, each followed by a module of several tests
+    # the four runs that wait for the two long ones, longest first, each of the one-test
+    # modules followed by a module of several tests that read the small run
     "tests/workflow/test_scan_on_cut_scans.py",
     "tests/workflow/test_report.py",
     "tests/workflow/test_corrupt_file.py",
     "tests/workflow/test_validation_run.py",
-    "tests/workflow/test_no_prior.py",
     "tests/workflow/test_executor.py",
+    "tests/workflow/test_accuracy_run.py",
+    "tests/workflow/test_no_prior.py",
     "tests/workflow/test_instrument_route.py",
 )
 
