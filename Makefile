@@ -17,21 +17,19 @@ TEST_WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 
-# The installer: uv, installed with the venv's own pip. It resolves to the same releases as
-# pip (the two venvs' package lists compared equal, 2026-11-30) in a third of the time, and
-# compiles the bytecode on every core: 24 s against pip's 72 s on 2 cores, the start of make
-# test, when nothing else can run yet. uv reads its own settings (UV_INDEX_URL, uv.toml),
-# not pip.conf: a lab behind a package mirror sets UV_INDEX_URL (docs/deploy.md).
-$(BIN)/uv: | $(BIN)/python
-	$(BIN)/python -m pip install --quiet "uv>=0.5"
-
-# Re-install whenever the declared dependencies change. (With the bytecode compiled: where
+# Re-install whenever the declared dependencies change, with uv, itself installed by the venv's
+# pip (which reads pip.conf) where the venv has none yet: uv resolves to the same releases as
+# pip (the two venvs' package lists compared equal, 2026-11-30) and installs them in some 40
+# s less on 2 cores, at the start of make test, when nothing else can run yet. uv reads its
+# own settings (UV_DEFAULT_INDEX, uv.toml), not pip.conf nor PIP_* (docs/deploy.md).
+# --compile-bytecode because uv, unlike pip, compiles none unless asked: where
 # PYTHONDONTWRITEBYTECODE is set, as on the developers' machines, nothing would ever compile
-# the packages' modules, and every process of the tests would parse them anew: 10 s an import.
-# Letting Python write the bytecode of what is imported instead made the suite slower by
-# more than the install saved, its processes compiling the same modules at once: make test
-# 1244 s from a fresh clone, against 1213 to 1242 s.)
-$(STAMP): pyproject.toml | $(BIN)/uv
+# the packages' modules, and every process of the tests would parse them anew. (Letting
+# Python write the bytecode of what is imported instead made the suite slower by more than
+# the install saved, its processes compiling the same modules at once: make test 1244 s from
+# a fresh clone with pip, against 1213 to 1242 s.)
+$(STAMP): pyproject.toml | $(BIN)/python
+	test -x $(BIN)/uv || $(BIN)/python -m pip install --quiet "uv>=0.5"
 	$(BIN)/uv pip install --quiet --python $(BIN)/python --compile-bytecode -e ".[test]"
 	touch $(STAMP)
 
