@@ -35,15 +35,17 @@ def sheet_schema() -> dict:
 #   other two wait for them and for the small data set (without them that core sat idle).
 # - Then the short Snakemake runs and the workflow tests, whose first tests (dry runs) run
 #   beside the two long runs and whose others wait for the small run.
-# - Then the runs that wait for the two long ones, longest first (as their runs took under
-#   make test: the lab's continuations, the cluster executor, the prior-free scans; the
-#   instrument route's short one last), so that they are at the head of the queue when the
-#   two long runs end, for the processes those free, side by side; the unit tests last, to
-#   fill the gaps. A process takes the next module as soon as it has two tests or fewer
-#   left: each one-test module is followed by a module of several tests that read the small
-#   run, so that no process takes two long runs in a row. (With the executor test and the
-#   instrument route after the prior-free scans, one process ran the two one after the
-#   other, the suite's last 100 s.)
+# - Then the runs that wait for the two long ones (the lab's three continuations and the
+#   cluster executor, each 100 to 170 s under make test, the cut-scan and corrupt-file runs,
+#   the longest, first; the instrument route's short run last), so that they are at the head
+#   of the queue when the two long runs end, for the processes those free, side by side; the
+#   unit tests last, to fill the gaps. A process takes the next module as soon as it has two
+#   tests or fewer left: each one-test module is followed by a module of several tests that
+#   read the small run, so that no process takes two of the long ones in a row. (The
+#   prior-free scans, three tests, may still take the instrument route after them when no
+#   other process asks first. With the executor test after the prior-free scans and the
+#   instrument route after it, one process ran those two one after the other, the suite's
+#   last 100 s.)
 MODULE_ORDER = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
@@ -81,8 +83,8 @@ MODULE_ORDER = (
     "tests/workflow/test_load_series_run.py",
     "tests/workflow/test_dag_unchanged.py",
     "tests/workflow/test_workflow.py",
-    # the four runs that wait for the two long ones, longest first, each of the one-test
-    # modules followed by a module of several tests that read the small run
+    # the runs that wait for the two long ones, each one-test module followed by a module
+    # of several tests that read the small run
     "tests/workflow/test_scan_on_cut_scans.py",
     "tests/workflow/test_report.py",
     "tests/workflow/test_corrupt_file.py",
