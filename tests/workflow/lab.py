@@ -52,6 +52,7 @@ CUT_SCANS = {"PS-cutscan": 50.0, "PS-noload": 24.0}
 # A scan that holds two loads' contacts with the solver's margin (25 and 50 mN: 1.25 × 23 and
 # 1.25 × 29 µm), not 100 mN's (1.25 × 36.6 µm): too few for the scans' criterion.
 TWO_LOAD_SCANS = {"PS-twoloads": 40.0}
+SCAN_SIDES_UM = CUT_SCANS | TWO_LOAD_SCANS
 # The lab's two rheometer programs: RheoCompass, whose exports config/config.yaml's single
 # map reads (named 'export'), and TRIOS, whose map the lab's config adds by a name (Snakemake
 # merges the two files key by key). PS-trios's row names its map; PS-ptu's RheoCompass files
@@ -116,16 +117,16 @@ def photons_for_map(folder: Path) -> None:
 
 def lab_sphere(small_data, lab: Path, name: str, remove: list[str]) -> Path:
     """A copy of the virtual PS sphere as measured data, less ``remove``, with its AFM scan
-    cut where CUT_SCANS names it, its rheometer files exported where EXPORTED names it, and
-    its FLIM as photons for PTU_SPHERE."""
+    cut where SCAN_SIDES_UM names it, its rheometer files exported where EXPORTED names it,
+    and its FLIM as photons for PTU_SPHERE."""
     folder = lab / name
     shutil.copytree(small_data / "resources" / "synthetic" / SMALL / "PS", folder)
     (folder / "truth.json").unlink()
     for entry in remove:
         path = folder / entry
         shutil.rmtree(path) if path.is_dir() else path.unlink()
-    if name in CUT_SCANS | TWO_LOAD_SCANS:
-        cut_scans(folder, (CUT_SCANS | TWO_LOAD_SCANS)[name])
+    if name in SCAN_SIDES_UM:
+        cut_scans(folder, SCAN_SIDES_UM[name])
     if name in EXPORTED:
         exported_rheometer(folder, EXPORTED[name][0])
     if name == PTU_SPHERE:
