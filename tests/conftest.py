@@ -43,9 +43,8 @@ def sheet_schema() -> dict:
 #   tests or fewer left: each one-test module is followed by a module of several tests that
 #   read the small run, so that no process takes two of the long ones in a row. (The
 #   prior-free scans, three tests, may still take the instrument route after them when no
-#   other process asks first. With the executor test after the prior-free scans and the
-#   instrument route after it, one process ran those two one after the other, the suite's
-#   last 100 s.)
+#   other process asks first.) docs/testing.md gives the measured timeline; earlier orders
+#   and what they cost are in benchmarks/HISTORY.md.
 MODULE_ORDER = (
     "tests/workflow/test_deploy.py",
     "tests/workflow/test_own_data.py",
