@@ -1,6 +1,9 @@
-"""The decision between the contact models (issue 65): a model is named only where every
-other model, the elastic limit among them, is excluded under the same errors; otherwise 'not
-decided', with the models the data cannot tell apart and why."""
+"""The decision between the contact models (issues 65 and 76): elastic is the limit of both
+plastic models, so it is named where no plastic model improves on it by more than the
+quantile (the likelihood ratio of nested models), with each plastic parameter's one-sided
+bound; where one does, elastic is excluded, and a plastic model is named only where every
+other is excluded; otherwise 'not decided', with the models the data cannot tell apart and
+why."""
 
 import pytest
 
@@ -16,32 +19,76 @@ def test_a_model_is_named_where_every_other_is_excluded():
         {"hardening": 50.0, "penetration_hardness": 60.0},
         RISE_5,
         5,
+        elastic_chi2=50.0,
     )
     assert decision.decided and decision.kept == ("hardening",)
     assert decision.delta_chi2 == {"hardening": 0.0, "penetration_hardness": 38.0, ELASTIC: 48.0}
-    assert "38 or more" in decision.why
+    assert decision.flow == {"hardening": 48.0, "penetration_hardness": 10.0}
+    assert "38 or more" in decision.why and "flow detected" in decision.why
 
 
-def test_an_elastic_end_within_the_quantile_keeps_the_elastic_model():
-    """The issue's 150 MPa truth: the p_Y scan's best lies near its elastic end (a plastic cap
-    of 1 % of the area against a model error of 2 %): penetration hardness and the elastic
-    limit cannot be told apart, and the verdict says so instead of naming either."""
+def test_a_plastic_best_near_its_elastic_limit_names_elastic():
+    """The issue's 150 MPa truth: the p_Y scan's best lies near its elastic limit (a plastic
+    cap of 1 % of the area against a model error of 2 %): no plastic model improves on the
+    elastic model by more than the quantile, so the simpler, nested model is the answer, with
+    the plastic parameters bounded on one side only (where a rule that names a model only
+    when it alone is kept could never name elastic: it at best ties)."""
     decision = decide(
         {"penetration_hardness": 3.0, "hardening": 30.0},
         {"penetration_hardness": 4.5, "hardening": 40.0},
         RISE_5,
         5,
+        elastic_chi2=4.5,
+    )
+    assert decision.decided and decision.elastic
+    assert decision.flow == {"penetration_hardness": 1.5, "hardening": -25.5}
+    assert "no flow detected" in decision.why and "one side only" in decision.why
+
+
+def test_elastic_is_excluded_by_its_own_chi2_not_by_a_plastic_models_error():
+    """The scans' elastic ends judged with a plastic model's smaller error lie far above the
+    best (60 and 50), but the elastic model judged with its own error lies within the quantile
+    of the best: elastic is named. The same scans judged by their elastic ends would name
+    hardening, the answer the issue found wrong (the elastic bias several times the
+    hardening one)."""
+    own = decide(
+        {"hardening": 2.0, "penetration_hardness": 9.0},
+        {"hardening": 50.0, "penetration_hardness": 60.0},
+        RISE_5,
+        5,
+        elastic_chi2=9.0,
+    )
+    assert own.elastic
+    by_ends = decide(
+        {"hardening": 2.0, "penetration_hardness": 9.0},
+        {"hardening": 50.0, "penetration_hardness": 60.0},
+        RISE_5,
+        5,
+    )
+    assert by_ends.kept == ("hardening", "penetration_hardness")
+    assert "no elastic solve judged" in by_ends.why
+
+
+def test_plastic_models_not_told_apart_once_flow_is_detected():
+    """Both plastic models improve on elastic by far more than the quantile, and lie within
+    it of each other: elastic is excluded, and the verdict is 'not decided' between them."""
+    decision = decide(
+        {"penetration_hardness": 3.0, "hardening": 8.0},
+        {"penetration_hardness": 90.0, "hardening": 80.0},
+        RISE_5,
+        5,
+        elastic_chi2=70.0,
     )
     assert not decision.decided
-    assert decision.kept == ("penetration_hardness", ELASTIC)
-    assert "inside the quantile" in decision.why
+    assert decision.kept == ("penetration_hardness", "hardening")
+    assert "flow detected" in decision.why and "inside it" in decision.why
 
 
 def test_a_misfit_of_every_model_scales_the_differences_by_the_best_ones():
     """The best model misses by χ² 40 over 4 degrees of freedom (Birge ratio² 10): the others'
     differences are judged under that scatter, so 60 more is 6, within the quantile."""
     decision = decide({"hardening": 40.0, "penetration_hardness": 100.0}, {"hardening": 400.0,
-                      "penetration_hardness": 500.0}, RISE_5, 5)  # fmt: skip
+                      "penetration_hardness": 500.0}, RISE_5, 5, elastic_chi2=400.0)  # fmt: skip
     assert decision.delta_chi2["penetration_hardness"] == pytest.approx(6.0)
     assert decision.kept == ("hardening", "penetration_hardness")
     assert "Birge" in decision.why

@@ -16,6 +16,7 @@ from docutils.core import publish_parts  # noqa: E402
 from amontons.study.summary import (  # noqa: E402
     ReportFigure,
     SummaryError,
+    decided_text,
     display_rows,
     markdown_table,
     matching_models,
@@ -45,6 +46,7 @@ def _row(model, source, exponent, ratio=1.0, parameter=None, **scan):
         "area_ratio_largest": ratio,
         "chi2_best": scan.get("chi2_best"),
         "chi2_elastic_end": scan.get("chi2_elastic_end"),
+        "chi2_elastic": scan.get("chi2_elastic"),
         "chi2_rise": 10.128 if "chi2_best" in scan else None,
         "n_loads": 5 if "chi2_best" in scan else None,
     }
@@ -70,6 +72,7 @@ def models_table() -> pd.DataFrame:
                 high=194.4,
                 chi2_best=40.0,
                 chi2_elastic_end=60.0,
+                chi2_elastic=48.0,
             ),
             _row(
                 "hardening",
@@ -78,11 +81,12 @@ def models_table() -> pd.DataFrame:
                 1.03,
                 "k_mpa_per_nm",
                 value=4.472,
-                estimate=5.26,
+                estimate=float("nan"),  # a bound has no estimate (best.json's null)
                 low=4.61,
                 high=float("nan"),
                 chi2_best=2.0,
                 chi2_elastic_end=50.0,
+                chi2_elastic=48.5,
             ),
         ]
     )
@@ -96,7 +100,7 @@ def test_a_plastic_model_is_judged_at_its_scan_and_the_others_at_their_scene():
     assert row["elastic_source"] == "scene elastic"
     assert row["greenwood_tripp_area_ratio"] is None  # no rendering, no area ratio
     assert (row["k_estimate"], row["k_low"], row["k_high"], row["k_grid_best"]) == (
-        5.26,
+        None,
         4.61,
         None,  # open at the scan's end
         4.472,
@@ -212,3 +216,21 @@ def test_the_verdict_table_states_the_decision_by_the_areas():
     assert lines["decided by the areas at every load (95%, scatter and model error)"] == [
         "contact hardening only"
     ]
+
+
+def test_an_elastic_answer_states_each_plastic_parameter_as_its_bound():
+    """The elastic model, judged with its own error, lies within the quantile of both scans'
+    best (χ² 3 against 2 and 40 → no flow detected): the verdict names elastic, and each
+    scanned parameter is stated as the one-sided bound its interval's lower end sets, with no
+    estimate and no upper end, even where the scan's own interval is closed (p_Y's
+    178.9-194.4): the elastic limit, p_Y → ∞, is kept."""
+    table = models_table()
+    table["chi2_elastic"] = table["chi2_elastic"].where(table["chi2_elastic"].isna(), 3.0)
+    (row,) = verdict_rows(table, "PS", "models.csv")
+    assert row["decided"] == "elastic"
+    assert "no flow detected" in row["decided_why"]
+    assert (row["p_y_estimate"], row["p_y_low"], row["p_y_high"]) == (None, 178.9, None)
+    assert (row["k_estimate"], row["k_low"], row["k_high"]) == (None, 4.61, None)
+    assert decided_text(row) == "elastic: no flow detected, p_Y ≥ 179 MPa, k ≥ 4.61 MPa/nm"
+    lines = {line[0]: line[1:] for line in display_rows(pd.DataFrame([row]), 0.95)}
+    assert lines["p_Y (estimate, MPa; 95% interval)"] == ["≥ 179 (bound); grid's best 179"]

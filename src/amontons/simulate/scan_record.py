@@ -37,11 +37,13 @@ def not_decided_note(best: Mapping) -> str:
 
 
 # best.json's numbers the verdict judges the models by (docs/study.md §6), as model-table
-# columns of a scan's row: χ² under the measured scatter at the best value and at the scan's
-# elastic end, the quantile's rise and the loads it counts.
+# columns of a scan's row: χ² under the measured scatter at the best value, at the scan's
+# elastic end and of the elastic model itself with its own error, the quantile's rise and
+# the loads it counts.
 JUDGEMENT_COLUMNS = {
     "chi2_min_measured_sd": "chi2_best",
     "chi2_elastic_end_measured_sd": "chi2_elastic_end",
+    "chi2_elastic_measured_sd": "chi2_elastic",
     "chi2_rise": "chi2_rise",
     "n_loads": "n_loads",
 }
@@ -60,7 +62,7 @@ def estimate_columns(best: Mapping | None) -> dict:
         "estimate": best["estimate"],
         "estimate_low": low,
         "estimate_high": high,
-        **{column: best[key] for key, column in JUDGEMENT_COLUMNS.items()},
+        **{column: best.get(key) for key, column in JUDGEMENT_COLUMNS.items()},
     }
 
 

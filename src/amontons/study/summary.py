@@ -31,7 +31,7 @@ from amontons.simulate.scan_record import (
     significant,
     symbol_and_unit,
 )
-from amontons.study.decision import Decision, decide
+from amontons.study.decision import ELASTIC, Decision, decide
 
 # The models of the verdict, in the order the study discusses them (docs/study.md §4), and
 # how a reader names them.
@@ -137,31 +137,53 @@ def verdict_rows(table: pd.DataFrame, material: str, source: str) -> list[dict]:
                 ("grid_best", "value"),
                 ("chi2_best", "chi2_best"),
                 ("chi2_elastic_end", "chi2_elastic_end"),
+                ("chi2_elastic", "chi2_elastic"),
             ):
                 row[f"{stem}_{column}"] = _cell(chosen[key]) if scanned else None
         row["matching"] = ";".join(matching_models(row))
         decision = model_decision(row, own)
         row["decided"] = ";".join(decision.kept)
         row["decided_why"] = decision.why
+        if decision.elastic:
+            state_as_bounds(row)
         rows.append(row)
     return rows
+
+
+def state_as_bounds(row: dict) -> None:
+    """Where the answer is elastic, each scanned parameter as the one-sided bound the data
+    set: its interval's lower end, no estimate and no upper end (the elastic limit, the
+    parameter → ∞, is kept)."""
+    for parameter in MODEL_PARAMETERS.values():
+        stem = parameter_named(parameter).stem
+        row[f"{stem}_estimate"] = None
+        row[f"{stem}_high"] = None
 
 
 def model_decision(row: Mapping, own: pd.DataFrame) -> Decision:
     """The decision between the models a verdict row's scans judged
     (:func:`amontons.study.decision.decide`), from their χ² columns (``own``: the sphere's
     model-table rows, for the quantile and the loads)."""
-    best, elastic_end = {}, {}
+    best, elastic_end, elastic = {}, {}, []
     for model, parameter in MODEL_PARAMETERS.items():
         stem = parameter_named(parameter).stem
         if _present(row[f"{stem}_chi2_best"]):
             best[model] = row[f"{stem}_chi2_best"]
             elastic_end[model] = row[f"{stem}_chi2_elastic_end"]
+            if _present(row[f"{stem}_chi2_elastic"]):
+                elastic.append(row[f"{stem}_chi2_elastic"])
     judged = own[own["chi2_rise"].notna()]  # verdict_rows has checked the column is there
     if judged.empty:
         return decide({}, {}, float("nan"), 0)
-    # the larger of the scans' quantiles: a model is excluded only where both would exclude it
-    return decide(best, elastic_end, judged["chi2_rise"].max(), int(judged["n_loads"].min()))
+    # the larger of the scans' quantiles: a model is excluded only where both would exclude it;
+    # each scan solved the elastic limit on its own window (the same up to its tolerance)
+    return decide(
+        best,
+        elastic_end,
+        judged["chi2_rise"].max(),
+        int(judged["n_loads"].min()),
+        min(elastic) if elastic else None,
+    )
 
 
 def verdict_table(tables: Mapping[str, str]) -> pd.DataFrame:
@@ -203,7 +225,7 @@ def parameter_text(row: Mapping, parameter: str) -> str:
     """A verdict row's cell for a scanned parameter: estimate, interval, grid's best."""
     stem = parameter_named(parameter).stem
     estimate = row.get(f"{stem}_estimate")
-    if not _present(estimate):
+    if not _present(row.get(f"{stem}_grid_best")):  # a bound has no estimate, a scan a grid
         return (
             NOT_DECIDED_SOURCE
             if _not_decided(row, model_of_parameter(parameter).name)
@@ -232,12 +254,33 @@ def verdict_text(row: Mapping) -> str:
     return f"{', '.join(matching)}: not decided"
 
 
+def bounds_text(row: Mapping) -> str:
+    """Each scanned parameter's one-sided bound in a verdict row ('p_Y ≥ 117 MPa'), or that
+    its scan does not bound it."""
+    parts = []
+    for parameter in MODEL_PARAMETERS.values():
+        own = parameter_named(parameter)
+        if not _present(row.get(f"{own.stem}_chi2_best")):
+            continue
+        low = _cell(row.get(f"{own.stem}_low"))
+        parts.append(
+            f"{own.symbol} not bounded by the scan"
+            if low is None
+            else f"{own.symbol} ≥ {significant(low)} {own.unit}"
+        )
+    return ", ".join(parts)
+
+
 def decided_text(row: Mapping) -> str:
-    """The decision by the areas at every load, in words: the one model the data name, or
-    'not decided' with the models they cannot tell apart (an empty cell: no scan judged)."""
+    """The decision by the areas at every load, in words: the one model the data name (elastic
+    with each plastic parameter's bound), or 'not decided' with the models they cannot tell
+    apart (an empty cell: no scan judged)."""
     kept = _model_names(row.get("decided"))
     if not kept:
         return "no scan judged"
+    if row.get("decided") == ELASTIC:
+        bounds = bounds_text(row)
+        return f"{kept[0]}: no flow detected" + (f", {bounds}" if bounds else "")
     if len(kept) == 1:
         return f"{kept[0]} only"
     return f"not decided: {', '.join(kept)}"
