@@ -12,12 +12,14 @@ from amontons.runlog import run_logged
 from amontons.simulate.scan_best import (
     best_scan_value,
     criterion_of_record,
+    elastic_limit_chi2,
     interval_resolution,
+    model_error_of_record,
     not_decided_record,
     point_from_record,
     too_few_loads_record,
 )
-from amontons.simulate.scan_criterion import ModelError, TooFewLoads
+from amontons.simulate.scan_criterion import TooFewLoads
 from amontons.simulate.scan_grid import ScanError
 from amontons.simulate.scan_record import NOT_DECIDED
 
@@ -69,8 +71,7 @@ def main(
             "the contact leaves the base scene's window; expected a range_factor whose values "
             "give contacts that fit (or a larger window_factor)"
         )
-    model_error = judgement.get("model_error") or {}
-    error = ModelError.from_record(model_error) if model_error.get("estimated") else None
+    error = model_error_of_record(judgement.get("model_error"))
     try:
         criterion = criterion_of_record(solved[0], error)
     except TooFewLoads as error:
@@ -95,9 +96,6 @@ def main(
         [best.resolution_low, best.resolution_high],
     )
     write_table(table_path, pd.DataFrame(scan_rows(records, best.value, refined)))
-    chosen = next(r for r in grid if r["value"] == best.value)
-    loads = [row["load_mn"] for row in chosen["loads"]]
-    rendered = [row["simulated_area_um2"] for row in chosen["loads"]]
     write_json(
         best_path,
         {
@@ -110,21 +108,43 @@ def main(
             "outside_scan": records[0]["outside_scan"],
             **best.to_record(),
             "criterion_loads_mn": list(criterion.loads_mn),
-            "model_error": judgement.get("model_error")
-            or {"estimated": False, "why": "the scan job measured none"},
-            "refinement": judgement.get("refinement"),
+            **judgement_record(judgement, solved[0]),
             "interval_resolution": interval_resolution([p.value for p in points], best),
-            "iou_largest": chosen["iou_largest"],
-            "area_ratio_largest": chosen["area_ratio_largest"],
-            "best_loads": [
-                {k: row[k] for k in ("load_mn", "simulated_area_um2", "solver_area_um2")}
-                for row in chosen["loads"]
-            ],
-            "best_rendered_fit": fit_power_law(
-                loads, rendered, x_ref=loads[0], confidence=confidence
-            ).to_record(),
+            **grid_best_record(next(r for r in grid if r["value"] == best.value), confidence),
         },
     )
+
+
+def judgement_record(judgement: dict, solved: dict) -> dict:
+    """best.json's model error, elastic limit (with its χ² under the elastic model's own
+    error and the scatter of ``solved``'s loads, one solved value's scan_point.json) and
+    refinement, from the scan job's refinement.json ``judgement``."""
+    return {
+        "model_error": judgement.get("model_error")
+        or {"estimated": False, "why": "the scan job measured none"},
+        "chi2_elastic_measured_sd": elastic_limit_chi2(solved, judgement.get("elastic_limit")),
+        "elastic_limit": judgement.get("elastic_limit")
+        or {"solved": False, "why": "the scan job solved none"},
+        "refinement": judgement.get("refinement"),
+    }
+
+
+def grid_best_record(chosen: dict, confidence: float) -> dict:
+    """best.json's numbers of the grid's best value (``chosen``, its scan_point.json): its
+    IoU and area ratio at the largest load, its loads' areas and its rendered power law."""
+    loads = [row["load_mn"] for row in chosen["loads"]]
+    rendered = [row["simulated_area_um2"] for row in chosen["loads"]]
+    return {
+        "iou_largest": chosen["iou_largest"],
+        "area_ratio_largest": chosen["area_ratio_largest"],
+        "best_loads": [
+            {k: row[k] for k in ("load_mn", "simulated_area_um2", "solver_area_um2")}
+            for row in chosen["loads"]
+        ],
+        "best_rendered_fit": fit_power_law(
+            loads, rendered, x_ref=loads[0], confidence=confidence
+        ).to_record(),
+    }
 
 
 def scan_rows(records: list[dict], best_value: float | None, refined=()) -> list[dict]:

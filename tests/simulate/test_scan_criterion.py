@@ -9,7 +9,12 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from amontons.simulate.model_error import model_error_of, richardson_log_bias, shared_line
+from amontons.simulate.model_error import (
+    model_error_of,
+    richardson_log_bias,
+    shared_line,
+    stated_model_error,
+)
 from amontons.simulate.scan_best import ScanPoint, best_scan_value, interval_resolution
 from amontons.simulate.scan_criterion import (
     MIN_LOADS,
@@ -145,6 +150,46 @@ def test_the_model_error_record_corrects_its_line_and_counts_the_order():
     assert criterion.covariance(0.03) == pytest.approx(expected, abs=1e-15)
     line = shared_line(LOADS_MN, [1.0, 2.0, 1.0, 2.0, 1.0])
     assert line.offset_se > 0 and line.slope_se > 0
+
+
+def test_a_model_error_that_cannot_be_measured_is_counted_at_its_stated_size():
+    """Where the finer solve fails, the scan does not fall back to the measured scatter
+    alone (the narrowest interval where the error is largest): the stated 0.46 per µm of
+    pixel at the `standard` preset's 206 nm is an offset sd of 0.095, shared by every load,
+    which holds the planted 9 % bias that the scatter alone excludes (the test above)."""
+    truth = 100.0
+    rng = np.random.default_rng(9)
+    measured = 40 * LOADS_MN**0.85 * np.exp(rng.normal(0, 0.01, N))
+    points = [_point(v, _truth_areas(v, truth) * 1.09, measured) for v in scan_values(
+        truth, [0.2, 4.0], 25)]  # fmt: skip
+    psf = np.full(N, 0.004)
+    error, record = stated_model_error(LOADS_MN, 206e-9, 0.46, psf)
+    assert error.offset_sd == pytest.approx(0.46 * 0.206, rel=1e-12)
+    assert error.bias == (0.0,) * N and error.slope_sd == 0.0
+    assert np.array(error.modes[0]) == pytest.approx(psf, abs=1e-12)
+    assert record["stated_per_um"] == 0.46 and ModelError.from_record(record) == error
+    criterion = Criterion(tuple(LOADS_MN), log_area_scatter(LOADS_MN, measured), error)
+    assert _inside(truth, best_scan_value(points, criterion, 0.95))
+    with pytest.raises(ValueError, match="model_error_stated_per_um = 0"):
+        stated_model_error(LOADS_MN, 206e-9, 0.0)
+
+
+def test_a_bound_states_no_estimate():
+    """An interval open at the scan's end is a bound: best.json's estimate is null (the least
+    χ² of a scan that reaches its end says nothing of where the parameter lies beyond), while
+    a closed interval keeps its estimate."""
+    truth = 100.0
+    measured = 40 * LOADS_MN**0.85
+    loads = tuple(LOADS_MN)
+    flat = [_point(v, measured * (1 + 0.001 * min(v / truth, 1.0)), measured)
+            for v in scan_values(truth, [0.2, 4.0], 25)]  # fmt: skip
+    bound = best_scan_value(flat, Criterion(loads, 0.03, ModelError.none(N)), 0.95)
+    assert bound.scatter_high is None and bound.estimate is None
+    assert bound.to_record()["estimate"] is None
+    points = [_point(v, _truth_areas(v, truth), measured) for v in scan_values(truth, [0.2,
+              4.0], 25)]  # fmt: skip
+    closed = best_scan_value(points, Criterion(loads, 0.03, ModelError.none(N)), 0.95)
+    assert closed.estimate == closed.refined == closed.to_record()["estimate"]
 
 
 def test_refinement_resolves_an_estimate_the_parabola_misplaces():

@@ -93,10 +93,18 @@ def test_best_json_names_the_estimate_and_the_grid_best():
         "estimate_high": high,
         "chi2_best": record["chi2_min_measured_sd"],
         "chi2_elastic_end": record["chi2_elastic_end_measured_sd"],
+        "chi2_elastic": None,  # the elastic limit is the scan job's (best_scan_value script)
         "chi2_rise": record["chi2_rise"],
         "n_loads": 5,
     }
-    empty = ("estimate", "estimate_low", "estimate_high", "chi2_best", "chi2_elastic_end")
+    empty = (
+        "estimate",
+        "estimate_low",
+        "estimate_high",
+        "chi2_best",
+        "chi2_elastic_end",
+        "chi2_elastic",
+    )
     assert estimate_columns(None) == dict.fromkeys((*empty, "chi2_rise", "n_loads"))
     # the scan's elastic end (20) misses by 0.3 ln 4 at every load: far beyond the quantile
     assert record["elastic_end"] == 20.0 and record["elastic_excluded"]

@@ -42,6 +42,8 @@ __all__ = [
     "best_scan_value",
     "best_targets",
     "criterion_of_record",
+    "elastic_limit_chi2",
+    "model_error_of_record",
     "interval_resolution",
     "interval_width_ln",
     "measured_rows",
@@ -97,6 +99,14 @@ class ScanBest:
     chi2_elastic_end_measured: float = float("nan")
 
     @property
+    def estimate(self) -> float | None:
+        """The scan's estimate where its interval is closed on both sides; None where the data
+        bound the parameter on one side only (a bound has no point estimate: the least χ²
+        of a scan that reaches its end says nothing of where the parameter lies beyond)."""
+        bounded = self.scatter_low is not None and self.scatter_high is not None
+        return self.refined if bounded else None
+
+    @property
     def elastic_excluded(self) -> bool:
         """Whether the data exclude the scan's elastic end (its highest value: the most
         nearly elastic contact it solved) against its best value, at the interval's
@@ -108,7 +118,7 @@ class ScanBest:
         grid's best (the scanned value the figures and the model table show), under the name
         ``grid_best`` and under its former name ``best``."""
         return {
-            "estimate": self.refined,
+            "estimate": self.estimate,
             "interval": [self.scatter_low, self.scatter_high],
             "grid_best": self.value,
             "best": self.value,
@@ -132,7 +142,8 @@ class ScanBest:
             "tie-break: IoU at the largest load",
             "estimate_definition": "the vertex in ln(value) of the parabola of chi2 through the "
             "solved value of least chi2 and its two solved neighbours (that value itself where "
-            "it lies at the scan's end or the three are not convex); it lies inside interval",
+            "it lies at the scan's end or the three are not convex); it lies inside interval; "
+            "null where the interval is open at an end (a bound, with no point estimate)",
             "grid_best_definition": "the coarse grid's value of least chi2 (also `best`); "
             "distance, iou_largest, area_ratio_largest, best_loads and best_rendered_fit are "
             "its, and it may lie outside interval, which belongs to the estimate",
@@ -336,6 +347,23 @@ def criterion_of_record(record: Mapping, model_error: ModelError | None = None) 
     return Criterion.of_measured(
         [row["load_mn"] for row in rows], [row["measured_area_um2"] for row in rows], model_error
     )
+
+
+def model_error_of_record(record: Mapping | None) -> ModelError | None:
+    """The model error a scan job counted (refinement.json's ``model_error``: measured, or
+    stated where it could not be measured); None where it records none."""
+    return ModelError.from_record(record) if record and "bias" in record else None
+
+
+def elastic_limit_chi2(record: Mapping, elastic_limit: Mapping | None) -> float | None:
+    """χ² of the elastic limit (refinement.json's ``elastic_limit``: the elastic model solved
+    on the scan's window) under the measured scatter of ``record``'s loads (a solved value's
+    scan_point.json) and the elastic model's own error; None where it was not solved."""
+    if not elastic_limit or not elastic_limit.get("solved"):
+        return None
+    criterion = criterion_of_record(record, model_error_of_record(elastic_limit["model_error"]))
+    residuals = [math.inf if r is None else r for r in elastic_limit["residuals"]]
+    return criterion.chi2(residuals, max(criterion.scatter_sd, SD_FLOOR))
 
 
 def point_from_record(record: Mapping, n_loads: int) -> ScanPoint:

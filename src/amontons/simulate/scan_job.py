@@ -23,8 +23,14 @@ from amontons.io.files import read_json, write_json
 from amontons.io.rawdata import fluorescence_planes, read_fluorescence_series
 from amontons.io.units import optional_nm_to_m
 from amontons.measure.area import OtsuSettings, image_contact_area, image_pixel_m
+from amontons.models import ELASTIC
 from amontons.simulate.compare import compare_loads, sheet_load_index
-from amontons.simulate.model_error import model_error_of, psf_log_change, richardson_log_bias
+from amontons.simulate.model_error import (
+    model_error_of,
+    psf_log_change,
+    richardson_log_bias,
+    stated_model_error,
+)
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
@@ -376,19 +382,24 @@ def _at_measured(values: list[float], record: dict) -> list[float]:
     ]
 
 
-def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement: dict):
-    """The model's error at the best solved value (amontons.simulate.model_error): the solver
-    pixel's bias from a solve at ``model_error_pixel_factor`` times the pixel (0.5: one step
-    finer), and the PSF's uncertainty from renders one standard error wider and narrower, at
-    the criterion's loads ``loads_mn``. Returns the error and its record; (None, why) where it
-    cannot be measured, which the record then says."""
+def estimate_model_error(
+    context: ScanContext, best: Solved, loads_mn, judgement: dict, what: str = "the best value"
+):
+    """The model's error at a solved value ``best`` (the grid's best, or the elastic limit:
+    ``what`` names it in the log) (amontons.simulate.model_error): the solver pixel's bias
+    from a solve at ``model_error_pixel_factor`` times the pixel (0.5: one step finer), and
+    the PSF's uncertainty from renders one standard error wider and narrower, at the
+    criterion's loads ``loads_mn``. Returns the error and its record; where the bias cannot
+    be measured, the stated error of :func:`stated_model_error`, and the record says why."""
     factor = judgement["model_error_pixel_factor"]
     check_scene = replace(best.scene, pixel_m=best.scene.pixel_m * factor)
     log.info(
-        "model error: the best value solved again at %.0f nm (%g x the pixel)",
+        "model error: %s solved again at %.0f nm (%g x the pixel)",
+        what,
         check_scene.pixel_m * 1e9,
         factor,
     )
+    psf_change, psf_note = psf_share(context, best)
     try:
         check = solve_scene(
             check_scene,
@@ -405,9 +416,7 @@ def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement
         )
     except (ContactError, ScanError, SceneError) as error:
         # a second grid that does not converge, does not fit the scan, or renders nothing
-        log.warning("model error not measured: %s", error)
-        return None, {"estimated": False, "why": str(error)}
-    psf_change, psf_note = psf_share(context, best)
+        return stated_error(best, loads_mn, judgement, psf_change, psf_note, error)
     error, record = model_error_of(loads_mn, bias, judgement["model_error_order_sd"], psf_change)
     return error, {
         "estimated": True,
@@ -418,6 +427,65 @@ def estimate_model_error(context: ScanContext, best: Solved, loads_mn, judgement
         "order": judgement["model_error_order"],
         "psf": psf_note,
         **record,
+    }
+
+
+def stated_error(best: Solved, loads_mn, judgement: dict, psf_change, psf_note: str, error):
+    """The stated model error (amontons.simulate.model_error.stated_model_error) at ``best``'s
+    solver pixel where its bias could not be measured (``error`` says why), and its record."""
+    stated, record = stated_model_error(
+        loads_mn, best.scene.pixel_m, judgement["model_error_stated_per_um"], psf_change
+    )
+    log.warning(
+        "model error not measured (%s): counted as the stated %.3g in ln area", error,
+        stated.offset_sd,
+    )  # fmt: skip
+    return stated, {
+        "estimated": False,
+        "why": str(error),
+        "counted": "stated: model_error_stated_per_um times the solver pixel, an offset of "
+        "unknown sign shared by every load",
+        "value": best.record["value"],
+        "solver_pixel_nm": best.scene.pixel_m * 1e9,
+        "psf": psf_note,
+        **record,
+    }
+
+
+def solve_elastic_limit(context: ScanContext, best: Solved, loads_mn, judgement: dict) -> dict:
+    """The nested models' common limit (docs/study.md §6, "The decision"): the elastic model
+    solved on the best value's window, rendered and compared as every value is, and its own
+    model error measured as the best value's is (:func:`estimate_model_error`), so that the
+    verdict judges elastic with the elastic model's error, not with the plastic model's
+    measured at its best value. Returns refinement.json's ``elastic_limit``: its residuals
+    ln A_sim − ln A_meas at the criterion's loads and its model error; where the elastic
+    solve fails, ``solved`` false and why (the verdict then reads the scans' elastic ends)."""
+    scene = replace(best.scene, model=ELASTIC.name, parameter_si=None)
+    try:
+        solution = solve_scene(
+            scene,
+            context.indenter(scene),
+            threads=context.threads,
+            backend=context.solver_backend,
+        )
+    except ContactError as error:
+        log.warning("the elastic limit not solved: %s", error)
+        return {"solved": False, "why": str(error)}
+    compared = _render_and_compare(context, scene, context.base_config, solution)
+    record = _solved_record({"model": ELASTIC.name, "value": None}, compared, solution)
+    areas = tuple(r.simulated_area_m2 for r in compared.rows)
+    limit = Solved(record, ScanStart(), scene, solution, areas)
+    _, error_record = estimate_model_error(context, limit, loads_mn, judgement, "the elastic limit")
+    residuals = point_from_record({**record, "outside_window": None}, len(loads_mn)).residuals
+    log.info("the elastic limit: D = %.4f over %d loads", compared.distance, len(compared.used))
+    return {
+        "solved": True,
+        "model": ELASTIC.name,
+        "loads_mn": list(loads_mn),
+        "residuals": [r if math.isfinite(r) else None for r in residuals],
+        "log_area_distance": compared.distance,
+        "wall_time_s": solution.wall_time_s,
+        "model_error": error_record,
     }
 
 
@@ -469,8 +537,8 @@ def judge_and_refine(context, chain, solved, best, judgement, refinement_path):
         write_json(refinement_path, {"judged": False, "why": str(error), "refined_points": []})
         return
     error, error_record = estimate_model_error(context, best, criterion.loads_mn, judgement)
-    if error is not None:
-        criterion = replace(criterion, model_error=error)
+    criterion = replace(criterion, model_error=error)
+    elastic_limit = solve_elastic_limit(context, best, criterion.loads_mn, judgement)
     records = {value: result.record for value, result in solved.items()}
     starts = {value: result.start for value, result in solved.items()}
     points = [point_from_record(r, criterion.n) for r in records.values()]
@@ -513,6 +581,7 @@ def judge_and_refine(context, chain, solved, best, judgement, refinement_path):
         {
             "judged": True,
             "model_error": error_record,
+            "elastic_limit": elastic_limit,
             "refinement": refinement.to_record(),
             "refined_points": refined,
         },
