@@ -17,10 +17,10 @@ from amontons.validation.tables import (
 )
 
 
-def main(records: list[str], ratio: float, outputs: dict):
+def main(records: list[str], ratio: float, confidence: float, outputs: dict):
     cases = [read_json(p) for p in records]
     table = case_table(cases)
-    coverage = coverage_table(table)
+    coverage = coverage_table(table, confidence)
     confusion = confusion_table(cases)
     cost = cost_table(table)
     checked = checks(coverage, confusion, ratio_label(ratio))
@@ -41,5 +41,6 @@ if __name__ == "__main__":
         sm.log[0],
         records=list(sm.input.records),
         ratio=sm.params.ratio,
+        confidence=sm.params.confidence,
         outputs=dict(sm.output.items()),
     )

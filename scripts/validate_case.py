@@ -21,6 +21,7 @@ def main(
         scans=scans,
         judgement=judgement,
         otsu=otsu_settings,
+        inner_confidence=validation["inner_confidence"],
     )
     record = run_case(
         case_named(validation, case),

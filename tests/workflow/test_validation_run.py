@@ -66,6 +66,8 @@ def test_no_wrong_model_is_named_and_the_clear_truths_are(records):
 
 def test_the_tables_count_the_records(validation, records):
     coverage = pd.read_csv(validation / "coverage.csv")
+    assert sorted(set(coverage["level"])) == [0.68, 0.95]  # calibration at two levels
+    coverage = coverage[coverage["level"] == 0.95]
     assert coverage["cases"].sum() == sum(
         1 for r in records for s in r["scans"].values() if s["holds_truth"] is not None
     )

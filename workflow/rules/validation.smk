@@ -68,6 +68,7 @@ rule tabulate_validation:
         runtime=measured_runtime("tabulate_validation"),
     params:
         ratio=config["validation"]["truth_pixel_ratio"],
+        confidence=SCAN_JUDGEMENT["confidence"],
     script:
         "../../scripts/tabulate_validation.py"
 

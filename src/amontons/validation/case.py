@@ -13,6 +13,7 @@ import time
 
 from amontons import models
 from amontons.measure.area import OtsuSettings
+from amontons.simulate.scan_best import ScanBest
 from amontons.simulate.scan_criterion import TooFewLoads
 from amontons.validation.cases import Case, Truth
 from amontons.validation.study import CaseStudy, ScanAnswer, StudySettings, judge_case
@@ -22,10 +23,11 @@ from amontons.validation.truth import Sphere, case_rng, grids_of, measure_truth
 NOT_DECIDED = "not decided"
 
 
-def holds_truth(answer: ScanAnswer, truth: Truth) -> bool | None:
-    """Whether the scan's interval holds the truth (module docstring); None where the scan
-    is of another plastic model than the truth's."""
-    low, high = answer.best.scatter_low, answer.best.scatter_high
+def holds_truth(answer: ScanAnswer, truth: Truth, best: ScanBest | None = None) -> bool | None:
+    """Whether the scan's interval (``best``'s; None: the scan's own) holds the truth (module
+    docstring); None where the scan is of another plastic model than the truth's."""
+    best = answer.best if best is None else best
+    low, high = best.scatter_low, best.scatter_high
     if truth.model == models.ELASTIC.name:
         return high is None
     if truth.model != answer.model:
@@ -37,11 +39,15 @@ def scan_record(answer: ScanAnswer, truth: Truth) -> dict:
     """What the case keeps of one scan: estimate, interval (null: open), grid best, the χ²
     the decision reads, whether it holds the truth, its model error and refinement."""
     best = answer.best
+    inner = answer.inner
     return {
-        "estimate": best.refined,
+        "estimate": best.estimate,
         "interval": [best.scatter_low, best.scatter_high],
         "grid_best": best.value,
         "holds_truth": holds_truth(answer, truth),
+        "inner_confidence": None if inner is None else inner.confidence,
+        "inner_interval": None if inner is None else [inner.scatter_low, inner.scatter_high],
+        "inner_holds_truth": None if inner is None else holds_truth(answer, truth, inner),
         "chi2_min_measured_sd": best.chi2_min_measured,
         "chi2_elastic_end_measured_sd": best.chi2_elastic_end_measured,
         "chi2_rise": best.rise,
@@ -88,7 +94,7 @@ def run_case(
         "psf_fwhm_study_nm": psf * 1e9,
     }
     try:
-        answers, decision = judge_case(study)
+        answers, elastic, decision = judge_case(study)
     except TooFewLoads as error:
         return {
             **record,
@@ -103,6 +109,12 @@ def run_case(
     return {
         **record,
         "scans": {a.model: scan_record(a, case.truth) for a in answers},
+        "elastic_limit": {
+            "chi2_measured_sd": elastic.chi2,
+            "log_area_distance": elastic.distance,
+            "model_error": elastic.model_error,
+        },
+        "flow_gain": decision.flow,
         "verdict": verdict_of(decision.kept),
         "kept": list(decision.kept),
         "why": decision.why,

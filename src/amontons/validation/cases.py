@@ -96,7 +96,8 @@ def cases_of(validation: Mapping) -> list[Case]:
     reproduction's truth against its study, now and before: what a truth close to the study's
     grid does)."""
     truths = truths_of(validation)
-    seeds = range(1, validation["seeds"] + 1)
+    first = validation["first_seed"]
+    seeds = range(first, first + validation["seeds"])
     cases = [
         Case(t, s, float(validation["truth_pixel_ratio"])) for t in truths.values() for s in seeds
     ]

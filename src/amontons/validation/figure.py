@@ -24,7 +24,8 @@ HELD, MISSED = "tab:blue", "tab:red"
 
 
 def _limits(rows: pd.DataFrame) -> tuple[float, float]:
-    ends = pd.concat([rows["low"], rows["high"], rows["estimate"]]).dropna() / rows["value"].iloc[0]
+    ends = pd.concat([rows["low"], rows["high"], rows["estimate"]]).dropna().astype(float)
+    ends = ends / rows["value"].iloc[0]
     return min(float(ends.min()), 1.0) / OPEN_REACH, max(float(ends.max()), 1.0) * OPEN_REACH
 
 
@@ -43,7 +44,8 @@ def _draw_case(ax, x: float, row, value: float, limits, pale: bool) -> None:
     colour = HELD if row["holds_truth"] else MISSED
     alpha = 0.4 if pale else 1.0
     ax.plot([x, x], [low, high], "-", color=colour, lw=2, alpha=alpha)
-    ax.plot(x, row["estimate"] / value, "o", color=colour, ms=3, alpha=alpha)
+    if not pd.isna(row["estimate"]):  # a bound has no estimate
+        ax.plot(x, row["estimate"] / value, "o", color=colour, ms=3, alpha=alpha)
 
 
 def plot_intervals(cases: pd.DataFrame, study_ratio: float, paths: list[str]) -> None:

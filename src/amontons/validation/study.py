@@ -18,16 +18,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from amontons.contact import FreeBoundaryError, solve_load_series
+from amontons.contact import ContactError, FreeBoundaryError, solve_load_series
 from amontons.measure.area import OtsuSettings
-from amontons.models import with_parameter
+from amontons.models import ELASTIC, with_parameter
 from amontons.simulate.compare import intersection_over_union
-from amontons.simulate.model_error import model_error_of, psf_log_change, richardson_log_bias
+from amontons.simulate.model_error import (
+    model_error_of,
+    psf_log_change,
+    richardson_log_bias,
+    stated_model_error,
+)
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance
 from amontons.simulate.scan_best import ScanBest, ScanPoint, best_scan_value
-from amontons.simulate.scan_criterion import Criterion, TooFewLoads
-from amontons.simulate.scan_grid import scan_values
+from amontons.simulate.scan_criterion import SD_FLOOR, Criterion, TooFewLoads
+from amontons.simulate.scan_grid import ScanError, scan_values
 from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.surface import area_average
 from amontons.study.decision import Decision, decide
@@ -39,7 +44,9 @@ from amontons.validation.truth import Measured, Sphere, law_of
 class StudySettings:
     """What the study solves and judges with: its solver pixel (m) and tolerance, each plastic
     model's prior (config units), the scans' grids (config ``scans``), the judgement (config
-    ``scan_judgement`` with its confidence) and the Otsu settings."""
+    ``scan_judgement`` with its confidence), the Otsu settings, and the second level the
+    intervals are also read at (``inner_confidence``: calibration at two levels; None:
+    none)."""
 
     pixel_m: float
     tol: float
@@ -47,6 +54,7 @@ class StudySettings:
     scans: Mapping[str, Mapping]
     judgement: Mapping
     otsu: OtsuSettings
+    inner_confidence: float | None = None
 
     def grid(self, model: str) -> list[float]:
         """The scan's coarse grid of ``model`` about its prior (config units)."""
@@ -153,35 +161,68 @@ def nearest_warm(solved: Mapping[float, Solved], value: float):
 
 
 def model_error(study: CaseStudy, model: str, best: Solved, judgement: Mapping):
-    """The model's error at the best grid value, as the scan job measures it: the bias from
-    a solve at ``model_error_pixel_factor`` times the pixel (Richardson) and the PSF's standard
-    error as a mode (amontons.simulate.model_error). Returns (ModelError, record)."""
+    """The model's error at a solved value ``best`` (a scan's best grid value, or the elastic
+    limit), as the scan job measures it: the bias from a solve at
+    ``model_error_pixel_factor`` times the pixel (Richardson) and the PSF's standard error as
+    a mode (amontons.simulate.model_error); where the bias cannot be measured, the stated
+    error. Returns (ModelError, record)."""
     factor = float(judgement["model_error_pixel_factor"])
-    value = best.point.value
-    other_fields = study.solve_fields(model, value, None, factor)
-    other = [
-        c.area_m2 for c in study.render(other_fields, study.indenter(factor)[1], study.psf_fwhm_m)
-    ]
-    bias = richardson_log_bias(best.rendered_m2, other, factor, judgement["model_error_order"])
     pixel = study.indenter()[1]
     psf = psf_log_change(
         lambda fwhm: [c.area_m2 for c in study.render(best.fields, pixel, fwhm)],
         study.psf_fwhm_m,
         study.sphere.psf_se_m,
     )
-    return model_error_of(study.loads_mn, bias, judgement["model_error_order_sd"], psf)
+    try:
+        other_fields = study.solve_fields(model, best.point.value, None, factor)
+        other = [
+            c.area_m2
+            for c in study.render(other_fields, study.indenter(factor)[1], study.psf_fwhm_m)
+        ]
+        bias = richardson_log_bias(best.rendered_m2, other, factor, judgement["model_error_order"])
+    except (ContactError, ScanError) as error:
+        stated, record = stated_model_error(
+            study.loads_mn, pixel, judgement["model_error_stated_per_um"], psf
+        )
+        return stated, {**record, "estimated": False, "why": str(error)}
+    error, record = model_error_of(study.loads_mn, bias, judgement["model_error_order_sd"], psf)
+    return error, {**record, "estimated": True}
+
+
+@dataclass(frozen=True)
+class ElasticLimit:
+    """The elastic model solved on the study's grid (the nested models' common limit), its
+    χ² under the measured scatter and its own model error, and that error's record."""
+
+    chi2: float
+    model_error: dict
+    distance: float
+
+
+def judge_elastic_limit(study: CaseStudy) -> ElasticLimit:
+    """The elastic model solved at the study's pixel and judged with its own model error, as
+    the scan job judges it (amontons.simulate.scan_job.solve_elastic_limit)."""
+    limit = study.solve(ELASTIC.name, None)
+    error, record = model_error(study, ELASTIC.name, limit, study.settings.judgement)
+    criterion = Criterion.of_measured(study.loads_mn, [a * 1e12 for a in study.measured_m2], error)
+    chi2 = criterion.chi2(limit.point.residuals, max(criterion.scatter_sd, SD_FLOOR))
+    return ElasticLimit(chi2, record, limit.point.distance)
 
 
 @dataclass(frozen=True)
 class ScanAnswer:
     """One plastic model's scan: its estimate and interval (amontons.simulate.scan_best), its
-    model error's record, the refinement's stop and the values it solved."""
+    model error's record, the refinement's stop and the values it solved; and its interval
+    at the settings' ``inner_confidence`` (``inner``), read off the same solved values (the
+    refinement solved about the outer interval's ends: the inner ends lie between solved
+    values and are read off the parabola about the estimate or interpolated)."""
 
     model: str
     best: ScanBest
     model_error: dict
     refinement: str
     values: tuple[float, ...]
+    inner: ScanBest | None = None
 
 
 def run_scan(study: CaseStudy, model: str) -> ScanAnswer:
@@ -224,27 +265,35 @@ def run_scan(study: CaseStudy, model: str) -> ScanAnswer:
         judgement["refine_max_values"],
     )
     answer = best_scan_value(points, criterion, judgement["confidence"], grid)
+    inner = settings.inner_confidence
     return ScanAnswer(
-        model, answer, record, refinement.stopped, tuple(sorted(p.value for p in points))
+        model,
+        answer,
+        record,
+        refinement.stopped,
+        tuple(sorted(p.value for p in points)),
+        None if inner is None else best_scan_value(points, criterion, inner, grid),
     )
 
 
-def decision_of(answers: Sequence[ScanAnswer]) -> Decision:
-    """The decision between the scanned models and the elastic limit, as the verdict takes
-    it (amontons.study.summary.model_decision): χ² under the measured scatter, the larger of
-    the scans' quantiles, the fewest loads."""
+def decision_of(answers: Sequence[ScanAnswer], elastic: ElasticLimit) -> Decision:
+    """The decision between the scanned models and the elastic model, as the verdict takes
+    it (amontons.study.summary.model_decision): χ² under the measured scatter, each model
+    with its own error, the larger of the scans' quantiles, the fewest loads."""
     return decide(
         {a.model: a.best.chi2_min_measured for a in answers},
         {a.model: a.best.chi2_elastic_end_measured for a in answers},
         max(a.best.rise for a in answers),
         min(a.best.n_loads for a in answers),
+        elastic.chi2,
     )
 
 
-def judge_case(study: CaseStudy) -> tuple[list[ScanAnswer], Decision]:
-    """Both plastic models' scans and the decision (TooFewLoads where the measured images
-    show a contact at fewer loads than the criterion needs)."""
+def judge_case(study: CaseStudy) -> tuple[list[ScanAnswer], ElasticLimit, Decision]:
+    """Both plastic models' scans, the elastic limit and the decision (TooFewLoads where the
+    measured images show a contact at fewer loads than the criterion needs)."""
     if len(study.used) < 3:
         raise TooFewLoads(study.loads_mn)
     answers = [run_scan(study, model.name) for model in with_parameter()]
-    return answers, decision_of(answers)
+    elastic = judge_elastic_limit(study)
+    return answers, elastic, decision_of(answers, elastic)
