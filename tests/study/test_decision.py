@@ -19,7 +19,7 @@ def test_a_model_is_named_where_every_other_is_excluded():
         {"hardening": 50.0, "penetration_hardness": 60.0},
         RISE_5,
         5,
-        elastic_chi2=50.0,
+        elastic_chi2={"hardening": 50.0, "penetration_hardness": 50.0},
     )
     assert decision.decided and decision.kept == ("hardening",)
     assert decision.delta_chi2 == {"hardening": 0.0, "penetration_hardness": 38.0, ELASTIC: 48.0}
@@ -38,11 +38,11 @@ def test_a_plastic_best_near_its_elastic_limit_names_elastic():
         {"penetration_hardness": 4.5, "hardening": 40.0},
         RISE_5,
         5,
-        elastic_chi2=4.5,
+        elastic_chi2={"penetration_hardness": 4.5, "hardening": 4.5},
     )
     assert decision.decided and decision.elastic
     assert decision.flow == {"penetration_hardness": 1.5, "hardening": -25.5}
-    assert "no flow detected" in decision.why and "one side only" in decision.why
+    assert "no flow detected" in decision.why and "from above" in decision.why
 
 
 def test_elastic_is_excluded_by_its_own_chi2_not_by_a_plastic_models_error():
@@ -56,7 +56,7 @@ def test_elastic_is_excluded_by_its_own_chi2_not_by_a_plastic_models_error():
         {"hardening": 50.0, "penetration_hardness": 60.0},
         RISE_5,
         5,
-        elastic_chi2=9.0,
+        elastic_chi2={"hardening": 9.0, "penetration_hardness": 9.0},
     )
     assert own.elastic
     by_ends = decide(
@@ -69,6 +69,15 @@ def test_elastic_is_excluded_by_its_own_chi2_not_by_a_plastic_models_error():
     assert "no elastic solve judged" in by_ends.why
 
 
+def test_a_scan_whose_own_elastic_end_is_kept_reports_no_flow():
+    """Flow needs a plastic model to beat elastic under both errors: the elastic model judged
+    with its own (here far off, χ² 100) and its own scan's elastic end judged with the
+    plastic model's (here within the quantile: the scan's interval is open above). Elastic is
+    named, and the verdict cannot contradict the scan's own bound."""
+    decision = decide({"hardening": 2.0}, {"hardening": 5.0}, RISE_5, 5, {"hardening": 100.0})
+    assert decision.elastic and decision.flow == {"hardening": 3.0}
+
+
 def test_plastic_models_not_told_apart_once_flow_is_detected():
     """Both plastic models improve on elastic by far more than the quantile, and lie within
     it of each other: elastic is excluded, and the verdict is 'not decided' between them."""
@@ -77,7 +86,7 @@ def test_plastic_models_not_told_apart_once_flow_is_detected():
         {"penetration_hardness": 90.0, "hardening": 80.0},
         RISE_5,
         5,
-        elastic_chi2=70.0,
+        elastic_chi2={"penetration_hardness": 70.0, "hardening": 70.0},
     )
     assert not decision.decided
     assert decision.kept == ("penetration_hardness", "hardening")
@@ -88,7 +97,8 @@ def test_a_misfit_of_every_model_scales_the_differences_by_the_best_ones():
     """The best model misses by χ² 40 over 4 degrees of freedom (Birge ratio² 10): the others'
     differences are judged under that scatter, so 60 more is 6, within the quantile."""
     decision = decide({"hardening": 40.0, "penetration_hardness": 100.0}, {"hardening": 400.0,
-                      "penetration_hardness": 500.0}, RISE_5, 5, elastic_chi2=400.0)  # fmt: skip
+                      "penetration_hardness": 500.0}, RISE_5, 5, {"hardening": 400.0,
+                      "penetration_hardness": 400.0})  # fmt: skip
     assert decision.delta_chi2["penetration_hardness"] == pytest.approx(6.0)
     assert decision.kept == ("hardening", "penetration_hardness")
     assert "Birge" in decision.why

@@ -121,6 +121,7 @@ SCAN_JUDGEMENT = {
     "confidence": config["load_area"]["confidence"],
 }
 SCAN_REFINED = SCAN_JUDGEMENT["refine_max_values"]
+SCAN_CHECK_FACTOR = SCAN_JUDGEMENT["model_error_pixel_factor"]
 # The validation study's cases (docs/study.md §7): one job each.
 VALIDATION_CASES = validation_cases(config)
 RING_OPTICS = ring_optics(config)

@@ -29,8 +29,12 @@ rule scan_scene:
     threads: 1
     resources:
         **SOLVE_GPU,
-        mem_mb=solve_mem_mb(scan_solves(SCANS, RUN.scenes.scan_chain, SCAN_REFINED)),
-        runtime=solve_runtime(scan_solves(SCANS, RUN.scenes.scan_chain, SCAN_REFINED)),
+        mem_mb=solve_mem_mb(
+            scan_solves(SCANS, RUN.scenes.scan_chain, SCAN_REFINED, SCAN_CHECK_FACTOR)
+        ),
+        runtime=solve_runtime(
+            scan_solves(SCANS, RUN.scenes.scan_chain, SCAN_REFINED, SCAN_CHECK_FACTOR)
+        ),
     params:
         **SOLVE_BACKEND,
         scan=lambda wc: RUN.scenes.scan_params(wc.sphere, wc.scan),

@@ -43,6 +43,8 @@ __all__ = [
     "best_targets",
     "criterion_of_record",
     "elastic_limit_chi2",
+    "finite_or_none",
+    "floored_log_residuals",
     "model_error_of_record",
     "interval_resolution",
     "interval_width_ln",
@@ -128,8 +130,8 @@ class ScanBest:
             "chi2_rise": self.rise,
             "chi2_min_measured_sd": self.chi2_min_measured,
             "elastic_end": self.elastic_end,
-            "chi2_elastic_end": self.chi2_elastic_end,
-            "chi2_elastic_end_measured_sd": self.chi2_elastic_end_measured,
+            "chi2_elastic_end": finite_or_none(self.chi2_elastic_end),
+            "chi2_elastic_end_measured_sd": finite_or_none(self.chi2_elastic_end_measured),
             "elastic_excluded": self.elastic_excluded,
             "measured_log_area_sd": self.scatter_sd,
             "log_area_sd_used": self.scatter_sd_used,
@@ -160,6 +162,24 @@ class ScanBest:
             "ln(value) near the estimate, linear between solved values beyond; null: open at "
             "the scan's end (a bound)",
         }
+
+
+def finite_or_none(value: float) -> float | None:
+    """``value`` where finite, else None (JSON has no infinity: a scan's elastic end whose
+    contact is lost at a load has no χ² to state)."""
+    return value if math.isfinite(value) else None
+
+
+def floored_log_residuals(
+    simulated_m2: Sequence[float], measured_m2: Sequence[float], floor_m2: float
+) -> tuple[float, ...]:
+    """ln A_sim − ln A_meas per load, a rendered area below ``floor_m2`` (m²; one image
+    pixel, the least contact the threshold can find) taken at it: a load where the model
+    renders no contact misses by at least that much, and the χ² stays finite to be
+    compared (used for the elastic limit, whose contact is the smallest)."""
+    return tuple(
+        math.log(max(s, floor_m2) / m) for s, m in zip(simulated_m2, measured_m2, strict=True)
+    )
 
 
 def _best_index(chi2: np.ndarray, points: Sequence[ScanPoint], among: Sequence[int]) -> int:
@@ -362,8 +382,7 @@ def elastic_limit_chi2(record: Mapping, elastic_limit: Mapping | None) -> float 
     if not elastic_limit or not elastic_limit.get("solved"):
         return None
     criterion = criterion_of_record(record, model_error_of_record(elastic_limit["model_error"]))
-    residuals = [math.inf if r is None else r for r in elastic_limit["residuals"]]
-    return criterion.chi2(residuals, max(criterion.scatter_sd, SD_FLOOR))
+    return criterion.chi2(elastic_limit["residuals"], max(criterion.scatter_sd, SD_FLOOR))
 
 
 def point_from_record(record: Mapping, n_loads: int) -> ScanPoint:

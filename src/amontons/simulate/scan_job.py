@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
 
-from amontons.contact import ContactError, FreeBoundaryError
+from amontons.contact import ContactError, ConvergenceError, FreeBoundaryError
 from amontons.io.fields import write_load_series
 from amontons.io.files import read_json, write_json
 from amontons.io.rawdata import fluorescence_planes, read_fluorescence_series
@@ -34,7 +34,11 @@ from amontons.simulate.model_error import (
 from amontons.simulate.register import Registration
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance, scene_config_at
-from amontons.simulate.scan_best import criterion_of_record, point_from_record
+from amontons.simulate.scan_best import (
+    criterion_of_record,
+    floored_log_residuals,
+    point_from_record,
+)
 from amontons.simulate.scan_criterion import TooFewLoads
 from amontons.simulate.scan_grid import ScanError, value_label
 from amontons.simulate.scan_refine import refine_scan
@@ -458,8 +462,10 @@ def solve_elastic_limit(context: ScanContext, best: Solved, loads_mn, judgement:
     model error measured as the best value's is (:func:`estimate_model_error`), so that the
     verdict judges elastic with the elastic model's error, not with the plastic model's
     measured at its best value. Returns refinement.json's ``elastic_limit``: its residuals
-    ln A_sim − ln A_meas at the criterion's loads and its model error; where the elastic
-    solve fails, ``solved`` false and why (the verdict then reads the scans' elastic ends)."""
+    ln A_sim − ln A_meas at the criterion's loads (a load it renders no contact at taken at
+    one image pixel, :func:`floored_log_residuals`) and its model error; where the elastic
+    solve fails to converge or to fit the window, or renders nothing to compare, ``solved``
+    false and why (the verdict then reads the scan's elastic end alone)."""
     scene = replace(best.scene, model=ELASTIC.name, parameter_si=None)
     try:
         solution = solve_scene(
@@ -468,22 +474,27 @@ def solve_elastic_limit(context: ScanContext, best: Solved, loads_mn, judgement:
             threads=context.threads,
             backend=context.solver_backend,
         )
-    except ContactError as error:
+        compared = _render_and_compare(context, scene, context.base_config, solution)
+    except (ConvergenceError, FreeBoundaryError, ScanError, SceneError) as error:
         log.warning("the elastic limit not solved: %s", error)
         return {"solved": False, "why": str(error)}
-    compared = _render_and_compare(context, scene, context.base_config, solution)
     record = _solved_record({"model": ELASTIC.name, "value": None}, compared, solution)
     areas = tuple(r.simulated_area_m2 for r in compared.rows)
     limit = Solved(record, ScanStart(), scene, solution, areas)
     _, error_record = estimate_model_error(context, limit, loads_mn, judgement, "the elastic limit")
-    residuals = point_from_record({**record, "outside_window": None}, len(loads_mn)).residuals
-    log.info("the elastic limit: D = %.4f over %d loads", compared.distance, len(compared.used))
+    residuals = floored_log_residuals(
+        [row.simulated_area_m2 for row in compared.used],
+        [row.measured_area_m2 for row in compared.used],
+        context.pixel_m**2,
+    )
+    distance = math.sqrt(sum(r * r for r in residuals) / len(residuals))
+    log.info("the elastic limit: D = %.4f over %d loads", distance, len(residuals))
     return {
         "solved": True,
         "model": ELASTIC.name,
         "loads_mn": list(loads_mn),
-        "residuals": [r if math.isfinite(r) else None for r in residuals],
-        "log_area_distance": compared.distance,
+        "residuals": list(residuals),
+        "log_area_distance": distance,
         "wall_time_s": solution.wall_time_s,
         "model_error": error_record,
     }

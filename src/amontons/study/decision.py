@@ -9,13 +9,14 @@ a plastic scan can always come as close to the elastic χ² as its elastic end a
 rule that names a model only where it alone is kept could never name elastic. The decision
 reads them as a likelihood ratio reads nested models:
 
-- **The elastic limit** is the elastic model itself, solved on the scan's window and judged
-  with the elastic model's own measured error (``elastic_chi2``; the scans' elastic ends,
-  judged with a plastic model's error, only where no elastic solve was judged).
-- **Flow is detected** where a plastic model's χ² at its best value lies below the elastic
-  χ² by more than the quantile (one parameter more). Where none does, the answer is
-  **elastic**, and each plastic parameter is stated as the one-sided bound its scan sets
-  (p_Y ≥ X, k ≥ Y: the values the data exclude).
+- **The elastic limit** is the elastic model itself, solved on each scan's window and judged
+  with the elastic model's own measured error (``elastic_chi2``), and the scan's own elastic
+  end, judged with the plastic model's error (``elastic_end_chi2``).
+- **Flow is detected** where a plastic model's χ² at its best value lies below both by more
+  than the quantile (one parameter more): the elastic model judged with its own error, and
+  its own scan's profile, so that a scan whose interval is open above never reports flow.
+  Where none does, the answer is **elastic**, and each plastic parameter is stated as the
+  one-sided bound its scan sets (p_Y ≥ X, k ≥ Y: the values the data exclude).
 - Where flow is detected, elastic is excluded, and the plastic models are compared with
   each other (not nested): one is **excluded** where its χ² lies above the least by more
   than the quantile, and a model is **named** only where every other plastic model is
@@ -66,18 +67,34 @@ class Decision:
         return self.kept == (ELASTIC,)
 
 
-def _elastic_reference(
-    elastic_chi2: float | None, elastic_end_chi2: Mapping[str, float]
-) -> tuple[float, str]:
-    """The elastic limit's χ² and a note where it is not the elastic model's own: the least
-    of the scans' elastic ends, judged with a plastic model's error, where no elastic solve
-    was judged."""
-    if elastic_chi2 is not None and math.isfinite(elastic_chi2):
-        return elastic_chi2, ""
-    return min(elastic_end_chi2.values()), (
-        " (no elastic solve judged: the elastic limit is the scans' elastic end, judged with "
-        "a plastic model's error)"
+def _finite(value) -> bool:
+    return value is not None and math.isfinite(value)
+
+
+def _elastic_references(
+    best_chi2: Mapping[str, float],
+    elastic_end_chi2: Mapping[str, float],
+    elastic_chi2: Mapping[str, float] | None,
+) -> tuple[dict[str, float], str]:
+    """Each plastic model's elastic reference: the smaller of the elastic model's χ² on its
+    scan's window (judged with the elastic model's own error) and its scan's elastic end's
+    (judged with its own error), so that flow is detected only where the plastic model beats
+    elastic under both errors; and a note where a scan has no elastic solve judged."""
+    own = elastic_chi2 or {}
+    references, missing = {}, []
+    for model in best_chi2:
+        pair = [v for v in (own.get(model), elastic_end_chi2.get(model)) if _finite(v)]
+        if not _finite(own.get(model)):
+            missing.append(model)
+        if pair:
+            references[model] = min(pair)
+    note = (
+        f" (no elastic solve judged on the window of {', '.join(missing)}: its elastic limit "
+        "is its scan's elastic end, judged with its own error)"
+        if missing
+        else ""
     )
+    return references, note
 
 
 def decide(
@@ -85,27 +102,32 @@ def decide(
     elastic_end_chi2: Mapping[str, float],
     rise: float,
     n: int,
-    elastic_chi2: float | None = None,
+    elastic_chi2: Mapping[str, float] | None = None,
 ) -> Decision:
     """The decision between the scanned plastic models (``best_chi2``: model → χ² at its best
-    value under the measured scatter) and the elastic model (``elastic_chi2``: its own χ²,
-    judged with its own error; where None, the least of ``elastic_end_chi2``, model → χ² at
-    its scan's elastic end), at the quantile's ``rise`` over ``n`` loads."""
+    value under the measured scatter) and the elastic model, at the quantile's ``rise`` over
+    ``n`` loads. The elastic model is judged on each scan's window by ``elastic_chi2`` (model
+    → the elastic model's own χ² there, with its own error) and ``elastic_end_chi2`` (model →
+    χ² at its scan's elastic end): a plastic model detects flow only where its χ² lies below
+    both by more than the quantile (:func:`_elastic_references`)."""
     if not best_chi2:
         return Decision((), {}, rise, "no scan judged", {})
-    elastic, note = _elastic_reference(elastic_chi2, elastic_end_chi2)
+    references, note = _elastic_references(best_chi2, elastic_end_chi2, elastic_chi2)
+    if not references:
+        raise ValueError("no elastic χ² to judge the elastic model by: neither an elastic solve "
+                         "nor a scan's elastic end")  # fmt: skip
+    elastic = min(references.values())
     chi2 = {**best_chi2, ELASTIC: elastic}
     least = min(chi2.values())
     birge = max(1.0, least / max(n - 1, 1))
     delta = {model: (value - least) / birge for model, value in chi2.items()}
-    flow = {model: (elastic - value) / birge for model, value in best_chi2.items()}
+    flow = {m: (references[m] - best_chi2[m]) / birge for m in references}
     if max(flow.values()) <= rise:
         kept = (ELASTIC,)
-        gain = max(flow.values())
         why = (
             f"no flow detected: no plastic model improves on the elastic model by more than "
-            f"the quantile's {rise:.3g} (the largest gain in χ² is {gain:.3g}); the plastic "
-            "parameters are bounded on one side only"
+            f"the quantile's {rise:.3g} (the largest gain in χ² is {max(flow.values()):.3g}); "
+            "the data bound no plastic parameter from above"
         )
     else:
         kept = tuple(sorted((m for m in best_chi2 if delta[m] <= rise), key=lambda m: delta[m]))
@@ -121,7 +143,7 @@ def _plastic_why(
     """Why, where flow is detected: elastic excluded by the largest gain, then the plastic
     models named or not told apart."""
     gain = max(flow.values())
-    excluded = f"flow detected: the elastic model's χ² lies {gain:.3g} above the best"
+    excluded = f"flow detected: a plastic model improves on the elastic model by {gain:.3g} in χ²"
     if len(kept) == 1:
         others = [d for m, d in delta.items() if m not in kept and m != ELASTIC]
         nearest = min(others, default=float("inf"))

@@ -164,25 +164,19 @@ def model_decision(row: Mapping, own: pd.DataFrame) -> Decision:
     """The decision between the models a verdict row's scans judged
     (:func:`amontons.study.decision.decide`), from their χ² columns (``own``: the sphere's
     model-table rows, for the quantile and the loads)."""
-    best, elastic_end, elastic = {}, {}, []
+    best, elastic_end, elastic = {}, {}, {}
     for model, parameter in MODEL_PARAMETERS.items():
         stem = parameter_named(parameter).stem
         if _present(row[f"{stem}_chi2_best"]):
             best[model] = row[f"{stem}_chi2_best"]
-            elastic_end[model] = row[f"{stem}_chi2_elastic_end"]
-            if _present(row[f"{stem}_chi2_elastic"]):
-                elastic.append(row[f"{stem}_chi2_elastic"])
+            elastic_end[model] = _cell(row[f"{stem}_chi2_elastic_end"])
+            elastic[model] = _cell(row[f"{stem}_chi2_elastic"])
     judged = own[own["chi2_rise"].notna()]  # verdict_rows has checked the column is there
     if judged.empty:
         return decide({}, {}, float("nan"), 0)
-    # the larger of the scans' quantiles: a model is excluded only where both would exclude it;
-    # each scan solved the elastic limit on its own window (the same up to its tolerance)
+    # the larger of the scans' quantiles: a model is excluded only where both would exclude it
     return decide(
-        best,
-        elastic_end,
-        judged["chi2_rise"].max(),
-        int(judged["n_loads"].min()),
-        min(elastic) if elastic else None,
+        best, elastic_end, judged["chi2_rise"].max(), int(judged["n_loads"].min()), elastic
     )
 
 

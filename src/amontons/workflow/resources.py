@@ -141,20 +141,27 @@ class SolveResources:
 
 
 def scan_solves(
-    scans: Mapping, chain: Callable[[str, str], list[str]], refined: int = 0
+    scans: Mapping,
+    chain: Callable[[str, str], list[str]],
+    refined: int = 0,
+    check_pixel_factor: float = 1.0,
 ) -> SolvesOf:
     """A scan job's solves for the timing model: its scene on its sphere at each value of
-    ``chain(sphere, scan)``, and, at most, ``refined`` values more and the model error's
-    coarser solve (docs/study.md §1), each costed as the grid's middle value: an upper bound,
-    so that a cluster's time limit holds the refined scan too."""
+    ``chain(sphere, scan)``; and, at most, ``refined`` values more, the elastic limit, and the
+    two model-error checks at ``check_pixel_factor`` times the pixel (the best value's and
+    the elastic limit's: docs/study.md §1, §6), each check costed as the cells it solves,
+    1/factor² times a solve's; each costed as the grid's middle value: an upper bound of the
+    time, so that a cluster's time limit holds the refined scan too (the memory is a solve's
+    at the scan's pixel: a check's is larger by its cells)."""
 
     def solves_of(wildcards):
         scan = scans[wildcards.scan]
         values = chain(wildcards.sphere, wildcards.scan)
         middle = sorted(values, key=float)[len(values) // 2]
+        checks = 2 * max(1, round(check_pixel_factor**-2))
         return [
             (scan["scene"], wildcards.sphere, scan["parameter"], value)
-            for value in [*values, *[middle] * (refined + 1)]
+            for value in [*values, *[middle] * (refined + 1 + checks)]
         ]
 
     return solves_of
