@@ -12,7 +12,6 @@ from amontons.validation.tables import (
     confusion_table,
     cost_table,
     coverage_table,
-    ratio_label,
     summary_markdown,
 )
 
@@ -23,7 +22,7 @@ def main(records: list[str], ratio: float, confidence: float, outputs: dict):
     coverage = coverage_table(table, confidence)
     confusion = confusion_table(cases)
     cost = cost_table(table)
-    checked = checks(coverage, confusion, ratio_label(ratio))
+    checked = checks(coverage, confusion, confidence)
     write_table(outputs["cases"], table)
     write_table(outputs["coverage"], coverage)
     write_table(outputs["confusion"], confusion)

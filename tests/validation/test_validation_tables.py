@@ -86,6 +86,7 @@ def _record(truth: str, model: str, value, signal: str, seed: int, ratio: float,
     return {
         "case": f"{truth}_r{ratio:g}_s{seed}", "truth": truth, "model": model, "value": value,
         "signal": signal, "seed": seed, "ratio": ratio, "verdict": verdict, "scans": scans,
+        "truth_solver": "amontons 0.1.0", "comparison": ratio != 4.0,
         "truth_wall_s": 1.0, "study_wall_s": 2.0, "study_solves": 20,
     }  # fmt: skip
 
@@ -114,7 +115,7 @@ def test_coverage_confusion_and_checks_count_what_the_records_say():
     confusion = confusion_table(records)
     row = confusion[confusion["ratio"] == "4"].iloc[0]
     assert row["penetration_hardness"] == 10 and row[NOT_DECIDED] == 0 and row["cases"] == 10
-    checked = {c["check"]: c for c in checks(coverage, confusion, "4")}
+    checked = {c["check"]: c for c in checks(coverage, confusion, 0.95)}
     assert checked["coverage of the p_y_mpa intervals"]["met"]  # 90 % is the target
     assert checked["clear truths: the true model named"]["value"] == 1.0
     assert checked["hard: a wrong model named"]["met"]
@@ -123,7 +124,7 @@ def test_coverage_confusion_and_checks_count_what_the_records_say():
     records[0]["scans"]["penetration_hardness"]["holds_truth"] = False
     records[1]["verdict"] = "hardening"
     coverage = coverage_table(case_table(records), 0.95)
-    checked = {c["check"]: c for c in checks(coverage, confusion_table(records), "4")}
+    checked = {c["check"]: c for c in checks(coverage, confusion_table(records), 0.95)}
     assert not checked["coverage of the p_y_mpa intervals"]["met"]  # 8 of 10
     assert not checked["hard: a wrong model named"]["met"]  # 1 of 10 > 5 %
     assert math.isclose(checked["clear truths: the true model named"]["value"], 0.9)
@@ -162,7 +163,7 @@ def test_elastic_on_a_faint_truth_is_wrong_only_where_its_bound_excludes_it():
     assert by_truth.loc["faint", "elastic"] == 2 and by_truth.loc["faint", BOUND_MISSES] == 1
     assert by_truth.loc["faint", "cases"] == 2  # the misses are not cases of their own
     checked = {c["check"]: c for c in checks(coverage_table(case_table(records), 0.95),
-                                             confusion, "4")}  # fmt: skip
+                                             confusion, 0.95)}  # fmt: skip
     assert checked["faint: a wrong model named"]["value"] == 0.5
     assert checked["hard: a wrong model named"]["value"] == 1.0
     assert checked["elastic: a wrong model named"]["value"] == 0.0
@@ -186,12 +187,16 @@ def test_coverage_is_checked_at_two_levels_too_wide_as_well_as_too_narrow():
         scan["inner_holds_truth"] = True
     coverage = coverage_table(case_table(records), 0.95)
     assert sorted(coverage["level"]) == [0.68, 0.95]
-    checked = {c["check"]: c for c in checks(coverage, confusion_table(records), "4")}
-    outer = "coverage of the 95% p_y_mpa intervals, within 2 binomial se of nominal"
-    inner = "coverage of the 68% p_y_mpa intervals, within 2 binomial se of nominal"
+    checked = {c["check"]: c for c in checks(coverage, confusion_table(records), 0.95)}
+    outer = (
+        "coverage of the 95% p_y_mpa intervals of plastic truths, within 2 binomial se of nominal"
+    )
+    inner = (
+        "coverage of the 68% p_y_mpa intervals of plastic truths, within 2 binomial se of nominal"
+    )
     assert checked[outer]["met"] and not checked[inner]["met"]
     for r in records[:3]:
         r["scans"]["penetration_hardness"]["inner_holds_truth"] = False
     coverage = coverage_table(case_table(records), 0.95)
-    checked = {c["check"]: c for c in checks(coverage, confusion_table(records), "4")}
+    checked = {c["check"]: c for c in checks(coverage, confusion_table(records), 0.95)}
     assert checked[inner]["met"] and checked[inner]["value"] == pytest.approx(0.7)

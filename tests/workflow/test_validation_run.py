@@ -80,3 +80,18 @@ def test_the_tables_count_the_records(validation, records):
         summary.splitlines()[0].startswith("# Validation") and "All targets met: **yes**" in summary
     )
     assert (validation / "intervals.png").stat().st_size > 10_000
+
+
+def test_a_truth_from_another_solver_is_judged_and_says_whose_it_is(records):
+    """ContactMechanics' elastic truth (config/test.yaml: at 2x) runs through the workflow's
+    own job, records its solver's release, and is named elastic, with its bounds open above
+    (the verdict's one-sided bounds hold it)."""
+    theirs = [r for r in records if r["truth"] == "elastic_cm"]
+    assert len(theirs) == 2
+    for record in theirs:
+        assert record["truth_solver"].startswith("ContactMechanics 1.")
+        assert record["ratio_solved"] >= 2.0
+        assert record["verdict"] == "elastic", record["why"]
+        assert all(scan["interval"][1] is None for scan in record["scans"].values())
+    ours = {r["truth_solver"] for r in records if r["truth"] != "elastic_cm"}
+    assert len(ours) == 1 and ours.pop().startswith("amontons ")

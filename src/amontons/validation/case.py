@@ -17,7 +17,13 @@ from amontons.simulate.scan_best import ScanBest
 from amontons.simulate.scan_criterion import TooFewLoads
 from amontons.validation.cases import Case, Truth
 from amontons.validation.study import CaseStudy, ScanAnswer, StudySettings, judge_case
-from amontons.validation.truth import Sphere, case_rng, grids_of, measure_truth
+from amontons.validation.truth import (
+    Sphere,
+    case_rng,
+    grids_of,
+    measure_truth,
+    truth_solver_label,
+)
 
 # the verdict where the data keep more than one model
 NOT_DECIDED = "not decided"
@@ -83,6 +89,8 @@ def run_case(
         "signal": case.truth.signal,
         "seed": case.seed,
         "ratio": case.ratio,
+        "comparison": case.comparison,
+        "truth_solver": truth_solver_label(case),
         "ratio_solved": grids.ratio,
         "truth_pixel_nm": grids.truth_pixel_m * 1e9,
         "study_pixel_nm": grids.study_pixel_m * 1e9,

@@ -23,6 +23,14 @@ CLEAR = "clear"
 BELOW_MODEL_ERROR = "below model error"
 NO_PLASTICITY = "none"
 SIGNALS = (CLEAR, BELOW_MODEL_ERROR, NO_PLASTICITY)
+# who solves a truth: our own solver, or ContactMechanics (amontons.validation.independent),
+# which has no contact hardening
+AMONTONS = "amontons"
+CONTACTMECHANICS = "contactmechanics"
+SOLVERS = {
+    AMONTONS: TRUTH_MODELS,
+    CONTACTMECHANICS: (models.ELASTIC.name, models.PENETRATION_HARDNESS.name),
+}
 
 
 @dataclass(frozen=True)
@@ -30,12 +38,16 @@ class Truth:
     """A contact model and its parameter's value (config units: p_y_mpa, k_mpa_per_nm; None
     for the elastic truth), under ``name``; ``signal``: whether its areas differ from the
     other models' by more than the study's model error ('clear'), less ('below model
-    error') or not at all ('none': an elastic truth)."""
+    error') or not at all ('none': an elastic truth); ``solver``: who solves it
+    (:data:`SOLVERS`); ``ratio``: its own truth-to-study pixel ratio where the study's
+    default is out of reach for its solver (None: the default)."""
 
     name: str
     model: str
     value: float | None
     signal: str
+    solver: str = AMONTONS
+    ratio: float | None = None
 
     def __post_init__(self):
         if self.model not in TRUTH_MODELS:
@@ -47,6 +59,11 @@ class Truth:
             raise ValueError(
                 f"validation truth {self.name!r}: signal = {self.signal!r}; expected one of "
                 f"{SIGNALS}"
+            )
+        if self.model not in SOLVERS.get(self.solver, ()):
+            raise ValueError(
+                f"validation truth {self.name!r}: solver = {self.solver!r} for a {self.model} "
+                f"truth; expected one of {[k for k, v in SOLVERS.items() if self.model in v]}"
             )
         if (self.value is None) != (self.parameter is None):
             raise ValueError(
@@ -63,16 +80,26 @@ class Truth:
         model = entry["model"]
         parameter = PARAMETER_OF.get(model)
         value = None if parameter is None else entry.get(parameter)
-        return cls(name, model, None if value is None else float(value), entry["signal"])
+        ratio = entry.get("ratio")
+        return cls(
+            name,
+            model,
+            None if value is None else float(value),
+            entry["signal"],
+            entry.get("solver", AMONTONS),
+            None if ratio is None else float(ratio),
+        )
 
 
 @dataclass(frozen=True)
 class Case:
-    """One truth on one seed's sphere, solved ``ratio`` times finer in pixel than the study."""
+    """One truth on one seed's sphere, solved ``ratio`` times finer in pixel than the study;
+    ``comparison``: one of the comparison ratios' cases (reported, not held to the targets)."""
 
     truth: Truth
     seed: int
     ratio: float
+    comparison: bool = False
 
     @property
     def name(self) -> str:
@@ -91,16 +118,15 @@ def truths_of(validation: Mapping) -> dict[str, Truth]:
 
 
 def cases_of(validation: Mapping) -> list[Case]:
-    """Every case of the study: each truth at ``truth_pixel_ratio`` over ``seeds`` seeds, and
-    the truths ``comparison_truths`` again at each of ``comparison_ratios`` (the default
-    reproduction's truth against its study, now and before: what a truth close to the study's
-    grid does)."""
+    """Every case of the study: each truth at its own ratio, or else ``truth_pixel_ratio``,
+    over ``seeds`` seeds, and the truths ``comparison_truths`` again at each of
+    ``comparison_ratios`` (the default reproduction's truth against its study, now and
+    before: what a truth close to the study's grid does)."""
     truths = truths_of(validation)
     first = validation["first_seed"]
     seeds = range(first, first + validation["seeds"])
-    cases = [
-        Case(t, s, float(validation["truth_pixel_ratio"])) for t in truths.values() for s in seeds
-    ]
+    default = float(validation["truth_pixel_ratio"])
+    cases = [Case(t, s, t.ratio or default) for t in truths.values() for s in seeds]
     for name in validation["comparison_truths"]:
         if name not in truths:
             raise ValueError(
@@ -108,7 +134,7 @@ def cases_of(validation: Mapping) -> list[Case]:
                 f"{list(truths)}"
             )
         cases += [
-            Case(truths[name], s, float(ratio))
+            Case(truths[name], s, float(ratio), comparison=True)
             for ratio in validation["comparison_ratios"]
             for s in seeds
         ]

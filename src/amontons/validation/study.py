@@ -30,7 +30,12 @@ from amontons.simulate.model_error import (
 )
 from amontons.simulate.render import render_load_series
 from amontons.simulate.scan import log_area_distance
-from amontons.simulate.scan_best import ScanBest, ScanPoint, best_scan_value
+from amontons.simulate.scan_best import (
+    ScanBest,
+    ScanPoint,
+    best_scan_value,
+    floored_log_residuals,
+)
 from amontons.simulate.scan_criterion import SD_FLOOR, Criterion, TooFewLoads
 from amontons.simulate.scan_grid import ScanError, scan_values
 from amontons.simulate.scan_refine import refine_scan
@@ -203,10 +208,15 @@ def judge_elastic_limit(study: CaseStudy) -> ElasticLimit:
     """The elastic model solved at the study's pixel and judged with its own model error, as
     the scan job judges it (amontons.simulate.scan_job.solve_elastic_limit)."""
     limit = study.solve(ELASTIC.name, None)
+    if limit.fields is None:
+        raise ValueError("the elastic contact outgrew the study's window: no elastic limit")
     error, record = model_error(study, ELASTIC.name, limit, study.settings.judgement)
     criterion = Criterion.of_measured(study.loads_mn, [a * 1e12 for a in study.measured_m2], error)
-    chi2 = criterion.chi2(limit.point.residuals, max(criterion.scatter_sd, SD_FLOOR))
-    return ElasticLimit(chi2, record, limit.point.distance)
+    residuals = floored_log_residuals(
+        limit.rendered_m2, study.measured_m2, study.sphere.image_pixel_m**2
+    )
+    chi2 = criterion.chi2(residuals, max(criterion.scatter_sd, SD_FLOOR))
+    return ElasticLimit(chi2, record, math.sqrt(sum(r * r for r in residuals) / len(residuals)))
 
 
 @dataclass(frozen=True)
@@ -285,7 +295,7 @@ def decision_of(answers: Sequence[ScanAnswer], elastic: ElasticLimit) -> Decisio
         {a.model: a.best.chi2_elastic_end_measured for a in answers},
         max(a.best.rise for a in answers),
         min(a.best.n_loads for a in answers),
-        elastic.chi2,
+        {a.model: elastic.chi2 for a in answers},  # both scans solve on the study's grid
     )
 
 

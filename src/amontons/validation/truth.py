@@ -15,6 +15,7 @@ import time
 import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass
+from importlib.metadata import version
 
 import numpy as np
 
@@ -26,7 +27,8 @@ from amontons.physics import hertz
 from amontons.physics.emission import confined_emission
 from amontons.simulate.grid import PixelAverager
 from amontons.simulate.render import image_side_px
-from amontons.validation.cases import Case, Truth
+from amontons.validation.cases import CONTACTMECHANICS, Case, Truth
+from amontons.validation.independent import contactmechanics_load_series, solver_label
 from amontons.virtual.fluorescence import render_fluorescence
 from amontons.virtual.rough_contact import HARDENING_RADIUS_GUESS, fast_even
 from amontons.virtual.roughness import Roughness, synthesize
@@ -151,14 +153,22 @@ class Measured:
         return [c.area_m2 for c in self.contacts]
 
 
-def measure_truth(
-    sphere: Sphere, grids: Grids, case: Case, tol: float, otsu: OtsuSettings
-) -> Measured:
-    """Solve the case's truth on the fine grid at ``tol`` and image every load."""
-    heights = fine_surface(sphere, grids, case)
-    start = time.perf_counter()
+def solve_truth(sphere: Sphere, grids: Grids, case: Case, heights: np.ndarray, tol: float):
+    """The truth's load series on the fine grid (each load's pressure, contact, area and mean
+    pressure), by the truth's solver: ours, or ContactMechanics
+    (amontons.validation.independent), at ``tol``."""
+    if case.truth.solver == CONTACTMECHANICS:
+        hardness = truth_law(case.truth)
+        return contactmechanics_load_series(
+            heights,
+            grids.truth_pixel_m,
+            sphere.e_star_pa,
+            list(sphere.loads_n),
+            None if hardness is None else hardness.p_y,
+            tol,
+        )
     try:
-        results = solve_load_series(
+        return solve_load_series(
             heights,
             grids.truth_pixel_m,
             sphere.e_star_pa,
@@ -171,6 +181,22 @@ def measure_truth(
             f"validation case {case.name}: the true contact reaches the window's edge "
             f"({error}); expected a larger validation.window_factor"
         ) from error
+
+
+def truth_solver_label(case: Case) -> str:
+    """Who solved the case's truth, with the release: ContactMechanics', or ours."""
+    if case.truth.solver == CONTACTMECHANICS:
+        return solver_label()
+    return f"amontons {version('amontons')}"
+
+
+def measure_truth(
+    sphere: Sphere, grids: Grids, case: Case, tol: float, otsu: OtsuSettings
+) -> Measured:
+    """Solve the case's truth on the fine grid at ``tol`` and image every load."""
+    heights = fine_surface(sphere, grids, case)
+    start = time.perf_counter()
+    results = solve_truth(sphere, grids, case, heights, tol)
     wall = time.perf_counter() - start
     side = image_side_px(grids.window_m, sphere.image_pixel_m)
     average = PixelAverager(heights.shape, grids.truth_pixel_m, (side, side), sphere.image_pixel_m)
