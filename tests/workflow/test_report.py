@@ -125,6 +125,11 @@ def test_the_first_page_opens_with_the_verdict_read_from_the_model_tables(small_
     verdict = cells["exponent inside the measured 95% interval"]
     assert verdict["PS"] == "contact hardening only"
     assert verdict["glass"].endswith("not decided")
+    # by the areas, glass, which does not flow, is named elastic (issue 76): no plastic model
+    # improves on it by more than the quantile (a gain of 1.6 against 5.5 on the machine that
+    # recorded it), while PS's hardening improves on it by 530
+    assert cells[DECIDED]["PS"] == "contact hardening only"
+    assert cells[DECIDED]["glass"].startswith("elastic: no flow detected")
 
 
 def test_the_first_page_shows_fig_b13_then_each_fig_b12_after_the_table(small_run, report_html):
@@ -145,22 +150,24 @@ def test_the_first_page_shows_fig_b13_then_each_fig_b12_after_the_table(small_ru
 
 
 def test_every_scan_states_an_estimate_inside_its_own_interval(small_run):
-    """Each scan's best.json: the estimate lies inside its interval (an open end bounds
-    nothing), the grid's best is named as such, and the model table gives the same estimate
-    and interval beside the grid's best value (its `value`)."""
+    """Each scan's best.json: the estimate lies inside its interval, and an interval open at
+    an end is a bound with no estimate (issue 76); the grid's best is named as such, and the
+    model table gives the same estimate and interval beside the grid's best value (its
+    `value`)."""
     for sphere in ("PS", "glass"):
         models = pd.read_csv(results(small_run, sphere, "models.csv"))
         for scan in ("k", "p_y"):
             best = scan_best(small_run, sphere, scan)
             low, high = best["interval"]
             print(sphere, scan, best["estimate"], [low, high], "grid", best["grid_best"])
-            assert (low is None or low <= best["estimate"]) and (
-                high is None or best["estimate"] <= high
-            )
-            assert best["grid_best"] == best["best"] and best["grid_best"] in best["values"]
             row = models[models["source"] == f"scan {scan}, best value"].iloc[0]
+            if low is None or high is None:
+                assert best["estimate"] is None and pd.isna(row["estimate"])
+            else:
+                assert low <= best["estimate"] <= high
+                assert row["estimate"] == best["estimate"]
+            assert best["grid_best"] == best["best"] and best["grid_best"] in best["values"]
             assert row["value"] == best["grid_best"]
-            assert row["estimate"] == best["estimate"]
             for end, column in ((low, "estimate_low"), (high, "estimate_high")):
                 assert (pd.isna(row[column]) and end is None) or row[column] == end
     assert "value_low" not in models and "value_high" not in models

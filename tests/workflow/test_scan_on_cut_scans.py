@@ -119,6 +119,6 @@ def _a_scan_with_nothing_to_judge_says_why(project, models):
     verdict = pd.read_csv(project / "results" / SMALL / "verdict.csv").set_index("sphere")
     assert verdict.loc["PS-noload", "penetration_hardness_source"] == "scan p_y, not decided"
     assert pd.isna(verdict.loc["PS-noload", "p_y_estimate"])
-    assert pd.notna(verdict.loc["PS-cutscan", "p_y_estimate"])
+    assert pd.notna(verdict.loc["PS-cutscan", "p_y_grid_best"])  # judged (a bound: no estimate)
     summary = (project / "results" / SMALL / "summary.md").read_text()
     assert f"not decided: {best['not_decided']}" in summary
