@@ -28,7 +28,6 @@ import numpy as np
 
 from amontons.simulate.scan_criterion import (
     MIN_LOADS,
-    SD_FLOOR,
     Criterion,
     ModelError,
     TooFewLoads,
@@ -46,6 +45,7 @@ __all__ = [
     "finite_or_none",
     "floored_log_residuals",
     "model_error_of_record",
+    "rms",
     "interval_resolution",
     "interval_width_ln",
     "measured_rows",
@@ -261,8 +261,7 @@ def chi2_of_points(
     """(χ² of every point, in the order of ``points``, under the random part Birge-inflated at
     the best point, and under the measured scatter; that random part; the index of least
     χ²)."""
-    floor = max(criterion.scatter_sd, SD_FLOOR)
-    measured = np.array([criterion.chi2(p.residuals, floor) for p in points])
+    measured = np.array([criterion.chi2_measured(p.residuals) for p in points])
     sd = criterion.random_sd_used(
         points[_best_index(measured, points, range(len(points)))].residuals
     )
@@ -369,6 +368,12 @@ def criterion_of_record(record: Mapping, model_error: ModelError | None = None) 
     )
 
 
+def rms(residuals: Sequence[float]) -> float:
+    """The root-mean-square of ``residuals`` (ln area): D of residuals already formed, such as
+    :func:`floored_log_residuals`'s."""
+    return math.sqrt(sum(r * r for r in residuals) / len(residuals))
+
+
 def model_error_of_record(record: Mapping | None) -> ModelError | None:
     """The model error a scan job counted (refinement.json's ``model_error``: measured, or
     stated where it could not be measured); None where it records none."""
@@ -382,7 +387,7 @@ def elastic_limit_chi2(record: Mapping, elastic_limit: Mapping | None) -> float 
     if not elastic_limit or not elastic_limit.get("solved"):
         return None
     criterion = criterion_of_record(record, model_error_of_record(elastic_limit["model_error"]))
-    return criterion.chi2(elastic_limit["residuals"], max(criterion.scatter_sd, SD_FLOOR))
+    return criterion.chi2_measured(elastic_limit["residuals"])
 
 
 def point_from_record(record: Mapping, n_loads: int) -> ScanPoint:

@@ -155,6 +155,17 @@ class Criterion:
     def n(self) -> int:
         return len(self.loads_mn)
 
+    @property
+    def measured_sd(self) -> float:
+        """The measured scatter, floored at :data:`SD_FLOOR` (ln area): the random part a
+        value is judged with before any Birge inflation."""
+        return max(self.scatter_sd, SD_FLOOR)
+
+    def chi2_measured(self, residuals: Sequence[float]) -> float:
+        """χ² of one value's residuals under the measured scatter (:attr:`measured_sd`): what
+        the verdict compares the models by."""
+        return self.chi2(residuals, self.measured_sd)
+
     @cached_property
     def shared_covariance(self) -> np.ndarray:
         """The model error's part of C, shared by every load: its offset, slope and modes
@@ -193,7 +204,7 @@ class Criterion:
         n − 1 degrees of freedom), the scatter that brings χ²_min to n − 1 (the Birge ratio:
         the model's misfit, not the measurement, then sets the scatter, and a misfit does
         not shrink the interval). Floor :data:`SD_FLOOR`."""
-        sd = max(self.scatter_sd, SD_FLOOR)
+        sd = self.measured_sd
         dof = self.n - 1
         if not self.chi2(best_residuals, sd) > dof:
             return sd
@@ -233,7 +244,7 @@ class Criterion:
         ``"chi2"`` quantile."""
         if self.quantile == "chi2":
             return float(stats.chi2.ppf(confidence, 1))
-        sd = max(self.scatter_sd, SD_FLOOR) if random_sd is None else random_sd
+        sd = self.measured_sd if random_sd is None else random_sd
         dof = self.effective_dof(direction, sd)
         if not np.isfinite(dof) or dof > 1e6:
             return float(stats.chi2.ppf(confidence, 1))

@@ -38,6 +38,7 @@ from amontons.simulate.scan_best import (
     criterion_of_record,
     floored_log_residuals,
     point_from_record,
+    rms,
 )
 from amontons.simulate.scan_criterion import TooFewLoads
 from amontons.simulate.scan_grid import ScanError, value_label
@@ -219,12 +220,18 @@ def _solve_from(context: ScanContext, scene, indenter, start: ScanStart, value: 
         log.info("%s = %g: %d of %d loads start from the neighbour's pressures (the value "
                  "before, or the elastic scene for the first)", context.scan["parameter"],
                  value, started, len(scene.loads_n))  # fmt: skip
+    return _solve(context, scene, starts if start.loads_n else None)
+
+
+def _solve(context: ScanContext, scene, warm_starts=None):
+    """The scene's load series on its window of the levelled map, with the scan's threads
+    and solver engine; ``warm_starts``: a starting pressure (Pa) or None per load."""
     return solve_scene(
         scene,
-        indenter,
+        context.indenter(scene),
         threads=context.threads,
         backend=context.solver_backend,
-        warm_starts=starts if start.loads_n else None,
+        warm_starts=warm_starts,
     )
 
 
@@ -405,12 +412,7 @@ def estimate_model_error(
     )
     psf_change, psf_note = psf_share(context, best)
     try:
-        check = solve_scene(
-            check_scene,
-            context.indenter(check_scene),
-            threads=context.threads,
-            backend=context.solver_backend,
-        )
+        check = _solve(context, check_scene)
         check_m2 = rendered_areas_m2(context, check_scene, check, context.psf_fwhm_m)
         bias = richardson_log_bias(
             _at_measured(best.rendered_m2, best.record),
@@ -468,12 +470,7 @@ def solve_elastic_limit(context: ScanContext, best: Solved, loads_mn, judgement:
     false and why (the verdict then reads the scan's elastic end alone)."""
     scene = replace(best.scene, model=ELASTIC.name, parameter_si=None)
     try:
-        solution = solve_scene(
-            scene,
-            context.indenter(scene),
-            threads=context.threads,
-            backend=context.solver_backend,
-        )
+        solution = _solve(context, scene)
         compared = _render_and_compare(context, scene, context.base_config, solution)
     except (ConvergenceError, FreeBoundaryError, ScanError, SceneError) as error:
         log.warning("the elastic limit not solved: %s", error)
@@ -487,7 +484,7 @@ def solve_elastic_limit(context: ScanContext, best: Solved, loads_mn, judgement:
         [row.measured_area_m2 for row in compared.used],
         context.pixel_m**2,
     )
-    distance = math.sqrt(sum(r * r for r in residuals) / len(residuals))
+    distance = rms(residuals)
     log.info("the elastic limit: D = %.4f over %d loads", distance, len(residuals))
     return {
         "solved": True,

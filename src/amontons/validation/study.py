@@ -35,8 +35,9 @@ from amontons.simulate.scan_best import (
     ScanPoint,
     best_scan_value,
     floored_log_residuals,
+    rms,
 )
-from amontons.simulate.scan_criterion import SD_FLOOR, Criterion, TooFewLoads
+from amontons.simulate.scan_criterion import Criterion, TooFewLoads
 from amontons.simulate.scan_grid import ScanError, scan_values
 from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.surface import area_average
@@ -215,8 +216,8 @@ def judge_elastic_limit(study: CaseStudy) -> ElasticLimit:
     residuals = floored_log_residuals(
         limit.rendered_m2, study.measured_m2, study.sphere.image_pixel_m**2
     )
-    chi2 = criterion.chi2(residuals, max(criterion.scatter_sd, SD_FLOOR))
-    return ElasticLimit(chi2, record, math.sqrt(sum(r * r for r in residuals) / len(residuals)))
+    chi2 = criterion.chi2_measured(residuals)
+    return ElasticLimit(chi2, record, rms(residuals))
 
 
 @dataclass(frozen=True)
