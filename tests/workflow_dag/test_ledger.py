@@ -72,6 +72,26 @@ def test_changed_data_or_config_let_the_sphere_back(measured_ps, tmp_path):
     assert not measured_ps().spheres.held_out
 
 
+def test_a_job_stopped_at_its_runtime_holds_nothing_out(measured_ps):
+    """SLURM's TIMEOUT says nothing about the sphere's data, and the runtime the user raises
+    is not in the data stamp: the sphere stays in the tables and its job runs again."""
+    run = measured_ps()
+    job = FailedJob(
+        "simulate_scene",
+        "PS",
+        "PS",
+        "logs/small/PS/PS/scenes/elastic/simulate_scene.log",
+        "stopped by SLURM (TIMEOUT) at its runtime of 1 min: raise it, e.g. "
+        "--set-resources simulate_scene:runtime=2",
+        "results/small/PS/PS/scenes/elastic/fields.h5",
+        run.data_stamp("PS"),
+        limit="runtime",
+    )
+    write_ledger(PATHS, [job])
+    assert read_failed_jobs(LEDGER) == [job]
+    assert not measured_ps().spheres.held_out
+
+
 def test_a_job_that_has_made_its_outputs_holds_nothing_out(measured_ps):
     _ledger_of_ps(measured_ps())
     Path(AREA).parent.mkdir(parents=True)

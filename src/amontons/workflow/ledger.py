@@ -16,6 +16,11 @@ that sees it:
 * when its job succeeds: an entry whose output files are all there no longer counts. That
   run's tables were made without the sphere, and the next run puts it back, as the run says.
 
+A job that a batch system stopped at one of its resources (its runtime, its memory) holds
+nothing out: its sphere's data are not in question, and what the user changes before the
+next run, the resource, is not in the data stamp. The next run runs the job again inside the
+tables; the run says which resource to raise.
+
 A run that ends rewrites the ledger: this run's failures, and the earlier entries that still
 hold (outputs missing, not failed again in this run, e.g. of a material this run did not
 target). A run without a failure that leaves no entry removes it.
@@ -54,8 +59,13 @@ def is_pending(job: FailedJob, workdir: Path = Path(".")) -> bool:
 
 def holds(job: FailedJob, stamp: Stamp, workdir: Path = Path(".")) -> bool:
     """Whether a ledger entry holds its sphere out of this run's tables: a sphere's job, still
-    pending, on the same data as when it failed."""
-    return bool(job.sphere) and is_pending(job, workdir) and job.data_stamp == stamp(job.sphere)
+    pending, on the same data as when it failed, and not stopped at a resource."""
+    return (
+        bool(job.sphere)
+        and not job.limit
+        and is_pending(job, workdir)
+        and job.data_stamp == stamp(job.sphere)
+    )
 
 
 def held_out(
@@ -108,15 +118,21 @@ def _logs_text(snakemake_logs: str | Path | list) -> str:
 
 
 def _rerun_lines(jobs: list[FailedJob], held: Iterable[str]) -> list[str]:
-    """What the next run will do about this run's failed spheres."""
+    """What the next run will do about this run's failed spheres: a job stopped at a resource
+    runs again with it raised; a sphere with another failure is held out."""
     by_material: dict[str, set[str]] = {}
     for job in jobs:
-        if job.sphere and job.sphere not in held:
+        if job.sphere and job.sphere not in held and not job.limit:
             by_material.setdefault(job.material, set()).add(job.sphere)
+    limits = sorted({(job.rule, job.limit) for job in jobs if job.limit})
     return [
         f"run again to make {material}'s tables, figures, summary and report without "
         f"{', '.join(sorted(spheres))}, marked as failed (or fix the data first)"
         for material, spheres in sorted(by_material.items())
+    ] + [
+        f"raise {rule}'s {limit} and run again: only the jobs that are missing run, and no "
+        "sphere is held out for it"
+        for rule, limit in limits
     ]
 
 
