@@ -1,6 +1,8 @@
 # Two entry points, each doing its own set-up from a fresh clone with only Python 3.11 and pip:
 #   make reproduce   full reproduction (config/config.yaml) + HTML report
 #   make test        the whole test suite (units, solver oracles, lint, dry runs, small-data run)
+# and, as root where Debian's packages can be installed (CI runs it after make test):
+#   make test-cluster the small run through a real one-node SLURM (tests/cluster, docs/cluster.md)
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -12,7 +14,7 @@ BASE   ?= HEAD
 # its last tables, its report) that a third process fills (13.6 against 14.2 min on 2 cores).
 TEST_WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
 
-.PHONY: reproduce test install golden-bits clean-venv
+.PHONY: reproduce test test-cluster install golden-bits clean-venv
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -53,6 +55,16 @@ test: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadscope \
 		--no-loadscope-reorder; tests=$$?; \
 	wait $$warm || { echo "make test: the kernel warm-up failed" >&2; exit 1; }; exit $$tests
+
+# The workflow through a real one-node SLURM with its accounting database (tests/cluster):
+# it installs and starts system services as root, which make test may not do on a user's
+# machine. The preflight installs what is missing, or stops at once saying why (no root, no
+# package registry), while the kernels compile; the tests start the cluster and stop it.
+test-cluster: $(STAMP)
+	$(BIN)/python -c "from amontons.contact.kernel_cache import main; main()" & warm=$$!; \
+	tests/cluster/start_slurm.sh preflight || { kill $$warm; exit 2; }; \
+	wait $$warm || { echo "make test-cluster: the kernel warm-up failed" >&2; exit 1; }; \
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest --cluster tests/cluster
 
 # A rebuild's same-machine check: the golden cases solved by BASE's solver and by the working
 # tree's, here, compared to the last bit (tests/contact/golden/same_bits.py).

@@ -9,6 +9,21 @@ from amontons.config import load_schema
 REPO = Path(__file__).resolve().parents[1]
 
 
+def pytest_addoption(parser):
+    parser.addoption(
+        "--cluster",
+        action="store_true",
+        help="collect tests/cluster: a one-node SLURM started as root (make test-cluster)",
+    )
+
+
+def pytest_ignore_collect(collection_path, config):
+    """tests/cluster only under --cluster (make test-cluster), never in make test."""
+    if collection_path == REPO / "tests" / "cluster" and not config.getoption("--cluster"):
+        return True
+    return None
+
+
 @pytest.fixture(scope="session")
 def repo() -> Path:
     return REPO

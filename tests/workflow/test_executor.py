@@ -10,7 +10,6 @@ and the PS sphere are left to the local run to keep the added time to ~2 min (11
 shared cores; the whole glass sphere, 29 jobs, took 3.5 min).
 """
 
-import json
 import os
 import re
 import shutil
@@ -18,9 +17,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import h5py
-import numpy as np
 import pytest
+
+from .same_output import assert_same_output
 
 pytestmark = pytest.mark.workflow
 
@@ -53,56 +52,6 @@ def cluster_run(project: Path, logdir: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         command, cwd=project, env=env, capture_output=True, text=True, timeout=1200
     )
-
-
-def without_wall_times(value):
-    """A JSON value with every ``wall_time_s`` (a measured duration) left out."""
-    if isinstance(value, dict):
-        return {k: without_wall_times(v) for k, v in value.items() if k != "wall_time_s"}
-    if isinstance(value, list):
-        return [without_wall_times(v) for v in value]
-    return value
-
-
-def h5_contents(path: Path) -> dict:
-    """Every dataset (values) and attribute of an HDF5 file, by path, but the attributes
-    ``wall_time_s`` (measured durations)."""
-    out = {}
-    with h5py.File(path, "r") as f:
-        out["/attrs"] = without_wall_times(dict(f.attrs))
-
-        def visit(name, obj):
-            out[f"{name}/attrs"] = without_wall_times(dict(obj.attrs))
-            if isinstance(obj, h5py.Dataset):
-                out[name] = obj[()]
-
-        f.visititems(visit)
-    return out
-
-
-def assert_same_output(ours: Path, reference: Path) -> None:
-    """``ours`` equals ``reference`` byte for byte, except where the bytes carry the time:
-    PDF (creation date; the PNG of the same figure is compared), HDF5 (object timestamps;
-    every dataset and attribute but the wall times is compared exactly instead) and
-    solve.json (wall times; the rest compared)."""
-    if ours.suffix == ".pdf":
-        return
-    if ours.suffix == ".h5":
-        a, b = h5_contents(ours), h5_contents(reference)
-        assert a.keys() == b.keys(), ours
-        for key in a:
-            if isinstance(a[key], dict):
-                assert a[key].keys() == b[key].keys(), (ours, key)
-                for name in a[key]:
-                    assert np.array_equal(a[key][name], b[key][name]), (ours, key, name)
-            else:
-                assert np.array_equal(a[key], b[key]), (ours, key)
-        return
-    if ours.name == "solve.json":
-        a, b = (json.loads(p.read_text()) for p in (ours, reference))
-        assert without_wall_times(a) == without_wall_times(b), ours
-        return
-    assert ours.read_bytes() == reference.read_bytes(), ours
 
 
 def test_cluster_executor_gives_the_local_run_byte_for_byte(small_run, tmp_path):
