@@ -59,12 +59,14 @@ test: $(STAMP)
 # The workflow through a real one-node SLURM with its accounting database (tests/cluster):
 # it installs and starts system services as root, which make test may not do on a user's
 # machine. The preflight installs what is missing, or stops at once saying why (no root, no
-# package registry), while the kernels compile; the tests start the cluster and stop it.
+# package registry), while the kernels compile (if cold); the tests start the cluster and
+# stop it, their first solve waiting for the kernels as make test's do.
 test-cluster: $(STAMP)
 	$(BIN)/python -c "from amontons.contact.kernel_cache import main; main()" & warm=$$!; \
 	tests/cluster/start_slurm.sh preflight || { kill $$warm; exit 2; }; \
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest --cluster tests/cluster; tests=$$?; \
 	wait $$warm || { echo "make test-cluster: the kernel warm-up failed" >&2; exit 1; }; \
-	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest --cluster tests/cluster
+	exit $$tests
 
 # A rebuild's same-machine check: the golden cases solved by BASE's solver and by the working
 # tree's, here, compared to the last bit (tests/contact/golden/same_bits.py).
