@@ -9,6 +9,7 @@ import pandas as pd
 
 from amontons.io.files import atomic_path, read_json
 from amontons.runlog import run_logged
+from amontons.study.decision import ELASTIC
 from amontons.study.summary import (
     amontons_headline,
     curvature_headlines,
@@ -38,9 +39,10 @@ def main(
     headlines = []
     for sphere, fit_path in layout["fits"].items():
         headlines.append(measured_headline(sphere, read_json(fit_path), fit_path))
-        for path in layout["bests"][sphere].values():
-            headlines.append(scan_headline(sphere, read_json(path), path))
         rows = [] if verdict is None else verdict[verdict["sphere"] == sphere].to_dict("records")
+        elastic = any(row.get("decided") == ELASTIC for row in rows)
+        for path in layout["bests"][sphere].values():
+            headlines.append(scan_headline(sphere, read_json(path), path, elastic))
         for row in rows:  # none for a sphere whose data allowed no scan
             headlines += model_headlines(row, layout["verdict"], layout["models"][row["material"]])
     for material, table in amontons.items():

@@ -123,6 +123,26 @@ def test_models_inside_the_measured_interval_are_all_named_and_none_singled_out(
     assert verdict_text(read_back) == "no model"
 
 
+def test_a_scan_of_a_sphere_named_elastic_is_quoted_as_its_bound():
+    """Where no flow is detected, a closed scan interval is no estimate: the headline states
+    its lower end as the verdict does, with no estimate and no upper end."""
+    best = {
+        "parameter": "p_y_mpa",
+        "estimate": 134.0,
+        "interval": [117.0, 150.0],
+        "grid_best": 130.0,
+        "at_scan_edge": False,
+        "confidence": 0.95,
+    }
+    closed = scan_headline("glass", best, "glass/scans/p_y/best.json")
+    assert closed.value.startswith("134 (95% interval 117–150")
+    bound = scan_headline("glass", best, "glass/scans/p_y/best.json", elastic=True)
+    assert bound.value == (
+        "≥ 117 (95% bound; no flow detected, the answer is elastic; grid's best 130)"
+    )
+    assert "134" not in bound.value and "150" not in bound.value
+
+
 def test_a_best_json_without_the_estimate_is_named():
     with pytest.raises(SummaryError, match=r"scans/k/best\.json: no 'estimate'.*--forcerun"):
         scan_headline("PS", {"best": 4.472, "interval": [4.6, 6.0]}, "PS/scans/k/best.json")

@@ -188,3 +188,7 @@ def test_summary_names_the_file_of_every_number(small_run):
     (k_line,) = [line for line in headlines if line.startswith("- **PS: k of")]
     assert f"{significant(best['estimate'])} (95% interval {interval_text(low, high)}" in k_line
     assert "PS/PS/scans/k/best.json" in k_line
+    # glass is named elastic: its scans are quoted as the bounds the verdict states
+    glass_lines = [line for line in headlines if line.startswith("- **glass: ")]
+    scans = [line for line in glass_lines if "/scans/" in line]
+    assert scans and all("no flow detected, the answer is elastic" in line for line in scans)

@@ -437,9 +437,11 @@ def measured_headline(sphere: str, fit: Mapping, path: str) -> Headline:
     )
 
 
-def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
+def scan_headline(sphere: str, best: Mapping, path: str, elastic: bool = False) -> Headline:
     """A scan's estimate with its interval and the grid's best (best.json); for a scan not
-    decided, why."""
+    decided, why. Where the sphere's answer is ``elastic`` (no flow detected), the scan is
+    stated as the verdict states it: its interval's lower end as a bound, with no estimate
+    and no upper end (:func:`state_as_bounds`)."""
     if not is_decided(best):
         symbol, unit = symbol_and_unit(best)
         return Headline(
@@ -457,7 +459,12 @@ def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
     low, high = best["interval"]
     edge = "; the grid's best is at the scan's end" if best["at_scan_edge"] else ""
     grid = f"grid's best {significant(best['grid_best'])}{edge}"
-    if is_bound(low, high):
+    if elastic:
+        value = (
+            f"{interval_text(low, None)} ({best['confidence']:.0%} bound; no flow detected, "
+            f"the answer is elastic; {grid})"
+        )
+    elif is_bound(low, high):
         value = f"{interval_text(low, high)} ({best['confidence']:.0%} bound; {grid})"
     else:
         value = (
@@ -467,7 +474,7 @@ def scan_headline(sphere: str, best: Mapping, path: str) -> Headline:
     return Headline(
         f"{sphere}: {symbol} of {model_of_parameter(best['parameter']).label} ({unit})",
         value,
-        f"`{path}`: estimate, interval, grid_best",
+        f"`{path}`: {'interval' if elastic else 'estimate, interval'}, grid_best",
     )
 
 
