@@ -139,6 +139,7 @@ def runs(slurm, tmp_path_factory):
     left = {
         "failed": pd.read_csv(record, keep_default_na=False) if record.is_file() else None,
         "long_scene_made": (cluster / LONG_SCENE).exists(),
+        "glass_made": [target for target in GLASS_TARGETS if (cluster / target).is_file()],
     }
 
     image.write_bytes(intact)
@@ -177,32 +178,55 @@ def test_glass_through_slurm_gives_the_local_run_byte_for_byte(runs):
         assert_same_output(cluster / path, local / path)
 
 
-def test_a_failed_job_and_a_timeout_are_named_and_the_rest_runs(runs):
-    faulty, cluster = runs["faulty"], runs["cluster"]
+def slurm_states() -> list[str]:
+    """The state of every job the cluster's accounting database holds."""
+    out = subprocess.run(
+        ["sacct", "-X", "-n", "-P", "-o", "State"], capture_output=True, text=True, check=True
+    )
+    return out.stdout.split()
+
+
+def test_a_failed_job_is_named_once_and_the_other_sphere_runs(runs):
+    """PS's job fails on the broken file: the run exits non-zero and names it with its
+    sphere and error as a local run does (tests/workflow/test_corrupt_file.py), once, though
+    the failed cluster job's own log repeats it; every glass target was made in that run."""
+    faulty = runs["faulty"]
     assert faulty.returncode != 0
-    # PS's job fails on the broken file: named with its sphere, as a local run names it
-    assert re.search(
-        rf"sphere PS \(PS\): measure_contact_area failed: .*{re.escape(BROKEN)}", faulty.stderr
-    ), faulty.stderr[-3000:]
-    # SLURM's TIMEOUT: the rule, the sphere, the resource and how to raise it
+    named = re.findall(
+        rf"^sphere PS \(PS\): measure_contact_area failed: .*{re.escape(BROKEN)}.*$",
+        faulty.stderr,
+        re.M,
+    )
+    assert len(named) == 1, faulty.stderr[-3000:]
+    assert "not a readable TIFF" in named[0]
+    assert "run again to make PS's tables, figures, summary and report without PS" in (
+        faulty.stderr
+    )
+    assert runs["glass_made"] == GLASS_TARGETS
+    record = runs["failed"]
+    assert record is not None, "the run left no results/small/failed_jobs.csv"
+    assert ("PS", "measure_contact_area", "") in set(
+        zip(record["sphere"], record["rule"], record["limit"], strict=True)
+    )
+    assert "FAILED" in slurm_states()
+
+
+def test_a_job_past_its_runtime_is_named_with_the_resource_to_raise(runs):
+    """SLURM stops the scene at its 1 min (state TIMEOUT); its log holds no error, and the
+    run names the rule, the sphere, the resource and the option that raises it."""
+    faulty = runs["faulty"]
     assert (
         "sphere glass (glass): simulate_scene failed: stopped by SLURM (TIMEOUT) at its "
         "runtime of 1 min: raise it, e.g. --set-resources simulate_scene:runtime=2"
     ) in faulty.stderr
+    assert "SLURM status is: 'TIMEOUT'" in faulty.stderr
     assert "raise simulate_scene's runtime and run again" in faulty.stderr
-    record = runs["failed"]
-    assert record is not None, "the run left no results/small/failed_jobs.csv"
-    assert set(zip(record["sphere"], record["limit"], strict=True)) >= {
-        ("PS", ""),
-        ("glass", "runtime"),
-    }
     assert not runs["long_scene_made"]
-    # the other jobs ran: glass's targets are all there (compared in the test above)
-    assert all((cluster / target).is_file() for target in GLASS_TARGETS)
-    states = subprocess.run(
-        ["sacct", "-X", "-n", "-P", "-o", "State"], capture_output=True, text=True, check=True
-    ).stdout.split()
-    assert "TIMEOUT" in states and "FAILED" in states
+    record = runs["failed"]
+    assert ("glass", "simulate_scene", "runtime") in set(
+        zip(record["sphere"], record["rule"], record["limit"], strict=True)
+    )
+    assert "TIMEOUT" in slurm_states()
 
 
 def test_the_run_again_completes_only_what_is_missing(runs):
