@@ -7,6 +7,7 @@ if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
+from amontons.models import CONTACT_HARDENING
 from amontons.runlog import run_logged
 from amontons.virtual.experiment import generate_sphere
 from amontons.virtual.settings import InstrumentSettings, OutputFormats, SurfaceSettings
@@ -35,7 +36,7 @@ def main(
         diameter_m=diameter_mm * 1e-3,
         e_star_pa=e_star_gpa * 1e9,
         roughness_rms_m=roughness_rms_nm * 1e-9,
-        hardening_k_pa_per_m=hardening_k_mpa_per_nm * 1e15,
+        hardening_k_pa_per_m=hardening_k_mpa_per_nm * CONTACT_HARDENING.parameter.to_si,
         loads_n=[load * 1e-3 for load in loads_mn],
         pixel_m=pixel_nm * 1e-9,
         reflection_load_n=reflection_load_mn * 1e-3,

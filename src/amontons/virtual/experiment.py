@@ -256,7 +256,7 @@ def _forward_model_truth(
         ),
         "diameter_mm": diameter_m * 1e3,
         "e_star_gpa": e_star_pa * 1e-9,
-        CONTACT_HARDENING.parameter.sheet_column: k_pa_per_m * 1e-15,
+        CONTACT_HARDENING.parameter.sheet_column: k_pa_per_m * CONTACT_HARDENING.parameter.from_si,
         "roughness": _roughness_truth(roughness, solution),
         "solver": _solver_truth(solution, surface),
         "approach_nm": [r.displacement * 1e9 for r in solution.results],
