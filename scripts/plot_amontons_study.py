@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from amontons.io.files import read_json, write_table
+from amontons.models import CONTACT_HARDENING
 from amontons.runlog import run_logged
 from amontons.simulate.scan_record import is_decided
 from amontons.study.figures import BEST_K, plot_normalised_study
@@ -55,7 +56,7 @@ def main(amontons_paths, best_paths: dict, table_path, figure_paths, reference_l
         records += [
             {
                 "sphere": sphere,
-                "series": "hardening model",
+                "series": f"{CONTACT_HARDENING.name} model",
                 "load_over_ref": xi,
                 "area_over_ref": a,
                 "friction_over_ref": None,

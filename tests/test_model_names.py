@@ -4,10 +4,11 @@ the records (the configs, the docs and the tests may name them). The solver
 (amontons.contact) keeps its routes' own names and is not read. docs/contributing.md.
 
 A literal is a string constant (an f-string's text parts included; docstrings are docs) that
-is a one-word model name (``"hardening"``, ``"elastic"``; the same word in prose, "the
-elastic end", is physics), or in which a compound name or label appears as a whole token
-(``"penetration_hardness"``, ``"contact hardening"``, ``"Greenwood–Tripp"``), or a parameter
-key or sheet column appears at all (``"best_k_mpa_per_nm"``); but not
+names a model by its one-word name (``"hardening"``, ``": hardening"``, ``"hardening model"``;
+the same word in prose, "the elastic end", is physics), or in which a compound name or
+label appears as a whole token (``"penetration_hardness"``, ``"contact hardening"``,
+``"Greenwood–Tripp"``), or a parameter key or sheet column appears at all
+(``"best_k_mpa_per_nm"``); but not
 ``"elastic_displacement"`` or ``"hardening_sphere"`` (another name that begins with a
 model's)."""
 
@@ -42,8 +43,15 @@ def _compound_words() -> set[str]:
 
 def _plain_words() -> set[str]:
     """The models' names that are one plain word (``elastic``, ``hardening``): they count
-    where a literal is that word alone (a key, a name), not in prose ("the elastic end")."""
+    where a literal names the model by it (the word alone, between punctuation as in
+    ``": hardening"``, or as ``"hardening model"``), not in prose ("the elastic end")."""
     return {m.name for m in models.MODELS if m.name.isalpha()}
+
+
+def _names_by_plain_word(text: str, word: str) -> bool:
+    """Whether ``text``, its punctuation and spaces at either end aside, is ``word`` alone or
+    ``word`` followed by "model"."""
+    return re.fullmatch(rf"[\W_]*{re.escape(word)}(?: model)?[\W_]*", text) is not None
 
 
 def _inner_words() -> set[str]:
@@ -57,7 +65,7 @@ def _inner_words() -> set[str]:
 
 def named_in(text: str) -> list[str]:
     """The model, label, parameter or sheet-column names ``text`` writes out."""
-    found = [word for word in _plain_words() if text.strip() == word]
+    found = [word for word in _plain_words() if _names_by_plain_word(text, word)]
     for word in _compound_words():
         if re.search(rf"(?<![\w]){re.escape(word)}(?![\w])", text, flags=re.IGNORECASE):
             found.append(word)
@@ -132,6 +140,8 @@ def test_no_model_name_is_written_outside_its_record():
         'label = f"{sphere}: Greenwood–Tripp area"\n',
         'rows = {"elastic": [], "x": []}\n',
         'prior = row.get("hardness_mpa")\n',
+        'label = f"{sphere}: hardening"\n',
+        'row = {"series": "hardening model"}\n',
     ],
 )
 def test_a_planted_literal_is_found(tmp_path, planted):
@@ -145,6 +155,7 @@ def test_a_docstring_or_a_longer_name_is_not_a_literal(tmp_path):
     path.write_text(
         '"""Contact hardening and penetration_hardness, in words."""\n'
         'FIELD = "elastic_displacement"\nPROBLEM = "hardening_sphere"\n'
+        'WHY = "the elastic limit"\nFLOW = "no plastic model improves on the elastic model"\n'
     )
     assert literal_names_at(path) == []
 

@@ -269,7 +269,8 @@ def plot_normalised_study(
         axes[1].plot(x, friction, "o", color=line.get_color(), label=sphere)
         if sphere in models:
             mx, ma = models[sphere]
-            axes[0].plot(mx, ma, "-", color=line.get_color(), lw=1, label=f"{sphere}: hardening")
+            label = f"{sphere}: {CONTACT_HARDENING.name}"
+            axes[0].plot(mx, ma, "-", color=line.get_color(), lw=1, label=label)
     for ax, name, label in (
         (axes[0], "a) contact area", "A / A_ref"),
         (axes[1], "b) static friction", "F_s / F_s,ref"),
