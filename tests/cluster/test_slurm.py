@@ -3,20 +3,22 @@ start_slurm.sh, with its accounting database answering sacct, and profiles/slurm
 account and partition set as docs/cluster.md tells a user to set them. Jobs go through the
 SLURM executor plugin: sbatch, the group jobs, sacct, srun in each job.
 
-Two SLURM runs of the small data set, each held to what a local run does:
+One project, run twice through SLURM:
 
-1. The glass sphere from its raw files to its tables, figures and elastic scene (13 jobs,
-   as tests/workflow/test_executor.py runs them from the virtual experiment on; the raw files
-   are made beforehand, as a lab's instruments would have) beside two faults: the PS sphere
-   with a truncated fluorescence image (its job fails), and glass's penetration-hardness
-   scene at a fine preset given 1 min, which it needs about 2 min for (SLURM stops it:
-   TIMEOUT). Glass's outputs equal a local run's byte for byte; the run exits non-zero and
-   names both, the second with the rule, the sphere and the resource to raise.
-2. The file fixed and the runtime raised, the same command again: only the missing jobs run.
+1. The glass sphere from its virtual experiment to its tables, figures and elastic scene
+   (14 jobs, as tests/workflow/test_executor.py runs them), beside two faults of the PS
+   sphere: a truncated fluorescence image (its job fails) and its penetration-hardness
+   scene at a fine preset given 1 min where it needs about 2 (SLURM stops it: TIMEOUT).
+   Glass's outputs equal a local run's byte for byte; the run exits non-zero and names both
+   faults, the first as a local run does, the second with the rule, the sphere and the
+   resource to raise.
+2. The file fixed and the runtime raised, the same command again: only PS's missing jobs
+   run, and it exits 0.
 
-A local run of the glass targets, from the virtual experiment on, runs beside the second
-SLURM run (the node's second core is idle while SLURM runs only the long scene), to keep the
-whole under 6 min on 2 cores.
+PS's raw files and levelled AFM map are made beforehand, locally (the first can then be
+broken before the cluster reads it): the long scene is among the first jobs SLURM starts,
+so that it holds one of the node's two cores from the start while the others queue for the
+second. The local run runs beside the second SLURM run. Measured: docs/cluster.md.
 """
 
 import re
@@ -45,17 +47,20 @@ GLASS_TARGETS = [
     f"{GLASS}/glass/scenes/elastic/fields.h5",
 ]
 PS = "results/small/PS"
-PS_TARGETS = [f"{PS}/load_area.csv", f"{PS}/amontons.csv", f"{PS}/PS/scenes/elastic/fields.h5"]
+# PS's tables: its measurements, fits and figures (its scenes are left out: the long one
+# below is enough of them)
+PS_TARGETS = [f"{PS}/load_area.csv", f"{PS}/amontons.csv"]
 PS_DATA = "resources/synthetic/small/PS"
-GLASS_DATA = "resources/synthetic/small/glass/truth.json"
 BROKEN = f"{PS_DATA}/fluorescence/100.tif"
-# Glass's penetration-hardness scene at a pixel of 45 nm to 1e-5: 112 s alone on the 2-core
-# Intel Xeon machine (load 0.9). SLURM checks time limits every 30 s, so a job given 1 min
+# PS's penetration-hardness scene at a pixel of 40 nm to 1e-5: 120 s alone on the 2-core
+# Intel Xeon machine (load 0.8). SLURM checks time limits every 30 s, so a job given 1 min
 # ends between 60 and 95 s (with KillWait): the scene runs past it on any machine as fast.
-LONG_SCENE = f"{GLASS}/glass/scenes/penetration_hardness/fields.h5"
+# Its chain starts from PS's levelled AFM map, made with the raw files.
+LONG_SCENE = f"{PS}/PS/scenes/penetration_hardness/fields.h5"
+LEVELLED = f"{PS}/PS/measure/afm_before_levelled.h5"
 FINE_PRESET = """\
 solver_presets:
-  fine: {pixel_nm: 45.0, max_side_px: 2048, window_factor: 1.5, tol: 1.0e-5}
+  fine: {pixel_nm: 40.0, max_side_px: 2048, window_factor: 1.5, tol: 1.0e-5}
 scenes:
   penetration_hardness:
     preset: fine
@@ -78,11 +83,10 @@ def user_profile(root: Path) -> Path:
     placeholders, as docs/cluster.md tells a user to edit it."""
     text = (REPO / "profiles" / "slurm" / "config.yaml").read_text()
     assert "YOUR_ACCOUNT" in text and "YOUR_PARTITION" in text
-    folder = root / "profile"
-    folder.mkdir()
+    root.mkdir()
     edited = text.replace("YOUR_ACCOUNT", ACCOUNT).replace("YOUR_PARTITION", PARTITION)
-    (folder / "config.yaml").write_text(edited)
-    return folder
+    (root / "config.yaml").write_text(edited)
+    return root
 
 
 def snakemake(root: Path, targets, *args) -> list[str]:
@@ -112,54 +116,56 @@ def started_outputs(log: str) -> dict[str, str]:
     return out
 
 
+def make_raw_files(root: Path, targets) -> None:
+    """Raw files (and what else ``targets`` name) made locally, as a lab's instruments
+    would have made the raw files."""
+    made = run(snakemake(root, targets, "--cores", "2"), root)
+    assert made.returncode == 0, made.stderr[-3000:]
+
+
+def failed_record(root: Path) -> pd.DataFrame | None:
+    """The run's record of its failed jobs (None where it left none)."""
+    record = root / "results" / "small" / "failed_jobs.csv"
+    return pd.read_csv(record, keep_default_na=False) if record.is_file() else None
+
+
 @pytest.fixture(scope="module")
 def runs(slurm, tmp_path_factory):
-    """The first SLURM run (with its faults), what it left, the second SLURM run with the
-    local run beside it, and their folders."""
-    local = project(tmp_path_factory.mktemp("local"))
-    cluster = project(tmp_path_factory.mktemp("slurm"))
-    profile = user_profile(cluster)
-    # The spheres' raw files, made here as a lab's instruments would have: one of PS's can
-    # then be broken before the cluster reads it, and the long scene's chain starts at once.
-    raw = [f"{PS_DATA}/truth.json", GLASS_DATA]
-    made = run(snakemake(cluster, raw, "--cores", "2"), cluster)
-    assert made.returncode == 0, made.stderr[-3000:]
+    """The first SLURM run and what it left, the second SLURM run, and the local run beside
+    it (and their folders)."""
+    out = {"local": project(tmp_path_factory.mktemp("local"))}
+    cluster = out["cluster"] = project(tmp_path_factory.mktemp("slurm"))
+    on_slurm = ("--profile", str(user_profile(tmp_path_factory.mktemp("user") / "profile")))
+    on_slurm += (*QUICK_STATUS, "--set-resources")
+    make_raw_files(cluster, [f"{PS_DATA}/truth.json", LEVELLED])
     image = cluster / BROKEN
     intact = image.read_bytes()
     image.write_bytes(intact[:2000])
 
-    # the long scene's chain first, so that SLURM's queue holds nothing before it
-    on_slurm = ("--profile", str(profile), *QUICK_STATUS, "--prioritize", LONG_SCENE)
     targets = [*GLASS_TARGETS, *PS_TARGETS, LONG_SCENE]
-    faulty = run(
-        snakemake(cluster, targets, *on_slurm, "--set-resources", "simulate_scene:runtime=1"),
-        cluster,
-    )
-    record = cluster / "results" / "small" / "failed_jobs.csv"
-    left = {
-        "failed": pd.read_csv(record, keep_default_na=False) if record.is_file() else None,
-        "long_scene_made": (cluster / LONG_SCENE).exists(),
-        "glass_made": [target for target in GLASS_TARGETS if (cluster / target).is_file()],
-    }
+    faulty = run(snakemake(cluster, targets, *on_slurm, "simulate_scene:runtime=1"), cluster)
+    out["faulty"] = faulty
+    out["failed"] = failed_record(cluster)
+    out["glass_made"] = [target for target in GLASS_TARGETS if (cluster / target).is_file()]
+    out["long_scene_made"] = (cluster / LONG_SCENE).exists()
 
     image.write_bytes(intact)
     beside = subprocess.Popen(
-        snakemake(local, GLASS_TARGETS, "--cores", "2"),
-        cwd=local,
+        snakemake(out["local"], GLASS_TARGETS, "--cores", "2"),
+        cwd=out["local"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
-    again = run(
-        snakemake(cluster, targets, *on_slurm, "--set-resources", "simulate_scene:runtime=10"),
-        cluster,
-    )
+    out["again"] = run(snakemake(cluster, targets, *on_slurm, "simulate_scene:runtime=10"), cluster)
     _, stderr = beside.communicate(timeout=900)
     assert beside.returncode == 0, stderr[-3000:]
-    return {"local": local, "cluster": cluster, "faulty": faulty, "again": again, **left}
+    return out
 
 
 def test_glass_through_slurm_gives_the_local_run_byte_for_byte(runs):
+    """Every file of the local run of glass's targets, virtual experiment included, equals
+    the SLURM run's (compared after the run again, which runs none of glass's jobs)."""
     local, cluster, faulty = runs["local"], runs["cluster"], runs["faulty"]
     log = faulty.stdout + faulty.stderr
     # every job went through sbatch, each with its own SLURM job id, some as group jobs
@@ -216,25 +222,28 @@ def test_a_job_past_its_runtime_is_named_with_the_resource_to_raise(runs):
     run names the rule, the sphere, the resource and the option that raises it."""
     faulty = runs["faulty"]
     assert (
-        "sphere glass (glass): simulate_scene failed: stopped by SLURM (TIMEOUT) at its "
+        "sphere PS (PS): simulate_scene failed: stopped by SLURM (TIMEOUT) at its "
         "runtime of 1 min: raise it, e.g. --set-resources simulate_scene:runtime=2"
-    ) in faulty.stderr
+    ) in faulty.stderr, faulty.stderr[-3000:]
     assert "SLURM status is: 'TIMEOUT'" in faulty.stderr
     assert "raise simulate_scene's runtime and run again" in faulty.stderr
     assert not runs["long_scene_made"]
     record = runs["failed"]
-    assert ("glass", "simulate_scene", "runtime") in set(
+    assert record is not None, "the run left no results/small/failed_jobs.csv"
+    assert ("PS", "simulate_scene", "runtime") in set(
         zip(record["sphere"], record["rule"], record["limit"], strict=True)
     )
     assert "TIMEOUT" in slurm_states()
 
 
 def test_the_run_again_completes_only_what_is_missing(runs):
+    """The file fixed and the runtime raised: only PS's jobs run, the scene among them, none
+    of glass's; the run exits 0 and leaves no record of failed jobs."""
     again, cluster = runs["again"], runs["cluster"]
     assert again.returncode == 0, again.stderr[-3000:]
     now = started_outputs(again.stdout + again.stderr)
-    assert LONG_SCENE in now and f"{PS}/load_area.csv" in now
-    assert all(path.startswith((PS, LONG_SCENE.rsplit("/", 1)[0])) for path in now), now
-    assert not any(path in now for path in GLASS_TARGETS)
-    assert all((cluster / target).is_file() for target in [*PS_TARGETS, LONG_SCENE])
-    assert not (cluster / "results" / "small" / "failed_jobs.csv").exists()
+    assert {LONG_SCENE, f"{PS}/load_area.csv", f"{PS}/PS/measure/contact_area.csv"} <= set(now)
+    assert all(path.startswith(f"{PS}/") for path in now), now
+    made = [*GLASS_TARGETS, *PS_TARGETS, LONG_SCENE]
+    assert all((cluster / target).is_file() for target in made)
+    assert failed_record(cluster) is None
