@@ -34,9 +34,12 @@ fail() {
     exit 2
 }
 
-require_root_and_packages() {
+require_root() {
     [ "$(id -u)" = 0 ] || fail "needs root: it installs Debian's ${PACKAGES[*]} and starts \
 them as system services; run it (make test-cluster) as root, as CI does"
+}
+
+install_missing_packages() {
     local missing=()
     for package in "${PACKAGES[@]}"; do
         dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
@@ -158,10 +161,11 @@ add_account() {
 }
 
 start() {
+    require_root
     mkdir -p "$DIR/state" "$DIR/spool"
     # a cluster left running by an earlier start (a test killed before its stop) goes first
     stop_daemons
-    require_root_and_packages
+    install_missing_packages
     write_slurm_conf
     start_munge
     start_database
@@ -215,8 +219,9 @@ stop() {
 
 case "${1:-}" in
 preflight)
+    require_root
     mkdir -p "$DIR"
-    require_root_and_packages
+    install_missing_packages
     say "ready: $(dpkg-query -W -f='${Package} ${Version}, ' "${PACKAGES[@]}")"
     ;;
 start) start ;;
