@@ -15,8 +15,9 @@
 # executor plugin's job steps drop every SLURM_* variable, SLURM_CONF included, before they
 # call srun, so a configuration found only through SLURM_CONF fails inside the jobs ("srun:
 # fatal: Could not establish a configuration source"). A slurm.conf there that this script
-# did not write is left alone: it stops instead. `stop` removes the two files. Ran with Debian 12's SLURM 22.05.8, MariaDB 10.11 and munge 0.5.15
-# (the `start` command prints the versions it found).
+# did not write is left alone: it stops instead. `stop` removes the two files. Ran with
+# Debian 12's SLURM 22.05.8, MariaDB 10.11 and munge 0.5.15 (`preflight` prints the versions
+# it finds, `start` the ones it runs).
 set -euo pipefail
 
 DIR=${AMONTONS_SLURM_DIR:-/tmp/amontons-slurm}

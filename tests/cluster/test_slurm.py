@@ -30,22 +30,12 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from ..workflow.same_output import assert_same_output
+from amontons.workflow.failures import started_resources
+
+from ..workflow.same_output import GLASS_TARGETS, assert_same_output
 
 REPO = Path(__file__).resolve().parents[2]
 ACCOUNT, PARTITION = "amontons-test", "amontons"
-GLASS = "results/small/glass"
-GLASS_TARGETS = [
-    f"{GLASS}/load_area.csv",
-    f"{GLASS}/amontons.csv",
-    f"{GLASS}/glass/measure/hertz_check.csv",
-    f"{GLASS}/glass/measure/intensity_pressure_fit.json",
-    f"{GLASS}/glass/measure/psf.json",
-    f"{GLASS}/glass/measure/edge_gap.json",
-    f"{GLASS}/glass/measure/grafting_density.json",
-    f"{GLASS}/glass/measure/topography.json",
-    f"{GLASS}/glass/scenes/elastic/fields.h5",
-]
 PS = "results/small/PS"
 # PS's tables: its measurements, fits and figures (its scenes are left out: the long one
 # below is enough of them)
@@ -104,16 +94,8 @@ def run(command, root: Path) -> subprocess.CompletedProcess:
 
 def started_outputs(log: str) -> dict[str, str]:
     """The output files of every job a run started, each with its rule, from Snakemake's
-    log of it (a group job's jobs are listed indented)."""
-    out, rule = {}, None
-    for line in log.splitlines():
-        started = re.match(r"^\s*(?:local)?rule (\w+):$", line)
-        if started:
-            rule = started[1]
-        elif rule and line.strip().startswith("output: "):
-            out.update(dict.fromkeys(line.strip()[len("output: ") :].split(", "), rule))
-            rule = None
-    return out
+    log of it (amontons.workflow.failures.started_resources reads the start blocks)."""
+    return {path: rule for rule, outputs in started_resources(log) for path in outputs.split(", ")}
 
 
 def make_raw_files(root: Path, targets) -> None:
@@ -127,6 +109,12 @@ def failed_record(root: Path) -> pd.DataFrame | None:
     """The run's record of its failed jobs (None where it left none)."""
     record = root / "results" / "small" / "failed_jobs.csv"
     return pd.read_csv(record, keep_default_na=False) if record.is_file() else None
+
+
+def recorded(record: pd.DataFrame | None) -> set[tuple[str, str, str]]:
+    """(sphere, rule, limit) of every job in a run's record of its failed jobs."""
+    assert record is not None, "the run left no results/small/failed_jobs.csv"
+    return set(zip(record["sphere"], record["rule"], record["limit"], strict=True))
 
 
 @pytest.fixture(scope="module")
@@ -209,11 +197,7 @@ def test_a_failed_job_is_named_once_and_the_other_sphere_runs(runs):
         faulty.stderr
     )
     assert runs["glass_made"] == GLASS_TARGETS
-    record = runs["failed"]
-    assert record is not None, "the run left no results/small/failed_jobs.csv"
-    assert ("PS", "measure_contact_area", "") in set(
-        zip(record["sphere"], record["rule"], record["limit"], strict=True)
-    )
+    assert ("PS", "measure_contact_area", "") in recorded(runs["failed"])
     assert "FAILED" in slurm_states()
 
 
@@ -228,11 +212,7 @@ def test_a_job_past_its_runtime_is_named_with_the_resource_to_raise(runs):
     assert "SLURM status is: 'TIMEOUT'" in faulty.stderr
     assert "raise simulate_scene's runtime and run again" in faulty.stderr
     assert not runs["long_scene_made"]
-    record = runs["failed"]
-    assert record is not None, "the run left no results/small/failed_jobs.csv"
-    assert ("PS", "simulate_scene", "runtime") in set(
-        zip(record["sphere"], record["rule"], record["limit"], strict=True)
-    )
+    assert ("PS", "simulate_scene", "runtime") in recorded(runs["failed"])
     assert "TIMEOUT" in slurm_states()
 
 

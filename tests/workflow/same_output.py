@@ -1,11 +1,28 @@
-"""Two runs' outputs compared byte for byte wherever the bytes do not carry the time: the
-cluster executors' tests (tests/workflow/test_executor.py, tests/cluster/test_slurm.py)."""
+"""What the cluster executors' tests share (tests/workflow/test_executor.py,
+tests/cluster/test_slurm.py): the glass sphere's targets of the small data set that they run
+through an executor, and two runs' outputs compared byte for byte wherever the bytes do not
+carry the time."""
 
 import json
 from pathlib import Path
 
 import h5py
 import numpy as np
+
+GLASS = "results/small/glass"
+# The glass sphere's measurements, fits, figures and elastic scene: 14 jobs from its virtual
+# experiment on.
+GLASS_TARGETS = [
+    f"{GLASS}/load_area.csv",
+    f"{GLASS}/amontons.csv",
+    f"{GLASS}/glass/measure/hertz_check.csv",
+    f"{GLASS}/glass/measure/intensity_pressure_fit.json",
+    f"{GLASS}/glass/measure/psf.json",
+    f"{GLASS}/glass/measure/edge_gap.json",
+    f"{GLASS}/glass/measure/grafting_density.json",
+    f"{GLASS}/glass/measure/topography.json",
+    f"{GLASS}/glass/scenes/elastic/fields.h5",
+]
 
 
 def without_wall_times(value):

@@ -19,24 +19,13 @@ from pathlib import Path
 
 import pytest
 
-from .same_output import assert_same_output
+from .same_output import GLASS_TARGETS, assert_same_output
 
 pytestmark = pytest.mark.workflow
 
 REPO = Path(__file__).resolve().parents[2]
 SUBMIT = Path(__file__).with_name("submit_local.py")
-GLASS = "results/small/glass"
-TARGETS = [
-    f"{GLASS}/load_area.csv",
-    f"{GLASS}/amontons.csv",
-    f"{GLASS}/glass/measure/hertz_check.csv",
-    f"{GLASS}/glass/measure/intensity_pressure_fit.json",
-    f"{GLASS}/glass/measure/psf.json",
-    f"{GLASS}/glass/measure/edge_gap.json",
-    f"{GLASS}/glass/measure/grafting_density.json",
-    f"{GLASS}/glass/measure/topography.json",
-    f"{GLASS}/glass/scenes/elastic/fields.h5",
-]
+TARGETS = GLASS_TARGETS
 
 
 def cluster_run(project: Path, logdir: Path) -> subprocess.CompletedProcess:
