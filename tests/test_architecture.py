@@ -221,9 +221,9 @@ CONTACT_FLOORS = (
     # 2. operators: FFT plans and wisdom, Green's functions, convolutions
     ("wisdom", "fft", "greens", "jit", "spectrum", "array_convolution", "convolution"),
     # 3. kernel sets: the element-wise work of one iteration
-    ("kernels", "device_sources", "array_kernels", "bounded_load"),
+    ("kernels", "device_sources", "array_kernels", "bounded_load", "preconditioned_kernels"),
     # 4. the iteration: the one Polonsky-Keer control flow, its steps and its constraints
-    ("stall", "constraints", "cg_iteration", "cg"),
+    ("stall", "constraints", "cg_iteration", "cg", "preconditioned", "conjugate_gradient"),
     # 5. routes, chosen from one table
     ("plastic_increments", "root_find", "elastic", "winkler", "bounded", "appendix", "routes"),
     # 6. public calls (and the warm-up, which solves through them)

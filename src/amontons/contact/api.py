@@ -61,6 +61,7 @@ def solve(
     max_outer=None,
     planner_effort=None,
     raise_on_failure=True,
+    iteration="polonsky-keer",
 ) -> ContactResult:
     """Solve the frictionless contact of a rigid rough indenter on an elastic half-space.
 
@@ -138,6 +139,9 @@ def solve(
         True (default): a solve that does not converge raises :class:`ConvergenceError`.
         False: it returns a :class:`ContactResult` with ``success=False``, its ``status``
         (1 iteration cap, 2 stalled) and ``message``, holding the last (finite) iterate.
+    iteration : {"polonsky-keer", "preconditioned"}
+        CG iteration of the elastic, bounded and Winkler routes: Polonsky and Keer's, or the
+        preconditioned bound-constrained CG (CPU backends; docs/models.md §2.2).
 
     Returns
     -------
@@ -174,23 +178,27 @@ def solve(
         method=method,
         max_outer=max_outer,
         raise_on_failure=raise_on_failure,
+        iteration=iteration,
     )
-    load, displacement = check_control(load, displacement)
-    if warm_start is not None:
-        warm_start = check_warm_start(warm_start, h.shape)
-    plastic_prev = _plastic_history(opts, plastic_displacement, h.shape)
-    _warn_ignored(
-        opts,
-        h.shape,
-        method=method,
-        max_outer=max_outer,
-        coarse_to_fine=coarse_to_fine,
-        warm_start=warm_start is not None,
+    step = _checked_step(
+        opts, h.shape, (load, displacement, warm_start, plastic_displacement), coarse_to_fine
     )
-    step = LoadStep(load, displacement, warm_start, plastic_prev, bool(coarse_to_fine))
+    given = {"method": method, "max_outer": max_outer, "coarse_to_fine": coarse_to_fine}
+    _warn_ignored(opts, h.shape, **given, warm_start=step.warm_start is not None)
     # BLAS pools on one thread, the kernels' OpenMP on ``threads`` (.pools says why)
     with solve_pools(opts.threads):
         return _solve_step(h, spacing, e_star, opts, step)
+
+
+def _checked_step(opts, shape, given, coarse_to_fine) -> LoadStep:
+    """The validated :class:`LoadStep` of one solve from what :func:`solve` was given:
+    ``(load N, displacement m, warm start Pa, plastic displacement m)``."""
+    load, displacement, warm_start, plastic_displacement = given
+    load, displacement = check_control(load, displacement)
+    if warm_start is not None:
+        warm_start = check_warm_start(warm_start, shape)
+    plastic_prev = _plastic_history(opts, plastic_displacement, shape)
+    return LoadStep(load, displacement, warm_start, plastic_prev, bool(coarse_to_fine))
 
 
 def solve_with_options(
@@ -229,6 +237,7 @@ def solve_load_series(
     planner_effort=None,
     raise_on_failure=True,
     warm_starts=None,
+    iteration="polonsky-keer",
 ) -> list[ContactResult]:
     """Solve for increasing loads, each step warm-started from the previous pressure.
 
@@ -250,6 +259,8 @@ def solve_load_series(
     raise_on_failure : bool
         As in :func:`solve`. With False a step that does not converge is returned with
         ``success=False`` and the series goes on from its state: check every result.
+    iteration : str
+        As in :func:`solve`.
     warm_starts : sequence of array_like or None, optional
         One starting pressure (Pa) per load, e.g. the pressures of the same loads under a
         neighbouring law (:func:`solve_scan`); an entry may be None (no neighbour at that
@@ -282,6 +293,7 @@ def solve_load_series(
         method=method,
         max_outer=max_outer,
         raise_on_failure=raise_on_failure,
+        iteration=iteration,
     )
     arr = check_loads(loads)
     starts = _checked_starts(warm_starts, arr.size, h.shape)
@@ -498,6 +510,7 @@ def _solve_info(opts, out, t0):
         max_iter=opts.max_iter,
         max_outer=opts.max_outer,
         wall_time_s=time.perf_counter() - t0,
+        iteration="polonsky-keer" if opts.route == "appendix" else opts.iteration,
     )
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .cg import polonsky_keer
+from .conjugate_gradient import conjugate_gradient
 from .constraints import BoundedWall
 from .plastic_increments import local_increment, penetration_at_bound
 from .result import Outcome
@@ -62,7 +62,7 @@ def hardness_bounded(
     heights, gaps, ``h_pl`` in m; ``p_y`` (per pixel) in Pa. The CG runs with
     ``cg_options`` (:class:`~.options.CGOptions`).
     """
-    out = polonsky_keer(
+    out = conjugate_gradient(
         operator,
         heights + plastic_prev,
         cg_options,

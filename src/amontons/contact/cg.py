@@ -181,6 +181,7 @@ def finish_outcome(
     resets,
     shape,
     extra=None,
+    method="Polonsky-Keer CG",
 ):
     """The :class:`~.result.Outcome` of a finished loop (``p`` Pa and ``u = K*p`` m, flat
     and fresh); raises ConvergenceError on failure when ``raise_on_failure``. ``p`` and
@@ -194,7 +195,7 @@ def finish_outcome(
         d = float(np.dot(gap, m) / nc) if nc else fully_bound_approach(u, h, p, d)
     gap -= d
     hist = np.asarray(history)
-    status, message = _status_message(converged, stalled, it, residual, tol, shape, p)
+    status, message = _status_message(converged, stalled, it, residual, tol, shape, p, method)
     if status != CONVERGED and raise_on_failure:
         raise ConvergenceError(
             message,
@@ -221,17 +222,16 @@ def finish_outcome(
     )
 
 
-def _status_message(converged, stalled, it, residual, tol, shape, p):
-    """Status code (0, 1, 2) and message of a finished CG solve."""
+def _status_message(converged, stalled, it, residual, tol, shape, p, method):
+    """Status code (0, 1, 2) and message of a finished CG solve (``method``: its name)."""
     if converged:
         return CONVERGED, (
-            f"Polonsky-Keer CG converged in {it} iterations: residual {residual:.3e} < "
-            f"tol {tol:.1e}"
+            f"{method} converged in {it} iterations: residual {residual:.3e} < tol {tol:.1e}"
         )
     if stalled is not None:
         return STALLED, f"{stalled}; stopped after {it} iterations at residual {residual:.3e}"
     return ITERATION_CAP, (
-        f"Polonsky-Keer CG did not converge in {it} iterations: residual "
+        f"{method} did not converge in {it} iterations: residual "
         f"{residual:.3e} > tol {tol:.1e} (grid {shape[0]}x{shape[1]}, "
         f"{int(np.count_nonzero(p))} contact pixels)"
     )

@@ -76,6 +76,46 @@ class _MultiplierMixin:
             return self._multiplier
         return self._mult_scaled / self._scale
 
+    def precondition(self, x: np.ndarray, out: np.ndarray, compliance: float = 0.0):
+        """``out`` = the kernel's inverse applied to ``x``: a displacement (m) to the
+        pressure (Pa) that would cause it on the whole grid, ``F⁻¹[F[x] / (Ĝ + c)]`` with
+        ``c`` a uniform Winkler ``compliance`` (m/Pa; 0 for the half-space alone).
+
+        The Fourier-diagonal preconditioner of :mod:`.preconditioned` (docs/models.md
+        §2.2, "The preconditioned iteration"): one forward and one inverse transform on the
+        operator's plans. Where ``Ĝ + c`` vanishes (the periodic kernel's rigid mode
+        without a compliance) the smallest nonzero value stands in: the iteration
+        projects that mode out under load control, and under displacement control it must
+        stay finite.
+        """
+        inverse = self._inverse_multiplier(float(compliance))
+        if self.splits:
+            self.forward(x)
+            with _spectrum.spectrum_threads(self.threads):
+                _spectrum.multiply_spectrum(self._spec, inverse)
+            return self.inverse(out)
+        shape = getattr(self, "padded_shape", self.shape)
+        n0, n1 = self.shape
+        spec = np.fft.rfft2(x, s=shape) * inverse
+        out[...] = np.fft.irfft2(spec, s=shape)[:n0, :n1]
+        return out
+
+    def _inverse_multiplier(self, compliance: float) -> np.ndarray:
+        """``1/(Ĝ + c)`` on the half-spectrum (Pa/m), with the inverse DFT's ``1/N``
+        folded in where the plans do not normalise (pyfftw); one array per compliance."""
+        cache = self.__dict__.setdefault("_inverse_multipliers", {})
+        if compliance not in cache:
+            symbol = self.multiplier + compliance
+            positive = symbol > 0
+            if not positive.any():
+                raise ValueError("the kernel's spectrum has no positive entry to invert")
+            inverse = np.where(positive, 1.0 / np.where(positive, symbol, 1.0), 0.0)
+            inverse[~positive] = 1.0 / symbol[positive].min()
+            if self.splits:
+                inverse *= self._scale
+            cache[compliance] = inverse
+        return cache[compliance]
+
 
 class PeriodicConvolution(_MultiplierMixin):
     """Periodic half-space convolution ``u = K * p`` on an ``n0 × n1`` grid.

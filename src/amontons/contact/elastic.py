@@ -14,7 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .cg import polonsky_keer
+from .conjugate_gradient import conjugate_gradient
 from .convolution import operator_for
 from .errors import STALLED
 from .options import default_max_iter
@@ -61,7 +61,7 @@ def run_cg(h, spacing, e_star, opts, cg_options, *, load, displacement, p_init):
         # array is round-off too, ~1e-16 of the height, not 0: that scale would turn the
         # round-off gap into a residual of order 1.)
         h_scale = spacing
-    return polonsky_keer(
+    return conjugate_gradient(
         operator_for(opts, h.shape, spacing, e_star),
         h,
         cg_options,

@@ -97,6 +97,9 @@ def resolve_planner_effort(planner_effort: str | None) -> str:
 
 
 METHODS = ("winkler", "bounded", "appendix")
+# The CG iterations a route can run (docs/models.md §2.2): Polonsky and Keer's, and the
+# preconditioned bound-constrained CG of .preconditioned.
+ITERATIONS = ("polonsky-keer", "preconditioned")
 
 # Default caps on the outer loop (max_outer=None): plastic updates per approach of the
 # appendix scheme, and active-set rounds of the Winkler route.
@@ -178,6 +181,7 @@ class CGOptions:
     threads: int | None = None
     bounded_load_sweep: bool = True
     array_module: str | None = None
+    iteration: str = "polonsky-keer"
 
 
 @dataclass(frozen=True)
@@ -203,6 +207,7 @@ class SolveOptions:
     max_outer: int | None
     raise_on_failure: bool
     bounded_load_sweep: bool = True
+    iteration: str = "polonsky-keer"
 
     @property
     def cg(self) -> CGOptions:
@@ -215,6 +220,7 @@ class SolveOptions:
             raise_on_failure=False,
             bounded_load_sweep=self.bounded_load_sweep,
             array_module=self.backend if self.backend in ARRAY_BACKENDS else None,
+            iteration=self.iteration,
         )
 
 
@@ -245,6 +251,7 @@ def solve_options(
     method,
     max_outer,
     raise_on_failure,
+    iteration="polonsky-keer",
 ) -> SolveOptions:
     """Validate the options of a solve on a grid of ``shape``."""
     tol = check_positive("tol", tol, "(dimensionless)")
@@ -253,6 +260,7 @@ def solve_options(
     backend = resolve_backend(backend, arrays=True)
     planner_effort = resolve_planner_effort(planner_effort)
     check_method(method)
+    iteration = check_iteration(iteration, backend)
     law = None if plasticity is None else check_law(plasticity)
     route = "elastic" if law is None else resolve_route(law, method)
     if max_outer is not None:
@@ -272,7 +280,23 @@ def solve_options(
         route=route,
         max_outer=max_outer,
         raise_on_failure=bool(raise_on_failure),
+        iteration=iteration,
     )
+
+
+def check_iteration(iteration, backend) -> str:
+    """The CG iteration of a solve, one of :data:`ITERATIONS`; the preconditioned one runs
+    on the CPU convolutions only (its preconditioner is their inverse spectrum)."""
+    if iteration not in ITERATIONS:
+        raise ContactInputError(
+            f"iteration must be one of {', '.join(map(repr, ITERATIONS))}, got {iteration!r}"
+        )
+    if iteration == "preconditioned" and backend in ARRAY_BACKENDS:
+        raise ContactInputError(
+            f"iteration='preconditioned' runs on the CPU backends, not backend={backend!r}; "
+            "use iteration='polonsky-keer' there"
+        )
+    return iteration
 
 
 def default_max_iter(shape) -> int:

@@ -161,6 +161,9 @@ class SolveInfo:
         Cap on ``outer_iterations``; None for an elastic solve and the ``"bounded"`` route.
     wall_time_s : float
         Wall time of the solve, s.
+    iteration : {"polonsky-keer", "preconditioned"}
+        The CG iteration that solved it (docs/models.md §2.2); the appendix route always
+        runs Polonsky and Keer's.
     """
 
     route: str
@@ -176,6 +179,7 @@ class SolveInfo:
     max_iter: int
     max_outer: int | None
     wall_time_s: float
+    iteration: str = "polonsky-keer"
 
 
 @dataclass(frozen=True, eq=False)

@@ -15,7 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .cg import polonsky_keer
+from .conjugate_gradient import conjugate_gradient
 from .errors import ITERATION_CAP, ContactInputError
 from .options import MAX_ACTIVE_SET_ROUNDS
 from .result import Outcome, Tally
@@ -84,7 +84,7 @@ def hardening_winkler(
     for rounds in range(1, max_rounds + 1):
         compliance = np.where(flowing, 1.0 / k, 0.0)
         effective = np.where(flowing, heights, heights - floor)
-        out = polonsky_keer(
+        out = conjugate_gradient(
             WinklerOperator(operator, compliance),
             effective,
             cg_options,
