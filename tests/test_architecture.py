@@ -549,6 +549,45 @@ def test_no_compiled_kernel_reads_a_name_from_another_module():
     assert found == []
 
 
+# The plasticity laws' class names: the solver asks a law what it needs (its exact route,
+# its bound, its capacity, its appendix start) instead of testing its type (issue 78).
+LAW_TYPES = {"PenetrationHardness", "ContactHardening", "PLASTICITY_LAWS"}
+
+
+def _law_type_tests(tree: ast.AST, name: str) -> list[str]:
+    """``isinstance`` calls of a module whose class argument names a plasticity law."""
+    found = []
+    for node in ast.walk(tree):
+        if not (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Name)
+            and node.func.id == "isinstance"
+            and len(node.args) == 2
+        ):
+            continue
+        named = {n.id for n in ast.walk(node.args[1]) if isinstance(n, ast.Name)}
+        if named & LAW_TYPES:
+            found.append(f"{name}:{node.lineno}")
+    return found
+
+
+def test_the_law_type_scan_finds_a_planted_test():
+    tree = ast.parse("if isinstance(law, PenetrationHardness | ContactHardening):\n    pass\n")
+    assert _law_type_tests(tree, "probe.py") == ["probe.py:1"]
+
+
+def test_no_module_tests_a_law_by_its_type_outside_the_laws():
+    """Only contact/laws.py (where ``check_law`` validates what a caller passed) may test
+    a law's type; the solver and the pipeline ask the law."""
+    found = [
+        hit
+        for path in sorted(PACKAGE.rglob("*.py"))
+        if path != PACKAGE / "contact" / "laws.py"
+        for hit in _law_type_tests(ast.parse(path.read_text()), str(path.relative_to(PACKAGE)))
+    ]
+    assert found == []
+
+
 LONGEST_FUNCTION = 80  # lines, the def's first to its last, its docstring aside
 
 

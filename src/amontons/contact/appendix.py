@@ -18,7 +18,6 @@ import numpy as np
 from .cg import polonsky_keer
 from .constraints import BoundedWall
 from .errors import ITERATION_CAP
-from .laws import ContactHardening, PenetrationHardness
 from .plastic_increments import increment as plastic_increment
 from .plastic_increments import penetration_at_bound
 from .result import Outcome, Tally
@@ -33,7 +32,7 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
     pixel_area = spacing**2
     h_scale = float(np.std(heights)) or spacing
     cg_options, max_outer, periodic = opts.cg, opts.max_outer, opts.periodic
-    bound = _bound(law, heights.shape)
+    bound = law.pressure_bound(heights.shape)
 
     def at(d, p_start):
         return plastic_iteration(
@@ -67,7 +66,7 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
         return float(state.pressure.sum()) * pixel_area, state
 
     span = float(np.ptp(heights)) or spacing
-    if isinstance(law, ContactHardening):
+    if law.appendix_start == "winkler":
         # the Winkler state is exact for local increments and close for volume-conserving ones
         guess = hardening_winkler(
             operator,
@@ -109,20 +108,6 @@ def solve(operator, heights, spacing, law, opts, *, load, displacement, plastic_
     return find_approach(
         evaluate, load, d_guess, 1e-3 * span, load_tol=opts.tol, load_atol=pixel_worth
     )
-
-
-def _bound(law, shape):
-    """``bound(h_pl)``: the pressure bound p_max per pixel (Pa) of ``law`` given the plastic
-    displacement ``h_pl`` (m)."""
-    if isinstance(law, PenetrationHardness):
-        p_y = np.broadcast_to(np.asarray(law.p_y, dtype=float), shape)
-        return lambda h_pl: p_y
-
-    def hardening_bound(h_pl):
-        # pile-up (h_pl > 0) has not yielded in compression: no hardness there
-        return law.k * np.maximum(-h_pl, 0.0)
-
-    return hardening_bound
 
 
 def plastic_iteration(

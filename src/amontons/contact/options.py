@@ -25,7 +25,12 @@ import numpy as np  # noqa: E402
 
 from .array_backends import ARRAY_BACKENDS, array_module  # noqa: E402
 from .errors import ContactInputError  # noqa: E402
-from .laws import ContactHardening, PenetrationHardness  # noqa: E402
+from .laws import (  # noqa: E402
+    PLASTICITY_LAWS,
+    ContactHardening,
+    PenetrationHardness,
+    check_law,
+)
 
 try:  # pyfftw is optional: numpy.fft is the fallback
     import pyfftw
@@ -97,6 +102,12 @@ def resolve_planner_effort(planner_effort: str | None) -> str:
 
 
 METHODS = ("winkler", "bounded", "appendix")
+# The routes that solve one law exactly (its ``exact_route``), as the errors describe them.
+EXACT_ROUTES = {
+    "winkler": "the exact elastic-plus-Winkler route",
+    "bounded": "one bounded CG under the force constraint",
+}
+_EXACT_ROUTE_LAWS = {law.exact_route: law.__name__ for law in PLASTICITY_LAWS}
 # The CG iterations a route can run (docs/models.md §2.2): Polonsky and Keer's, and the
 # preconditioned bound-constrained CG of .preconditioned.
 ITERATIONS = ("polonsky-keer", "preconditioned")
@@ -129,25 +140,16 @@ def resolve_route(law, method) -> str:
         ``"appendix"`` for contact hardening with ``alpha = 1``.
     """
     check_method(method)
-    winkler_ok = isinstance(law, ContactHardening) and law.increment == "local"
-    bounded_ok = isinstance(law, PenetrationHardness) and law.increment == "local"
+    exact = law.exact_route if law.increment == "local" else None
     if method is None:
-        method = "winkler" if winkler_ok else "bounded" if bounded_ok else "appendix"
-    if method == "winkler" and not winkler_ok:
+        method = exact or "appendix"
+    if method in EXACT_ROUTES and method != exact:
         raise ContactInputError(
-            "method='winkler' (the exact elastic-plus-Winkler route) only solves "
-            f"ContactHardening with local increments, not {law!r}; use method='appendix' or "
-            "None"
-        )
-    if method == "bounded" and not bounded_ok:
-        raise ContactInputError(
-            "method='bounded' (one bounded CG under the force constraint) only solves "
-            f"PenetrationHardness with local increments, not {law!r}; use "
+            f"method={method!r} ({EXACT_ROUTES[method]}) only solves "
+            f"{_EXACT_ROUTE_LAWS[method]} with local increments, not {law!r}; use "
             "method='appendix' or None"
         )
-    if method == "appendix" and isinstance(law, ContactHardening) and law.alpha == 1:
-        # with p_Y = k|h_pl| and α = 1 the first update closes every gap at zero pressure,
-        # a fixed point of the scheme that is not the hardening state
+    if method == "appendix" and law.appendix_needs_relaxation and law.alpha == 1:
         raise ContactInputError(
             "the iterative contact-hardening scheme needs over-relaxation alpha < 1; got 1"
         )
@@ -412,15 +414,6 @@ def check_warm_start(warm_start, shape) -> np.ndarray:
     if (w < 0).any():
         raise ContactInputError(f"warm_start must be a pressure >= 0 (Pa), min is {w.min():.3e}")
     return w
-
-
-def check_law(law):
-    """A plasticity law: PenetrationHardness or ContactHardening."""
-    if not isinstance(law, PenetrationHardness | ContactHardening):
-        raise ContactInputError(
-            f"plasticity must be PenetrationHardness(p_y) or ContactHardening(k), got {law!r}"
-        )
-    return law
 
 
 def check_plastic_history(plastic, shape) -> np.ndarray:

@@ -24,7 +24,6 @@ from . import appendix, bounded, elastic, winkler
 from .convolution import operator_for
 from .elastic import start_pressure
 from .errors import ContactInputError, FreeBoundaryError
-from .laws import PenetrationHardness
 
 
 def _plastic(route):
@@ -74,9 +73,9 @@ def check_capacity(law, heights, pixel_area, load, periodic) -> None:
     """Penetration hardness under load control: refuse a load (N) that the whole window at
     p_Y (Pa) could not carry (pixel area m²) - ContactInputError on a periodic grid (no
     state carries it), FreeBoundaryError on a half-space (the window is too small)."""
-    if not isinstance(law, PenetrationHardness) or load is None:
+    p_y = None if (law is None or load is None) else law.capacity(heights.shape)
+    if p_y is None:
         return
-    p_y = np.broadcast_to(np.asarray(law.p_y, dtype=float), heights.shape)
     capacity = float(p_y.sum()) * pixel_area
     if load < capacity:
         return
