@@ -19,6 +19,7 @@ import pytest
 from amontons.contact import (
     ContactHardening,
     ContactInputError,
+    IgnoredOptionWarning,
     PenetrationHardness,
     self_affine,
     solve,
@@ -260,6 +261,18 @@ def test_periodic_displacement_control_at_full_contact_fails_loudly():
     )
     assert not res.success and res.status == 2
     assert "full contact" in res.message
+
+
+def test_the_appendix_route_says_it_ignores_the_preconditioned_iteration():
+    """The appendix's scheme runs Polonsky and Keer's iteration whatever is asked: a warning
+    says so, and the result's info names the iteration that ran."""
+    h, dx = _rough_sphere(48)
+    with pytest.warns(IgnoredOptionWarning, match="iteration='preconditioned' is ignored"):
+        res = solve(
+            h, dx, E_PMMA, load=0.1 * LOAD, plasticity=PenetrationHardness(P_Y),
+            method="appendix", **PRECONDITIONED,
+        )  # fmt: skip
+    assert res.info.iteration == "polonsky-keer"
 
 
 def test_an_unknown_iteration_is_refused_by_name():

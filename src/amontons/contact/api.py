@@ -457,6 +457,11 @@ def _ignored_options(opts, shape, *, method, max_outer, coarse_to_fine, warm_sta
             f"max_outer={max_outer!r} is ignored: the 'bounded' route of penetration hardness "
             "is one bounded solve with no outer loop"
         )
+    if opts.route == "appendix" and opts.iteration != "polonsky-keer":
+        notes.append(
+            f"iteration={opts.iteration!r} is ignored: the appendix route runs Polonsky and "
+            "Keer's iteration"
+        )
     if coarse_to_fine:
         reason = _coarse_to_fine_obstacle(opts, shape, warm_start)
         if reason:

@@ -76,46 +76,6 @@ class _MultiplierMixin:
             return self._multiplier
         return self._mult_scaled / self._scale
 
-    def precondition(self, x: np.ndarray, out: np.ndarray, compliance: float = 0.0):
-        """``out`` = the kernel's inverse applied to ``x``: a displacement (m) to the
-        pressure (Pa) that would cause it on the whole grid, ``F⁻¹[F[x] / (Ĝ + c)]`` with
-        ``c`` a uniform Winkler ``compliance`` (m/Pa; 0 for the half-space alone).
-
-        The Fourier-diagonal preconditioner of :mod:`.preconditioned` (docs/models.md
-        §2.2, "The preconditioned iteration"): one forward and one inverse transform on the
-        operator's plans. Where ``Ĝ + c`` vanishes (the periodic kernel's rigid mode
-        without a compliance) the smallest nonzero value stands in: the iteration
-        projects that mode out under load control, and under displacement control it must
-        stay finite.
-        """
-        inverse = self._inverse_multiplier(float(compliance))
-        if self.splits:
-            self.forward(x)
-            with _spectrum.spectrum_threads(self.threads):
-                _spectrum.multiply_spectrum(self._spec, inverse)
-            return self.inverse(out)
-        shape = getattr(self, "padded_shape", self.shape)
-        n0, n1 = self.shape
-        spec = np.fft.rfft2(x, s=shape) * inverse
-        out[...] = np.fft.irfft2(spec, s=shape)[:n0, :n1]
-        return out
-
-    def _inverse_multiplier(self, compliance: float) -> np.ndarray:
-        """``1/(Ĝ + c)`` on the half-spectrum (Pa/m), with the inverse DFT's ``1/N``
-        folded in where the plans do not normalise (pyfftw); one array per compliance."""
-        cache = self.__dict__.setdefault("_inverse_multipliers", {})
-        if compliance not in cache:
-            symbol = self.multiplier + compliance
-            positive = symbol > 0
-            if not positive.any():
-                raise ValueError("the kernel's spectrum has no positive entry to invert")
-            inverse = np.where(positive, 1.0 / np.where(positive, symbol, 1.0), 0.0)
-            inverse[~positive] = 1.0 / symbol[positive].min()
-            if self.splits:
-                inverse *= self._scale
-            cache[compliance] = inverse
-        return cache[compliance]
-
 
 class PeriodicConvolution(_MultiplierMixin):
     """Periodic half-space convolution ``u = K * p`` on an ``n0 × n1`` grid.
@@ -206,6 +166,46 @@ class PeriodicConvolution(_MultiplierMixin):
         """Whether the convolution can be taken in halves (:meth:`forward`,
         :meth:`multiply_energy`, :meth:`inverse`): with the pyfftw backend."""
         return self.backend == "pyfftw"
+
+    # the preconditioner's transforms in this operator's FFT pairs
+    precondition_pairs = 1.0
+
+    def precondition(self, x: np.ndarray, out: np.ndarray, compliance: float = 0.0):
+        """``out`` = the kernel's inverse applied to ``x``: a displacement (m) to the
+        pressure (Pa) that would cause it on the whole grid, ``F⁻¹[F[x] / (Ĝ + c)]`` with
+        ``c`` a uniform Winkler ``compliance`` (m/Pa; 0 for the half-space alone), ``Ĝ``
+        the periodic kernel's ``2/(E*|q|)``.
+
+        The Fourier-diagonal preconditioner of :mod:`.preconditioned` (docs/models.md
+        §2.2, "The preconditioned iteration"): one forward and one inverse transform on the
+        operator's plans. Where ``Ĝ + c`` vanishes (the rigid mode without a compliance)
+        the smallest nonzero value stands in: the iteration projects that mode out under
+        load control, and under displacement control it must stay finite.
+        """
+        inverse = self._inverse_multiplier(float(compliance))
+        if self.splits:
+            self.forward(x)
+            with _spectrum.spectrum_threads(self.threads):
+                _spectrum.multiply_spectrum(self._spec, inverse)
+            return self.inverse(out)
+        out[...] = np.fft.irfft2(np.fft.rfft2(x) * inverse, s=self.shape)
+        return out
+
+    def _inverse_multiplier(self, compliance: float) -> np.ndarray:
+        """``1/(Ĝ + c)`` on the half-spectrum (Pa/m), with the inverse DFT's ``1/N``
+        folded in where the plans do not normalise (pyfftw); one array per compliance."""
+        cache = self.__dict__.setdefault("_inverse_multipliers", {})
+        if compliance not in cache:
+            symbol = self.multiplier + compliance
+            positive = symbol > 0
+            if not positive.any():
+                raise ValueError("the kernel's spectrum has no positive entry to invert")
+            inverse = np.where(positive, 1.0 / np.where(positive, symbol, 1.0), 0.0)
+            inverse[~positive] = 1.0 / symbol[positive].min()
+            if self.splits:
+                inverse *= self._scale
+            cache[compliance] = inverse
+        return cache[compliance]
 
     def forward(self, p: np.ndarray) -> None:
         """First half of ``K*p``: the spectrum of ``p`` (Pa) into the operator's work array.
@@ -358,6 +358,26 @@ class NonPeriodicConvolution(_MultiplierMixin):
             self._scale = 1.0 / (m0 * m1)
             self._mult_scaled = _scaled(self._multiplier, self._scale)
             self._multiplier = None  # keep one copy only (memory)
+
+    def precondition(self, x: np.ndarray, out: np.ndarray, compliance: float = 0.0):
+        """The preconditioner of :meth:`PeriodicConvolution.precondition` on the window
+        itself, periodic: the contact keeps off the window's edge, and the periodic inverse
+        on ``n0 × n1`` costs a quarter of the padded one's transforms for the same
+        iterations (benchmarks/README.md, benchmark 3b). Displacement m to pressure Pa."""
+        window = self.__dict__.get("_window_operator")
+        if window is None:
+            window = PeriodicConvolution(
+                self.shape, self.spacing, self.e_star, self.backend, self.threads,
+                self.planner_effort,
+            )  # fmt: skip
+            self.__dict__["_window_operator"] = window
+        return window.precondition(x, out, compliance)
+
+    @property
+    def precondition_pairs(self) -> float:
+        """The preconditioner's transforms in this operator's FFT pairs: the window's grid
+        over the padded one."""
+        return (self.shape[0] * self.shape[1]) / (self.padded_shape[0] * self.padded_shape[1])
 
     def real_space_kernel(self) -> np.ndarray:
         """The kernel of the padded circular convolution, ``padded_shape = (m0, m1)``, m/Pa

@@ -289,7 +289,7 @@ class _Iteration:
         self.convolution.precondition(
             self.gf.reshape(self.shape), self.w.reshape(self.shape), self.winkler
         )
-        self.calls += 1
+        self.calls += self.convolution.precondition_pairs
         total_w, gw, total_t = _pk.preconditioned_sums(self.w, self.gf, self.t, self.free)
         beta = gw / self.gw_old if self.gw_old > 0 else 0.0
         shift = (total_w + beta * total_t) / self.n_free if self.load_control else 0.0
