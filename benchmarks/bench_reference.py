@@ -1,9 +1,11 @@
 """Benchmark 4: time to solution against Tamaas 2.9 and ContactMechanics 1.8.
 
 Same periodic self-affine surface (Hurst 0.8, rms slope 0.1, p̄ = 0.005 E*, ~10 % contact),
-same load, one thread. Two problems: the elastic contact, and penetration hardness at
-p_Y = 0.1 E* (local increments; ContactMechanics' PlasticNonSmoothContactSystem, Tamaas
-left out: its KatoSaturated is much slower still). Every solver runs in a fresh subprocess
+same load, one thread; this solver with each of its CG iterations (``amontons``:
+Polonsky-Keer's, ``amontons-preconditioned``: the preconditioned one). Two problems: the
+elastic contact, and penetration hardness at p_Y = 0.1 E* (local increments;
+ContactMechanics' PlasticNonSmoothContactSystem, Tamaas left out: its KatoSaturated is much
+slower still). Every solver runs in a fresh subprocess
 and only the solve call is timed (model set-up and, for us, plan building and the kernels'
 load happen before; our plans use planner_effort="FFTW_MEASURE", passed explicitly), median
 of --repeats runs.
@@ -51,6 +53,9 @@ from amontons.contact.convolution import PeriodicConvolution
 # Penetration hardness of the benchmark (issue 14): p_Y = 0.1 E*.
 HARDNESS = 0.1 * E_STAR
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+# This solver with its two CG iterations: Polonsky-Keer's (the default) and the
+# preconditioned one (docs/models.md §2.2), each in a child of its own.
+OURS = ("amontons", "amontons-preconditioned")
 
 # One child per solver and problem: loads the heights, times `repeats` solves, saves the last
 # pressure. {problem} is "elastic" or "hardness"; {hardness} is p_Y in E* units.
@@ -63,9 +68,10 @@ n = h.shape[0]
 load, hardness, e_star, L = {load!r}, {hardness!r}, {e_star!r}, float(n)
 times, extra = [], {{}}
 for _ in range(repeats):
-    if solver == "amontons":
+    if solver.startswith("amontons"):
         from amontons.contact import PenetrationHardness, solve
-        kw = dict(periodic=True, threads=threads, planner_effort={effort!r})
+        iteration = "preconditioned" if solver.endswith("preconditioned") else "polonsky-keer"
+        kw = dict(periodic=True, threads=threads, planner_effort={effort!r}, iteration=iteration)
         if problem == "hardness":
             kw["plasticity"] = PenetrationHardness(hardness)
         if not times:  # plans, kernels and pools ready before the timing
@@ -116,7 +122,7 @@ def run_child(solver, problem, h, load, repeats, threads, python, tmp):
         np.save(heights, h)
     out = os.path.join(tmp, f"{solver}_{problem}_{h.shape[0]}.npy")
     env = dict(os.environ)
-    if solver != "amontons" or PINNED:
+    if not solver.startswith("amontons") or PINNED:
         env.update(dict.fromkeys(THREAD_VARIABLES, str(threads)))
     else:  # a plain process, as a user runs the solver
         for key in THREAD_VARIABLES:
@@ -175,9 +181,9 @@ def main():
                 ref = solve(h, 1.0, E_STAR, load=load, periodic=True, tol=1e-11, **law).pressure
                 p_max = HARDNESS if problem == "hardness" else None
                 ref_area, ref_d = contact_measures(ref, h, p_max)
-                ours_t = None
-                for solver in ("amontons", *peers[problem]):
-                    python = sys.executable if solver == "amontons" else args.peer_python
+                ours_t = preconditioned_t = None
+                for solver in (*OURS, *peers[problem]):
+                    python = sys.executable if solver in OURS else args.peer_python
                     info, p = run_child(
                         solver, problem, h, load, repeats, args.threads, python, tmp
                     )
@@ -187,6 +193,8 @@ def main():
                         continue
                     t = statistics.median(info["times"])
                     ours_t = t if solver == "amontons" else ours_t
+                    if solver == "amontons-preconditioned":
+                        preconditioned_t = t
                     area, d = contact_measures(p, h, p_max)
                     rows.append(
                         {
@@ -199,6 +207,9 @@ def main():
                             "approach rel. error": relative(d, ref_d),
                             "load error": float(abs(p.sum() / load - 1)),
                             "time / ours": t / ours_t if ours_t else "-",
+                            "time / ours preconditioned": (
+                                t / preconditioned_t if preconditioned_t else "-"
+                            ),
                         }
                     )
                     print(rows[-1], file=sys.stderr, flush=True)
