@@ -7,23 +7,26 @@ a bound whose gap pulls them off it):
 
 1. ``g = u - h - d`` on ``F``; load control: ``d`` the mean of ``u - h`` over the interior,
    then ``g`` made zero-sum on ``F`` (a step must not change the force);
-2. ``w = K⁻¹ g`` by the kernel's inverse symbol in Fourier space (``|q| E*/2`` periodic, the
-   padded Love kernel's inverse spectrum free; plus a uniform Winkler compliance), kept on
-   ``F`` and made zero-sum there: a Fourier-diagonal preconditioner restricted to the
-   contact set (Vollebregt, J. Comput. Phys. 257 (2014) 333);
+2. ``w = K⁻¹ g`` by the kernel's inverse symbol in Fourier space (``|q| E*/2``, plus a
+   uniform Winkler compliance; on a padded window the periodic one of the window itself),
+   kept on ``F`` and made zero-sum there: a Fourier-diagonal preconditioner restricted to
+   the contact set (Vollebregt, J. Comput. Phys. 257 (2014) 333);
 3. ``t = w + β t`` with ``β = Σ g·w / (Σ g·w)_old`` (Fletcher–Reeves), never restarted when
    ``F`` changes (Vollebregt's BCCG, J. Optim. Theory Appl. 162 (2014) 931); only a
    direction that is no descent falls back to ``w``;
 4. ``τ = Σ g·t / Σ t·K t`` (the denominator by Parseval from the forward transform of
-   ``t``); ``p ← clip(p - τ t, 0, p_max)``: the points that cross a bound stop there;
-5. load control: the interior points scaled to carry the load again;
-6. ``u = K p`` afresh.
+   ``t``); ``p ← clip(p - τ t, 0, p_max)``: the points that cross a bound stop there, a
+   pressure below round-off of the peak goes to 0;
+5. load control: the interior points scaled to carry the load again
+   (``_Iteration._impose_load`` says what happens where they cannot);
+6. ``u`` follows the step by its linear part and the responses of a few clipped points, or
+   is taken afresh (under a bound, after many clipped points, every ``refresh`` steps).
 
 Convergence is the Polonsky–Keer loop's: the complementarity and the relative change of
-``p`` both below ``tol``, on a fresh ``u`` (it is fresh every iteration here). One
-iteration costs 2.5 FFT pairs (the preconditioner's pair, the direction's forward transform,
-the fresh ``u``), against Polonsky–Keer's 1.5–2; it pays where it takes fewer than about
-0.6–0.8 as many iterations (benchmarks/README.md, benchmark 3).
+``p`` both below ``tol`` and the load carried, judged on a fresh ``u``. One iteration costs
+2–2.5 FFT pairs (the preconditioner's pair, the direction's forward transform, the inverse
+``u`` follows by or a fresh ``u``), against Polonsky–Keer's 1.3–1.5; it takes 0.2–0.5 of
+Polonsky–Keer's iterations on rough periodic surfaces (benchmarks/README.md, benchmark 3b).
 """
 
 from __future__ import annotations
@@ -71,7 +74,7 @@ def preconditioned_cg(
     :mod:`.convolution` (its ``precondition``), or a Winkler wrapper of one (``operator``
     and ``compliance`` attributes: contact hardening), whose compliance the
     preconditioner takes as its largest value. Of ``options`` it reads ``tol``,
-    ``max_iter`` and ``raise_on_failure``."""
+    ``max_iter``, ``refresh`` and ``raise_on_failure``."""
     if (load is None) == (displacement is None):
         raise ValueError("exactly one of load and displacement must be given")
     state = _Iteration(
