@@ -116,6 +116,7 @@ class PeriodicConvolution(_MultiplierMixin):
         self.planner_effort = _fft.check_planner_effort(planner_effort)
         self._multiplier = periodic_multiplier(self.shape, spacing, e_star)
         self._green = None  # real-space kernel, built on first use
+        self._inverse_multipliers = {}  # the preconditioner's, per compliance
         self.ncalls = 0
         if self.backend == "pyfftw":
             spec_shape = self._multiplier.shape
@@ -194,7 +195,7 @@ class PeriodicConvolution(_MultiplierMixin):
     def _inverse_multiplier(self, compliance: float) -> np.ndarray:
         """``1/(Ĝ + c)`` on the half-spectrum (Pa/m), with the inverse DFT's ``1/N``
         folded in where the plans do not normalise (pyfftw); one array per compliance."""
-        cache = self.__dict__.setdefault("_inverse_multipliers", {})
+        cache = self._inverse_multipliers
         if compliance not in cache:
             symbol = self.multiplier + compliance
             positive = symbol > 0
@@ -364,13 +365,10 @@ class NonPeriodicConvolution(_MultiplierMixin):
         itself, periodic: the contact keeps off the window's edge, and the periodic inverse
         on ``n0 × n1`` costs a quarter of the padded one's transforms for the same
         iterations (benchmarks/README.md, benchmark 3b). Displacement m to pressure Pa."""
-        window = self.__dict__.get("_window_operator")
-        if window is None:
-            window = PeriodicConvolution(
-                self.shape, self.spacing, self.e_star, self.backend, self.threads,
-                self.planner_effort,
-            )  # fmt: skip
-            self.__dict__["_window_operator"] = window
+        window = get_operator(
+            self.shape, self.spacing, self.e_star, periodic=True, backend=self.backend,
+            threads=self.threads, planner_effort=self.planner_effort,
+        )  # fmt: skip
         return window.precondition(x, out, compliance)
 
     @property

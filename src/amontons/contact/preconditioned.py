@@ -259,9 +259,7 @@ class _Iteration:
             if self.since_fresh == 0:
                 self.converged = True
                 return True
-            self._fresh_displacement()  # judge it on a fresh u, never a followed one
-            self.history.pop()
-            self._gradient()
+            self._judge_on_fresh_displacement()
             return self._finished(monitor)
         if self.n_free == 0:
             self.stalled = "no free point is left and the gaps do not close"
@@ -279,6 +277,13 @@ class _Iteration:
             self.stalled = monitor.message()
             return True
         return False
+
+    def _judge_on_fresh_displacement(self):
+        """``u`` taken afresh and the gradient and residual taken again on it, in place of
+        the last ones: convergence is never judged on a followed ``u``."""
+        self._fresh_displacement()
+        self.history.pop()
+        self._gradient()
 
     def _at_load(self) -> bool:
         """Whether the field carries the load (to round-off; always under displacement
@@ -314,9 +319,7 @@ class _Iteration:
         residual, on a fresh ``u``, is below ``tol``; else stalled."""
         self.it -= 1  # this iteration took no step
         if self.since_fresh:
-            self._fresh_displacement()
-            self.history.pop()
-            self._gradient()
+            self._judge_on_fresh_displacement()
         if self.residual < self.tol:
             self.converged = True
         else:
@@ -348,7 +351,7 @@ class _Iteration:
                 self.clip_added,
             )  # fmt: skip
             factor = self.target / total if (self.load_control and total > 0) else 1.0
-            if not self.load_control or self._impose_load(total, inner):
+            if not self.load_control or self._impose_load(total, inner) or self.saved is None:
                 break
             # every loaded point went to a bound short of the load, none left to carry the
             # deficit: a shorter step (as Polonsky-Keer's bounded load step does)

@@ -115,15 +115,6 @@ def next_direction(w, gf, free, shift, beta, t):
 
 
 @numba.njit(**_SERIAL)
-def squares(x):
-    """``Σ x²`` (the Winkler layer's share of ``Σ t·(K+C)t``, times its compliance)."""
-    total = 0.0
-    for i in range(x.size):
-        total += x[i] * x[i]
-    return total
-
-
-@numba.njit(**_SERIAL)
 def step(p, t, tau, p_max, floor, idx, added):
     """``p ← clip(p - τ t, 0, p_max)`` in place, a pressure below ``floor`` (round-off of
     the field's, Pa) set to 0. The first ``idx.size`` points the clip moved are recorded:
