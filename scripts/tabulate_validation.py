@@ -16,7 +16,7 @@ from amontons.validation.tables import (
 )
 
 
-def main(records: list[str], ratio: float, confidence: float, outputs: dict):
+def main(records: list[str], ratio: float, confidence: float, left_out: list[str], outputs: dict):
     cases = [read_json(p) for p in records]
     table = case_table(cases)
     coverage = coverage_table(table, confidence)
@@ -29,7 +29,7 @@ def main(records: list[str], ratio: float, confidence: float, outputs: dict):
     write_table(outputs["cost"], cost)
     write_table(outputs["checks"], pd.DataFrame(checked))
     with atomic_path(outputs["summary"]) as tmp:
-        tmp.write_text(summary_markdown(coverage, confusion, checked, cost))
+        tmp.write_text(summary_markdown(coverage, confusion, checked, cost, left_out))
     plot_intervals(table, ratio, [outputs["figure"]])
 
 
@@ -41,5 +41,6 @@ if __name__ == "__main__":
         records=list(sm.input.records),
         ratio=sm.params.ratio,
         confidence=sm.params.confidence,
+        left_out=list(sm.params.left_out),
         outputs=dict(sm.output.items()),
     )

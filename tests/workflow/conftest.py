@@ -125,13 +125,23 @@ def small_data(tmp_path_factory) -> Path:
 @pytest.fixture(scope="session")
 def small_run(small_data, tmp_path_factory) -> Path:
     """The deployed folder after the whole small-data run, 2 cores, the accuracy study
-    (`snakemake accuracy`) and the reduced validation study (`snakemake validation`), with
-    the report at results/small/report.html. Tests only read it (the rerun test's dry runs
+    (`snakemake accuracy`) and the reduced validation study (`snakemake validation`, and
+    `snakemake validation_spheres` on the sheet's PS sphere), with the report at
+    results/small/report.html. Tests only read it (the rerun test's dry runs
     read an edited copy of its overlay)."""
     root = _shared_root(tmp_path_factory)
 
     def make():
-        _snakemake(small_data, "all", "accuracy", "validation", "--cores", "2", timeout=2400)
+        _snakemake(
+            small_data,
+            "all",
+            "accuracy",
+            "validation",
+            "validation_spheres",
+            "--cores",
+            "2",
+            timeout=2400,
+        )
         _snakemake(small_data, "--report", f"results/{RUN}/report.html", timeout=600)
 
     _once(root, "small_run", make)

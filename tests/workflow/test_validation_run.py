@@ -16,7 +16,7 @@ import pytest
 
 from amontons.config import read_config
 from amontons.validation.case import NOT_DECIDED
-from amontons.validation.cases import case_names
+from amontons.validation.cases import case_names, sphere_case_names
 
 
 @pytest.fixture(scope="module")
@@ -95,3 +95,29 @@ def test_a_truth_from_another_solver_is_judged_and_says_whose_it_is(records):
         assert all(scan["interval"][1] is None for scan in record["scans"].values())
     ours = {r["truth_solver"] for r in records if r["truth"] != "elastic_cm"}
     assert len(ours) == 1 and ours.pop().startswith("amontons ")
+
+
+def test_the_sheets_sphere_is_validated_by_the_workflows_own_jobs(small_run, settings):
+    """`snakemake validation_spheres` (config/test.yaml: the sheet's PS sphere, one seed of an
+    elastic truth and one of each plastic model at its config value): each truth solved at
+    the sheet's loads, 2x finer than the draft preset's pixel by the preconditioned
+    iteration, judged about the sheet's priors; no wrong model named; the tables count the
+    three cases and name no sphere left out."""
+    folder = small_run / "results" / "small" / "validation"
+    names = sphere_case_names(settings["validation"])
+    assert len(names) == 3
+    records = [json.loads((folder / "cases" / f"{name}.json").read_text()) for name in names]
+    preset = settings["solver_presets"][settings["solver_preset"]]
+    for record in records:
+        assert record["sphere"] == "PS"
+        assert record["loads_mn"] == [25.0, 50.0, 100.0, 200.0, 300.0]  # the sheet's
+        assert record["study_pixel_nm"] == pytest.approx(preset["pixel_nm"])
+        assert record["ratio_solved"] >= 2.0
+        assert record["truth_iteration"] == "preconditioned"
+        assert record["verdict"] in (record["model"], NOT_DECIDED), record["case"]
+        # the p_Y scan about the sheet's 200 MPa: 0.2-4x it
+        assert min(record["scans"]["penetration_hardness"]["values"]) == pytest.approx(40.0)
+    cases = pd.read_csv(folder / "spheres" / "cases.csv")
+    assert set(cases["sphere"]) == {"PS"} and cases["case"].nunique() == 3
+    summary = (folder / "spheres" / "validation.md").read_text()
+    assert "Left out" not in summary

@@ -49,7 +49,12 @@ from amontons.workflow.accuracy import TIMING_POINT
 from amontons.workflow.run import WorkflowRun
 from amontons.workflow.optional_inputs import RHEOMETER
 from amontons.workflow.sheet_rows import TRUE_HARDENING_COLUMN
-from amontons.workflow.validation import validation_cases
+from amontons.workflow.validation import (
+    left_out_validation_spheres,
+    validation_cases,
+    validation_sphere_cases,
+    validation_sphere_record,
+)
 from amontons.workflow.wildcards import names_pattern
 
 CONFIG_SOURCE = ", ".join(
@@ -124,6 +129,11 @@ SCAN_REFINED = SCAN_JUDGEMENT["refine_max_values"]
 SCAN_CHECK_FACTOR = SCAN_JUDGEMENT["model_error_pixel_factor"]
 # The validation study's cases (docs/study.md §7): one job each.
 VALIDATION_CASES = validation_cases(config)
+# ... and on the materials sheet's spheres (docs/study.md §7, target validation_spheres); the
+# spheres it names but cannot run on are named in its summary.
+VALIDATION_SPHERE_CASES = validation_sphere_cases(config, SPHERES.rows.records)
+VALIDATION_SPHERES_LEFT_OUT = left_out_validation_spheres(config, SPHERES.rows.records)
+validation_sphere = partial(validation_sphere_record, config, SPHERES.rows.records)
 RING_OPTICS = ring_optics(config)
 AFM_READING = afm_reading(config)
 # Which plane of a confocal file is the image: the fluorescence and bead one, the reflection one.

@@ -10,7 +10,7 @@ import jsonschema
 import yaml
 
 from amontons.config.errors import ConfigError
-from amontons.models import model_names, parameter_keys, with_parameter
+from amontons.models import FIELD, MODELS, model_names, parameter_keys, with_parameter
 
 
 def load_schema(path: str | Path) -> dict:
@@ -54,7 +54,33 @@ def with_models(schema: dict) -> dict:
     elif "sphere" in properties:
         for parameter in parameters:
             properties.setdefault(parameter.sheet_column, _sheet_column_property(parameter))
+    if "validation" in properties:
+        _fill_validation(properties["validation"]["properties"], parameters)
     return schema
+
+
+def _fill_validation(validation: dict, parameters: list) -> None:
+    """The validation study's keys that the records decide: a truth's models (those solved on
+    a grid) and its value's key, the priors' keys and the sheet spheres' values' keys, one
+    per parameter, each required."""
+    truth = validation["truths"]["additionalProperties"]["properties"]
+    truth["model"]["enum"] = [m.name for m in MODELS if m.kind == FIELD]
+    for parameter in parameters:
+        truth.setdefault(parameter.key, _value_property(parameter, "a truth of its model"))
+    values = validation["spheres"]["properties"]["values"]["additionalProperties"]
+    for node, what in ((validation["priors"], "the scan's prior"), (values, "the truth's value")):
+        node["required"] = [p.key for p in parameters]
+        node.setdefault("properties", {})
+        for parameter in parameters:
+            node["properties"].setdefault(parameter.key, _value_property(parameter, what))
+
+
+def _value_property(parameter, what: str) -> dict:
+    return {
+        "type": "number",
+        "exclusiveMinimum": 0,
+        "description": f"{parameter.description}: {what}",
+    }
 
 
 def _key_path(error: jsonschema.ValidationError) -> str:

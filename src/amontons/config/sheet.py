@@ -40,7 +40,7 @@ _BOOLEAN_WORDS = {"true": True, "false": False, "yes": True, "no": False, "1": T
 # second rule of that name (each material gets its own target, `snakemake PS`).
 RESERVED_NAMES = frozenset(
     {"all", "optics", "surface", "friction", "fits", "figures", "virtual_experiment", "scenes"}
-    | {"scans", "study", "accuracy", "validation"}
+    | {"scans", "study", "accuracy", "validation", "validation_spheres"}
     | {"synthetic"}  # the folder of the synthetic scenes, results/<run>/synthetic/
 )
 

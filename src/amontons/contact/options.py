@@ -111,6 +111,8 @@ _EXACT_ROUTE_LAWS = {law.exact_route: law.__name__ for law in PLASTICITY_LAWS}
 # The CG iterations a route can run (docs/models.md §2.2): Polonsky and Keer's, and the
 # preconditioned bound-constrained CG of .preconditioned.
 ITERATIONS = ("polonsky-keer", "preconditioned")
+# the iteration a solve runs unless asked otherwise
+DEFAULT_ITERATION = ITERATIONS[0]
 
 # Default caps on the outer loop (max_outer=None): plastic updates per approach of the
 # appendix scheme, and active-set rounds of the Winkler route.
@@ -183,7 +185,7 @@ class CGOptions:
     threads: int | None = None
     bounded_load_sweep: bool = True
     array_module: str | None = None
-    iteration: str = "polonsky-keer"
+    iteration: str = DEFAULT_ITERATION
 
 
 @dataclass(frozen=True)
@@ -209,7 +211,7 @@ class SolveOptions:
     max_outer: int | None
     raise_on_failure: bool
     bounded_load_sweep: bool = True
-    iteration: str = "polonsky-keer"
+    iteration: str = DEFAULT_ITERATION
 
     @property
     def cg(self) -> CGOptions:
@@ -253,7 +255,7 @@ def solve_options(
     method,
     max_outer,
     raise_on_failure,
-    iteration="polonsky-keer",
+    iteration=DEFAULT_ITERATION,
 ) -> SolveOptions:
     """Validate the options of a solve on a grid of ``shape``."""
     tol = check_positive("tol", tol, "(dimensionless)")

@@ -12,6 +12,7 @@ from __future__ import annotations
 import time
 
 from amontons import models
+from amontons.contact.options import DEFAULT_ITERATION
 from amontons.measure.area import OtsuSettings
 from amontons.simulate.scan_best import ScanBest
 from amontons.simulate.scan_criterion import TooFewLoads
@@ -27,6 +28,8 @@ from amontons.validation.truth import (
 
 # the verdict where the data keep more than one model
 NOT_DECIDED = "not decided"
+# the record's name for the study's own small sphere (the config's ``validation`` keys)
+SMALL_SPHERE = "validation"
 
 
 def holds_truth(answer: ScanAnswer, truth: Truth, best: ScanBest | None = None) -> bool | None:
@@ -71,17 +74,24 @@ def verdict_of(kept: tuple[str, ...]) -> str:
 
 
 def run_case(
-    case: Case, sphere: Sphere, settings: StudySettings, truth_tol: float, otsu: OtsuSettings
+    case: Case,
+    sphere: Sphere,
+    settings: StudySettings,
+    truth_tol: float,
+    otsu: OtsuSettings,
+    truth_iteration: str = DEFAULT_ITERATION,
 ) -> dict:
-    """The case's truth, its study and the record of both (JSON-ready)."""
+    """The case's truth (ours solved by our CG ``truth_iteration``), its study and the record
+    of both (JSON-ready)."""
     grids = grids_of(sphere, settings.pixel_m, case.ratio)
-    measured = measure_truth(sphere, grids, case, truth_tol, otsu)
+    measured = measure_truth(sphere, grids, case, truth_tol, otsu, truth_iteration)
     # the PSF the study measured: the truth's, off by one draw of its stated standard error
     psf = sphere.psf_fwhm_m + sphere.psf_se_m * float(case_rng(case, "psf").standard_normal())
     study = CaseStudy(sphere, measured, settings, psf)
     start = time.perf_counter()
     record = {
         "case": case.name,
+        "sphere": case.sphere or SMALL_SPHERE,
         "truth": case.truth.name,
         "model": case.truth.model,
         "value": case.truth.value,
@@ -91,6 +101,7 @@ def run_case(
         "ratio": case.ratio,
         "comparison": case.comparison,
         "truth_solver": truth_solver_label(case),
+        "truth_iteration": truth_iteration,
         "ratio_solved": grids.ratio,
         "truth_pixel_nm": grids.truth_pixel_m * 1e9,
         "study_pixel_nm": grids.study_pixel_m * 1e9,

@@ -4,11 +4,14 @@ without loading the numerical stack.
 
 A *truth* is a contact model with its parameter (an elastic truth has none); a *case* is one
 truth on one seed's rough sphere, solved ``ratio`` times finer in pixel than the study then
-solves it."""
+solves it. The cases are on the study's own small sphere (the config's ``validation`` keys),
+or on a sphere of the materials sheet (``validation.spheres``: the reproduction's spheres, at
+the pixel the run's solver preset solves each at), whose truths are its elastic contact and
+each plastic model at the value the config gives that sphere."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 
 from amontons import models
@@ -94,12 +97,15 @@ class Truth:
 @dataclass(frozen=True)
 class Case:
     """One truth on one seed's sphere, solved ``ratio`` times finer in pixel than the study;
-    ``comparison``: one of the comparison ratios' cases (reported, not held to the targets)."""
+    ``comparison``: one of the comparison ratios' cases (reported, not held to the targets);
+    ``sphere``: the materials sheet's sphere it is on (None: the study's own small sphere;
+    the truth's name then starts with the sphere's)."""
 
     truth: Truth
     seed: int
     ratio: float
     comparison: bool = False
+    sphere: str | None = None
 
     @property
     def name(self) -> str:
@@ -142,13 +148,62 @@ def cases_of(validation: Mapping) -> list[Case]:
 
 
 def case_named(validation: Mapping, name: str) -> Case:
-    """The case of ``name`` (:attr:`Case.name`)."""
-    for case in cases_of(validation):
+    """The case of ``name`` (:attr:`Case.name`), on the small sphere or a sheet sphere."""
+    for case in [*cases_of(validation), *sphere_cases(validation)]:
         if case.name == name:
             return case
     raise ValueError(f"validation case {name!r} is not one of the config's cases")
 
 
 def case_names(validation: Mapping) -> list[str]:
-    """The names of every case of the study (the jobs' wildcards)."""
+    """The names of every case of the study on its small sphere (the jobs' wildcards)."""
     return [case.name for case in cases_of(validation)]
+
+
+# the truths on a sheet sphere: each model solved on a grid and its signal (each plastic model
+# at the value ``validation.spheres`` gives the sphere, clear of the model error by its choice)
+SPHERE_TRUTHS = tuple(
+    (name, NO_PLASTICITY if name not in PARAMETER_OF else CLEAR) for name in TRUTH_MODELS
+)
+
+
+def sphere_truths(sphere: str, values: Mapping) -> list[Truth]:
+    """The truths on sheet sphere ``sphere``: elastic, and each plastic model at its value in
+    ``values`` (config units: p_y_mpa, k_mpa_per_nm), named ``<sphere>_<model>``."""
+    truths = []
+    for model, signal in SPHERE_TRUTHS:
+        parameter = PARAMETER_OF.get(model)
+        value = None if parameter is None else float(values[parameter])
+        truths.append(Truth(f"{sphere}_{model}", model, value, signal))
+    return truths
+
+
+def sphere_cases(validation: Mapping, available: Collection[str] | None = None) -> list[Case]:
+    """The cases on the materials sheet's spheres: every truth (:func:`sphere_truths`) of each
+    sphere ``validation.spheres.run`` names (of those in ``available``, where given) on
+    ``seeds`` seeds from ``first_seed``, at ``ratio``."""
+    block = validation["spheres"]
+    seeds = range(block["first_seed"], block["first_seed"] + block["seeds"])
+    ratio = float(block["ratio"])
+    cases = []
+    for sphere in block["run"]:
+        if available is not None and sphere not in available:
+            continue
+        if sphere not in block["values"]:
+            raise ValueError(
+                f"validation.spheres.run names {sphere!r}; expected one of its values' spheres "
+                f"{list(block['values'])}"
+            )
+        truths = sphere_truths(sphere, block["values"][sphere])
+        cases += [Case(truth, seed, ratio, sphere=sphere) for truth in truths for seed in seeds]
+    return cases
+
+
+def sphere_case_names(validation: Mapping, available: Collection[str] | None = None) -> list[str]:
+    """The names of the cases on the sheet's spheres (the jobs' wildcards)."""
+    return [case.name for case in sphere_cases(validation, available)]
+
+
+def sphere_of_case(validation: Mapping, name: str) -> str | None:
+    """The sheet sphere case ``name`` is on (None: the study's own small sphere)."""
+    return case_named(validation, name).sphere

@@ -70,6 +70,12 @@ class StudySettings:
         )
 
 
+def sheet_priors(record: Mapping) -> dict[str, float]:
+    """A sheet sphere's priors (config units, by parameter key): each plastic model's prior
+    column of its row (config/materials.tsv), as the reproduction's scans take them."""
+    return {m.parameter.key: float(record[m.parameter.sheet_column]) for m in with_parameter()}
+
+
 @dataclass
 class Solved:
     """One value solved: its point of the scan, its pressures (the neighbours' warm start;

@@ -23,7 +23,7 @@ from scipy.stats import binomtest
 
 from amontons import models
 from amontons.study.summary import markdown_table
-from amontons.validation.case import NOT_DECIDED
+from amontons.validation.case import NOT_DECIDED, SMALL_SPHERE
 from amontons.validation.cases import (
     BELOW_MODEL_ERROR,
     CLEAR,
@@ -43,11 +43,13 @@ MAX_NAMED_WRONG = 0.05
 
 
 def case_table(records: Sequence[dict]) -> pd.DataFrame:
-    """One row per case and scan: the truth, the scan's estimate and interval, whether it
+    """One row per case and scan: the sphere (a record before the sheet's spheres were
+    validated is on the small one), the truth, the scan's estimate and interval, whether it
     holds the truth, the verdict and the cost."""
     rows = []
     for r in records:
-        base = {k: r[k] for k in ("case", "truth", "model", "value", "signal", "seed", "ratio")}
+        base = {"case": r["case"], "sphere": r.get("sphere", SMALL_SPHERE)}
+        base |= {k: r[k] for k in ("truth", "model", "value", "signal", "seed", "ratio")}
         base |= {"solver": r["truth_solver"], "comparison": r["comparison"]}
         base |= {
             "verdict": r["verdict"],
@@ -278,10 +280,23 @@ def _markdown(table: pd.DataFrame) -> str:
     return markdown_table(lines).rstrip("\n")
 
 
+def _left_out_section(left_out: Sequence[str]) -> list[str]:
+    """validation.md's list of the spheres the config named but the run left out (none:
+    no section)."""
+    if not left_out:
+        return []
+    return ["Left out:\n\n" + "\n".join(f"- {line}" for line in left_out)]
+
+
 def summary_markdown(
-    coverage: pd.DataFrame, confusion: pd.DataFrame, checked: list[dict], cost: pd.DataFrame
+    coverage: pd.DataFrame,
+    confusion: pd.DataFrame,
+    checked: list[dict],
+    cost: pd.DataFrame,
+    left_out: Sequence[str] = (),
 ) -> str:
-    """validation.md: the checks first, then coverage, confusion and cost."""
+    """validation.md: the checks first, then the spheres the config named but the run left out
+    (``left_out``: a line each, why), coverage, confusion and cost."""
     met = all(c["met"] for c in checked)
     return (
         "\n\n".join(
@@ -289,6 +304,7 @@ def summary_markdown(
                 "# Validation: the study's intervals and verdicts against truths of every model",
                 f"All targets met: **{'yes' if met else 'no'}** (docs/study.md §7 says how the "
                 "truths were made and what the intervals count).",
+                *_left_out_section(left_out),
                 _markdown(pd.DataFrame(checked)),
                 "## Coverage of the intervals at each level (Clopper–Pearson 95 % interval of the "
                 "fraction)",

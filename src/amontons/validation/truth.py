@@ -19,7 +19,10 @@ from importlib.metadata import version
 
 import numpy as np
 
+from amontons.config import geometry
+from amontons.config.geometry import Frame
 from amontons.contact import FreeBoundaryError, laws, solve_load_series
+from amontons.contact.options import DEFAULT_ITERATION
 from amontons.contact.surfaces import sphere as sphere_cap
 from amontons.measure.area import ContactArea, OtsuSettings, otsu_contact_area
 from amontons.models import model_named
@@ -73,6 +76,45 @@ class Sphere:
             confinement_floor_pa=v["confinement_floor_mpa"] * 1e6,
             window_factor=v["window_factor"],
         )
+
+    @classmethod
+    def from_sheet(cls, record: Mapping, validation: Mapping, virtual: Mapping) -> Sphere:
+        """A sphere of the materials sheet (``record``: diameter, E*, loads, roughness rms,
+        fluorescence pixel) as the virtual experiment makes and images it (``virtual``: the
+        roughness spectrum at the AFM pixel, the PSF, the counts, the confinement floor), told
+        its PSF to ``validation.psf_se_nm``, on ``validation.spheres.window_factor``."""
+        return cls.from_config(
+            {
+                "diameter_mm": record["diameter_mm"],
+                "e_star_gpa": record["e_star_gpa"],
+                "loads_mn": record["loads"],
+                "roughness_rms_nm": record["roughness_rms_nm"],
+                "roughness_hurst": virtual["roughness_hurst"],
+                "roughness_rolloff_um": virtual["roughness_rolloff_um"],
+                "roughness_reference_pixel_nm": virtual["afm_pixel_nm"],
+                "image_pixel_nm": record.get("fluorescence_pixel_nm")
+                or validation["image_pixel_nm"],
+                "psf_fwhm_nm": virtual["psf_fwhm_nm"],
+                "psf_se_nm": validation["psf_se_nm"],
+                "background_counts": virtual["background_counts"],
+                "contact_counts": virtual["contact_counts"],
+                "confinement_floor_mpa": virtual["confinement_floor_mpa"],
+                "window_factor": validation["spheres"]["window_factor"],
+            }
+        )
+
+    @property
+    def frame(self) -> Frame:
+        """The sphere as a scene's frame (amontons.config.geometry)."""
+        return Frame(self.loads_n, self.radius_m, self.e_star_pa)
+
+
+def study_pixel_m(sphere: Sphere, preset: Mapping) -> float:
+    """The pixel (m) the run's solver ``preset`` solves the sphere's scenes at: its
+    ``pixel_nm``, coarsened where its window would need more than ``max_side_px`` pixels
+    (amontons.config.geometry), as the reproduction solves its large spheres."""
+    window = geometry.window_m("validation", preset, sphere.frame)
+    return geometry.solver_pixel_m(preset, window)
 
 
 def law_of(model: str, value: float | None):
@@ -153,10 +195,17 @@ class Measured:
         return [c.area_m2 for c in self.contacts]
 
 
-def solve_truth(sphere: Sphere, grids: Grids, case: Case, heights: np.ndarray, tol: float):
+def solve_truth(
+    sphere: Sphere,
+    grids: Grids,
+    case: Case,
+    heights: np.ndarray,
+    tol: float,
+    iteration: str = DEFAULT_ITERATION,
+):
     """The truth's load series on the fine grid (each load's pressure, contact, area and mean
-    pressure), by the truth's solver: ours, or ContactMechanics
-    (amontons.validation.independent), at ``tol``."""
+    pressure), by the truth's solver: ours (its CG ``iteration``, docs/models.md §2), or
+    ContactMechanics (amontons.validation.independent), at ``tol``."""
     if case.truth.solver == CONTACTMECHANICS:
         hardness = truth_law(case.truth)
         return contactmechanics_load_series(
@@ -175,6 +224,7 @@ def solve_truth(sphere: Sphere, grids: Grids, case: Case, heights: np.ndarray, t
             list(sphere.loads_n),
             plasticity=truth_law(case.truth),
             tol=tol,
+            iteration=iteration,
         )
     except FreeBoundaryError as error:
         raise ValueError(
@@ -191,12 +241,18 @@ def truth_solver_label(case: Case) -> str:
 
 
 def measure_truth(
-    sphere: Sphere, grids: Grids, case: Case, tol: float, otsu: OtsuSettings
+    sphere: Sphere,
+    grids: Grids,
+    case: Case,
+    tol: float,
+    otsu: OtsuSettings,
+    iteration: str = DEFAULT_ITERATION,
 ) -> Measured:
-    """Solve the case's truth on the fine grid at ``tol`` and image every load."""
+    """Solve the case's truth on the fine grid at ``tol`` (by our CG ``iteration`` where the
+    truth is ours) and image every load."""
     heights = fine_surface(sphere, grids, case)
     start = time.perf_counter()
-    results = solve_truth(sphere, grids, case, heights, tol)
+    results = solve_truth(sphere, grids, case, heights, tol, iteration)
     wall = time.perf_counter() - start
     side = image_side_px(grids.window_m, sphere.image_pixel_m)
     average = PixelAverager(heights.shape, grids.truth_pixel_m, (side, side), sphere.image_pixel_m)

@@ -1,13 +1,61 @@
 """The validation study's jobs (docs/study.md §7): one per case of the config's
-``validation`` slice (amontons.validation.cases), named for the Snakefile."""
+``validation`` slice (amontons.validation.cases), named for the Snakefile, on its small
+sphere (target ``validation``) and on the materials sheet's spheres that
+``validation.spheres.run`` names (target ``validation_spheres``)."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 
-from amontons.validation.cases import case_names
+from amontons.models import with_parameter
+from amontons.validation.cases import case_names, sphere_case_names, sphere_of_case
 
 
 def validation_cases(config: Mapping) -> list[str]:
-    """The names of the validation study's cases: the wildcards of its case jobs."""
+    """The names of the validation study's cases on its small sphere."""
     return case_names(config["validation"])
+
+
+def runnable_validation_spheres(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
+    """The spheres ``validation.spheres.run`` names that the run can validate on: spheres of
+    the selected materials whose sheet row states each plastic model's prior."""
+    return [
+        sphere
+        for sphere in config["validation"]["spheres"]["run"]
+        if sphere in selected and not _missing_priors(selected[sphere])
+    ]
+
+
+def left_out_validation_spheres(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
+    """A line for each sphere ``validation.spheres.run`` names that the run cannot validate
+    on, and why (the rest of the study runs without it)."""
+    lines = []
+    for sphere in config["validation"]["spheres"]["run"]:
+        if sphere not in selected:
+            lines.append(
+                f"validation.spheres.run: {sphere} is not a sphere of the selected materials "
+                f"{list(config['materials'])}; its validation cases are left out"
+            )
+        elif missing := _missing_priors(selected[sphere]):
+            lines.append(
+                f"validation.spheres.run: {sphere}'s sheet row has no {', '.join(missing)}, the "
+                "prior its scans are centred on; its validation cases are left out"
+            )
+    return lines
+
+
+def _missing_priors(record: Mapping) -> list[str]:
+    """The prior columns a sheet row leaves empty."""
+    columns = [m.parameter.sheet_column for m in with_parameter()]
+    return [c for c in columns if record.get(c) is None]
+
+
+def validation_sphere_cases(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
+    """The names of the cases on the sheet's spheres the run can validate on."""
+    return sphere_case_names(config["validation"], runnable_validation_spheres(config, selected))
+
+
+def validation_sphere_record(config: Mapping, selected: Mapping[str, dict], case: str):
+    """The sheet record of the sphere case ``case`` is on, None for the small sphere's."""
+    sphere = sphere_of_case(config["validation"], case)
+    return None if sphere is None else selected[sphere]
