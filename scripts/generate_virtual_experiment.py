@@ -7,7 +7,6 @@ if "snakemake" in globals():
     # The contact solve's BLAS calls spin OpenBLAS threads beyond the rule's (benchmarks/README)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", str(snakemake.threads))  # noqa: F821
 
-from amontons.models import CONTACT_HARDENING
 from amontons.runlog import run_logged
 from amontons.virtual.experiment import generate_sphere
 from amontons.virtual.settings import InstrumentSettings, OutputFormats, SurfaceSettings
@@ -19,7 +18,8 @@ def main(
     diameter_mm: float,
     e_star_gpa: float,
     roughness_rms_nm: float,
-    hardening_k_mpa_per_nm: float,
+    true_model: str,
+    true_value: float | None,
     loads_mn: list[float],
     reflection_load_mn: float,
     flim_load_mn: float | None,
@@ -36,7 +36,8 @@ def main(
         diameter_m=diameter_mm * 1e-3,
         e_star_pa=e_star_gpa * 1e9,
         roughness_rms_m=roughness_rms_nm * 1e-9,
-        hardening_k_pa_per_m=hardening_k_mpa_per_nm * CONTACT_HARDENING.parameter.to_si,
+        true_model=true_model,
+        true_value=true_value,
         loads_n=[load * 1e-3 for load in loads_mn],
         pixel_m=pixel_nm * 1e-9,
         reflection_load_n=reflection_load_mn * 1e-3,
@@ -60,7 +61,8 @@ if __name__ == "__main__":
         diameter_mm=sm.params.diameter_mm,
         e_star_gpa=sm.params.e_star_gpa,
         roughness_rms_nm=sm.params.roughness_rms_nm,
-        hardening_k_mpa_per_nm=sm.params.hardening_k_mpa_per_nm,
+        true_model=sm.params.true_model,
+        true_value=sm.params.true_value,
         loads_mn=sm.params.loads_mn,
         reflection_load_mn=sm.params.reflection_load_mn,
         flim_load_mn=sm.params.flim_load_mn,

@@ -100,10 +100,11 @@ def test_only_the_validation_study_connects_them_and_nothing_of_either_imports_i
     halves = ("measure", "virtual", "simulate", "study", "contact")
     for source in halves:
         assert _edges(f"amontons.{source}", "amontons.validation") == []
-    assert {name for _, name in _edges("amontons.workflow", "amontons.validation")} <= {
-        "amontons.validation.cases",
-        "amontons.validation.cases.case_names",
-    }
+    # the workflow names the jobs from the cases module alone (pure Python)
+    assert {
+        name.removeprefix("amontons.validation.cases").split(".")[0]
+        for _, name in _edges("amontons.workflow", "amontons.validation")
+    } == {""}
 
 
 def test_the_generator_takes_from_simulate_only_what_knows_nothing_of_the_analysis():

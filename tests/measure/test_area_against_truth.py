@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter
 
+from amontons.contact import ContactHardening
 from amontons.measure.area import otsu_contact_area
 from amontons.physics.gaussian import FWHM_PER_SIGMA
 from amontons.physics.newton_rings import APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX
@@ -39,7 +40,7 @@ def rough_solution(request):
     solution = simulate_rough_sphere(
         radius_m=radius,
         e_star_pa=e_star,
-        k_pa_per_m=k,
+        law=ContactHardening(k),
         loads_n=[25e-3, 200e-3],
         reflection_load_n=25e-3,
         ring_reach_gap_m=ring_reach_gap(1, APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX),

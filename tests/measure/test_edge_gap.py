@@ -4,6 +4,7 @@
 import numpy as np
 import pytest
 
+from amontons.contact import ContactHardening
 from amontons.io.tiff import read_image, write_image
 from amontons.measure.area import OtsuSettings
 from amontons.measure.edge_gap import (
@@ -184,7 +185,7 @@ def patchy_sphere(tmp_path_factory):
     solution = simulate_rough_sphere(
         radius_m=RADIUS,
         e_star_pa=E_STAR,
-        k_pa_per_m=1e19,
+        law=ContactHardening(1e19),
         loads_n=[LOAD],
         reflection_load_n=LOAD,
         ring_reach_gap_m=ring_reach_gap(3, APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX),

@@ -30,8 +30,10 @@ from amontons.virtual.experiment import generate_sphere
 from amontons.virtual.settings import InstrumentSettings, SurfaceSettings
 
 LOADS_MN = [25.0, 50.0, 100.0, 200.0]
-GLASS = {"diameter_m": 4e-3, "e_star_pa": 32.8e9, "roughness_rms_m": 0.0, "k": 1e19}
-PS = {"diameter_m": 0.6e-3, "e_star_pa": 3.7e9, "roughness_rms_m": 80e-9, "k": 5e15}
+# the truths' values in the records' config units: k = 10000 MPa/nm (1e19 Pa/m) makes glass's
+# hardening layer negligible; PS flows by contact hardening at 5 MPa/nm
+GLASS = {"diameter_m": 4e-3, "e_star_pa": 32.8e9, "roughness_rms_m": 0.0, "k": 10000.0}
+PS = {"diameter_m": 0.6e-3, "e_star_pa": 3.7e9, "roughness_rms_m": 80e-9, "k": 5.0}
 
 
 def _config(repo, **overrides):
@@ -42,8 +44,11 @@ def _config(repo, **overrides):
     return settings, config["optics"]["newton_rings"]
 
 
-def _generate(folder, repo, sphere="glass", seed=11, flim_load_n=None, **overrides):
+def _generate(folder, repo, sphere="glass", seed=11, flim_load_n=None, truth=None, **overrides):
+    """One sphere's files; ``truth``: its (model, value), contact hardening at the sphere's k
+    where None."""
     spec = GLASS if sphere == "glass" else PS
+    model, value = ("hardening", spec["k"]) if truth is None else truth
     settings, newton_rings = _config(repo, **overrides)
     return generate_sphere(
         folder,
@@ -51,7 +56,8 @@ def _generate(folder, repo, sphere="glass", seed=11, flim_load_n=None, **overrid
         diameter_m=spec["diameter_m"],
         e_star_pa=spec["e_star_pa"],
         roughness_rms_m=spec["roughness_rms_m"],
-        hardening_k_pa_per_m=spec["k"],
+        true_model=model,
+        true_value=value,
         loads_n=[f * 1e-3 for f in LOADS_MN],
         pixel_m=200e-9,
         reflection_load_n=0.025,
@@ -208,6 +214,32 @@ def test_afm_after_contact_is_flattened_by_the_plastic_displacement(rough):
     assert afm["max_plastic_depth_nm"] > 20  # PS flows by tens of nm here
 
 
+@pytest.fixture(scope="module")
+def other_truths(tmp_path_factory, repo):
+    """The rough PS sphere (the same surface) made elastic and with penetration hardness at
+    110 MPa."""
+    root = tmp_path_factory.mktemp("truths")
+    return {
+        model: _generate(root / model, repo, sphere="PS", truth=(model, value))
+        for model, value in (("elastic", None), ("penetration_hardness", 110.0))
+    }
+
+
+def test_a_sphere_is_made_with_the_model_its_truth_names(other_truths):
+    """Penetration hardness caps every pressure at p_Y, so its mean contact pressure stays
+    below it and its area exceeds the elastic one at every load (the same surface and
+    loads); an elastic sphere does not flow. The truth names the model and its value."""
+    elastic, hardness = other_truths["elastic"], other_truths["penetration_hardness"]
+    assert elastic["true_model"] == "elastic" and "hardness_mpa" not in elastic
+    assert hardness["true_model"] == "penetration_hardness" and hardness["hardness_mpa"] == 110.0
+    assert elastic["max_plastic_depth_nm"] == [0.0] * len(LOADS_MN)
+    assert elastic["afm"]["max_plastic_depth_nm"] == 0.0
+    # 1e-9: the load control's tolerance on the mean pressure of a capped field
+    assert max(hardness["mean_pressure_mpa"]) <= 110.0 * (1 + 1e-9)
+    assert max(elastic["mean_pressure_mpa"]) > 110.0
+    assert all(h > e for h, e in zip(hardness["area_um2"], elastic["area_um2"], strict=True))
+
+
 def test_rough_sphere_area_grows_sublinearly(rough):
     _, truth = rough
     # Contact hardening on a rough sphere: α between 2/3 (Hertz) and 1 (the κ-law of a flat
@@ -268,7 +300,8 @@ def test_reflection_load_must_be_a_load(tmp_path, repo):
             diameter_m=4e-3,
             e_star_pa=32.8e9,
             roughness_rms_m=0.0,
-            hardening_k_pa_per_m=1e19,
+            true_model="hardening",
+            true_value=10000.0,
             loads_n=[0.025, 0.05],
             pixel_m=200e-9,
             reflection_load_n=0.03,

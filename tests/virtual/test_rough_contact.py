@@ -4,6 +4,7 @@ from the solver grid onto an instrument's pixels."""
 import numpy as np
 import pytest
 
+from amontons.contact import ContactHardening
 from amontons.physics.newton_rings import APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX
 from amontons.virtual.rough_contact import (
     SolverSettings,
@@ -59,7 +60,7 @@ def solution():
     return simulate_rough_sphere(
         radius_m=0.3e-3,
         e_star_pa=3.7e9,
-        k_pa_per_m=5e15,
+        law=ContactHardening(5e15),
         loads_n=[25e-3, 100e-3],
         reflection_load_n=25e-3,
         ring_reach_gap_m=ring_reach_gap(1, APPENDIX_WAVELENGTH_M, FORMAMIDE_REFRACTIVE_INDEX),

@@ -432,3 +432,34 @@ def test_a_map_the_config_lacks_or_cannot_read_stops_the_run_before_any_job():
     bad = {"trios": {**TWO_MAPS["trios"], "decimal": ";"}}
     with pytest.raises(ConfigError, match=r"mine\.yaml: rheometer_export\.trios\.decimal = ';'"):
         check_rheometer_exports(bad, {}, "mine.yaml")
+
+
+def test_a_virtual_sphere_is_made_with_the_model_and_value_its_row_names(tmp_path):
+    """Contact hardening at the sheet's k where the row names no true model (the
+    reproduction's spheres); another model at ``true_value``, or else at its prior column;
+    elastic with no value; a model with neither value stops the DAG, naming the sphere."""
+    rows = {
+        "default": {**RECORD, "hardening_k_mpa_per_nm": 5.0},
+        "hardness": {**RECORD, "true_model": "penetration_hardness", "hardness_mpa": 200.0},
+        "given": {
+            **RECORD,
+            "true_model": "penetration_hardness",
+            "hardness_mpa": 200.0,
+            "true_value": 110.0,
+        },
+        "elastic": {**RECORD, "true_model": "elastic", "hardness_mpa": 200.0},
+        "missing": {**RECORD, "true_model": "penetration_hardness"},
+    }
+    sheet = Spheres({k: {**v, "data_source": "synthetic"} for k, v in rows.items()}, RunPaths("s"))
+    found = {
+        name: (sheet.rows.true_model(name), sheet.rows.true_value(name))
+        for name in ("default", "hardness", "given", "elastic")
+    }
+    assert found == {
+        "default": ("hardening", 5.0),
+        "hardness": ("penetration_hardness", 200.0),
+        "given": ("penetration_hardness", 110.0),
+        "elastic": ("elastic", None),
+    }
+    with pytest.raises(ConfigError, match="sphere missing: .*neither true_value nor hardness_mpa"):
+        sheet.rows.true_value("missing")

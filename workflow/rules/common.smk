@@ -48,7 +48,6 @@ from amontons.workflow.resources import scan_solves
 from amontons.workflow.accuracy import TIMING_POINT
 from amontons.workflow.run import WorkflowRun
 from amontons.workflow.optional_inputs import RHEOMETER
-from amontons.workflow.sheet_rows import TRUE_HARDENING_COLUMN
 from amontons.workflow.validation import (
     left_out_validation_spheres,
     validation_cases,

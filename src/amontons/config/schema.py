@@ -54,6 +54,8 @@ def with_models(schema: dict) -> dict:
     elif "sphere" in properties:
         for parameter in parameters:
             properties.setdefault(parameter.sheet_column, _sheet_column_property(parameter))
+        if "true_model" in properties:
+            properties["true_model"]["enum"] = [m.name for m in MODELS if m.kind == FIELD]
     if "validation" in properties:
         _fill_validation(properties["validation"]["properties"], parameters)
     return schema

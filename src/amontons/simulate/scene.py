@@ -18,7 +18,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from amontons.config import geometry
-from amontons.contact import ContactHardening, PenetrationHardness, laws
+from amontons.contact import ContactHardening, PenetrationHardness
+from amontons.model_laws import law_si
 from amontons.models import UnknownModelError, model_named, model_names, with_parameter
 
 INCREMENTS = {"local": "local", "volume_conserving": "volume"}
@@ -77,11 +78,14 @@ class Scene:
     @property
     def plasticity(self) -> PenetrationHardness | ContactHardening | None:
         """The plasticity law, None for an elastic (or Greenwood–Tripp) scene: no plastic loop."""
-        model = model_named(self.model)
-        if model.law is None:
+        if model_named(self.model).law is None:
             return None
-        law = getattr(laws, model.law)
-        return law(self.parameter_si, increment=INCREMENTS[self.increment], alpha=self.alpha)
+        return law_si(
+            self.model,
+            self.parameter_si,
+            increment=INCREMENTS[self.increment],
+            alpha=self.alpha,
+        )
 
     def _parameters_record(self) -> dict:
         """Every model's parameter in config units: the scene's own model's value, None for

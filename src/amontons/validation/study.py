@@ -20,6 +20,7 @@ import numpy as np
 
 from amontons.contact import ContactError, FreeBoundaryError, solve_load_series
 from amontons.measure.area import OtsuSettings
+from amontons.model_laws import law_of
 from amontons.models import ELASTIC, with_parameter
 from amontons.simulate.compare import intersection_over_union
 from amontons.simulate.model_error import (
@@ -43,7 +44,7 @@ from amontons.simulate.scan_refine import refine_scan
 from amontons.simulate.surface import area_average
 from amontons.study.decision import Decision, decide
 from amontons.validation.cases import PARAMETER_OF
-from amontons.validation.truth import Measured, Sphere, law_of
+from amontons.validation.truth import Measured, Sphere
 
 
 @dataclass(frozen=True)

@@ -21,11 +21,11 @@ import numpy as np
 
 from amontons.config import geometry
 from amontons.config.geometry import Frame
-from amontons.contact import FreeBoundaryError, laws, solve_load_series
+from amontons.contact import FreeBoundaryError, solve_load_series
 from amontons.contact.options import DEFAULT_ITERATION
 from amontons.contact.surfaces import sphere as sphere_cap
 from amontons.measure.area import ContactArea, OtsuSettings, otsu_contact_area
-from amontons.models import model_named
+from amontons.model_laws import law_of
 from amontons.physics import hertz
 from amontons.physics.emission import confined_emission
 from amontons.simulate.grid import PixelAverager
@@ -115,15 +115,6 @@ def study_pixel_m(sphere: Sphere, preset: Mapping) -> float:
     (amontons.config.geometry), as the reproduction solves its large spheres."""
     window = geometry.window_m("validation", preset, sphere.frame)
     return geometry.solver_pixel_m(preset, window)
-
-
-def law_of(model: str, value: float | None):
-    """The plasticity law of ``model`` at ``value`` (config units: p_y_mpa, k_mpa_per_nm), SI;
-    None for the elastic model."""
-    record = model_named(model)
-    if record.law is None:
-        return None
-    return getattr(laws, record.law)(value * record.parameter.to_si)
 
 
 def truth_law(truth: Truth):

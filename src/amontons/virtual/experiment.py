@@ -32,7 +32,8 @@ from amontons.io.layout import (
     rheometer_name,
 )
 from amontons.io.rheometer_export_shapes import EXPORT_SHAPES
-from amontons.models import CONTACT_HARDENING
+from amontons.model_laws import law_of
+from amontons.models import model_named
 from amontons.physics import hertz
 from amontons.physics.newton_rings import ring_gap
 from amontons.power_law import fit_power_law
@@ -90,7 +91,8 @@ def generate_sphere(
     diameter_m: float,
     e_star_pa: float,
     roughness_rms_m: float,
-    hardening_k_pa_per_m: float,
+    true_model: str,
+    true_value: float | None,
     loads_n: list[float],
     pixel_m: float,
     reflection_load_n: float,
@@ -104,8 +106,10 @@ def generate_sphere(
 ) -> dict:
     """Write every raw file of one sphere into ``out_dir`` and ``truth.json``; return the truth.
 
-    The contact is a rough sphere under contact hardening (amontons.virtual.rough_contact),
-    solved once per load on the solver grid and seen by each instrument on its own grid.
+    The contact is a rough sphere under ``true_model`` (a model solved on a grid: the
+    reproduction's spheres flow by contact hardening) at ``true_value`` (its parameter in the
+    record's config unit; None for elastic; amontons.virtual.rough_contact), solved once per
+    load on the solver grid and seen by each instrument on its own grid.
     ``contact_counts`` (settings) is the expected signal at the mean contact pressure of the
     smallest load; the signal scales as √max(p, p_c) in contact (p_c: the settings'
     ``confinement_floor_pa``). Static friction is ``shear_strength_pa`` × the true contact
@@ -123,7 +127,7 @@ def generate_sphere(
         seed=seed,
         radius_m=radius_m,
         e_star_pa=e_star_pa,
-        k_pa_per_m=hardening_k_pa_per_m,
+        law=law_of(true_model, true_value),
         loads_n=loads_n,
         reflection_load_n=reflection_load_n,
         roughness=roughness,
@@ -149,8 +153,9 @@ def generate_sphere(
         out_dir, solution, radius_m, roughness, surface.afm, scan_pixel, afm_rng
     )
     model_truth = _forward_model_truth(
-        solution, roughness, surface, settings, loads_n, diameter_m, e_star_pa, hardening_k_pa_per_m
+        solution, roughness, surface, settings, loads_n, diameter_m, e_star_pa
     )
+    model_truth = {**_true_model_record(true_model, true_value), **model_truth}
     truth.update(model_truth)
     truth["afm"] = afm_truth
     write_json(out_dir / "truth.json", truth)
@@ -163,7 +168,7 @@ def _solve_rough_sphere(
     seed: int,
     radius_m: float,
     e_star_pa: float,
-    k_pa_per_m: float,
+    law,
     loads_n: list[float],
     reflection_load_n: float,
     roughness: Roughness,
@@ -172,14 +177,14 @@ def _solve_rough_sphere(
     surface: SurfaceSettings,
     threads: int,
 ) -> RoughSphereSolution:
-    """The rough sphere's contact-hardening load series on the solver grid (SI units), its
+    """The rough sphere's load series under ``law`` on the solver grid (SI units), its
     surface drawn from the sphere's own roughness stream (seed, sphere, 'roughness'), on a
     window that holds the reflection image's Newton rings and the AFM scans of
     ``scan_pixel_m`` pixels (m)."""
     return simulate_rough_sphere(
         radius_m=radius_m,
         e_star_pa=e_star_pa,
-        k_pa_per_m=k_pa_per_m,
+        law=law,
         loads_n=loads_n,
         reflection_load_n=reflection_load_n,
         ring_reach_gap_m=ring_reach_gap(
@@ -242,7 +247,6 @@ def _forward_model_truth(
     loads_n: list[float],
     diameter_m: float,
     e_star_pa: float,
-    k_pa_per_m: float,
 ) -> dict:
     """The truth of the rough sphere's contact solve (JSON-ready, units in the key names)."""
     radius_m = diameter_m / 2
@@ -251,18 +255,12 @@ def _forward_model_truth(
     areas = np.array([r.area for r in solution.results])
     fit = fit_power_law(np.array(loads_n), areas, x_ref=loads_n[0])
     return {
-        "forward_model": (
-            f"rough sphere, {CONTACT_HARDENING.label} (elastic half-space + Winkler layer)"
-        ),
         "diameter_mm": diameter_m * 1e3,
         "e_star_gpa": e_star_pa * 1e-9,
-        CONTACT_HARDENING.parameter.sheet_column: k_pa_per_m * CONTACT_HARDENING.parameter.from_si,
         "roughness": _roughness_truth(roughness, solution),
         "solver": _solver_truth(solution, surface),
         "approach_nm": [r.displacement * 1e9 for r in solution.results],
-        "max_plastic_depth_nm": [
-            float(-r.plastic_displacement.min() * 1e9) for r in solution.results
-        ],
+        "max_plastic_depth_nm": [_max_plastic_depth_nm(r) for r in solution.results],
         "contact_radius_um": [contact_radius_m(r.contact, dx) * 1e6 for r in solution.results],
         "edge_radius_um": [edge_radius_m(r.contact, dx, closing) * 1e6 for r in solution.results],
         "hertz_contact_radius_um": [
@@ -270,6 +268,23 @@ def _forward_model_truth(
         ],
         "area_exponent": fit.exponent.estimate,
     }
+
+
+def _true_model_record(model: str, value: float | None) -> dict:
+    """The forward model's name and its parameter under its sheet column, in its unit (a
+    contact-hardening truth's k where the reproduction's truth has always had it)."""
+    record = model_named(model)
+    out = {"forward_model": f"rough sphere, {record.label}", "true_model": model}
+    if record.parameter is not None:
+        out[record.parameter.sheet_column] = value
+    return out
+
+
+def _max_plastic_depth_nm(result) -> float:
+    """The deepest plastic displacement of a load's solve, nm (0 for an elastic solve)."""
+    if result.plastic_displacement is None:
+        return 0.0
+    return float(-result.plastic_displacement.min() * 1e9)
 
 
 def _roughness_truth(roughness: Roughness, solution: RoughSphereSolution) -> dict:

@@ -24,7 +24,7 @@ import numpy as np
 import scipy.fft
 from scipy import ndimage
 
-from amontons.contact import ContactHardening, ContactResult, FreeBoundaryError, solve_load_series
+from amontons.contact import ContactResult, FreeBoundaryError, solve_load_series
 from amontons.contact.surfaces import sphere as sphere_cap
 from amontons.physics import hertz
 from amontons.physics.emission import confined_emission
@@ -163,7 +163,7 @@ def simulate_rough_sphere(
     *,
     radius_m: float,
     e_star_pa: float,
-    k_pa_per_m: float,
+    law,
     loads_n: list[float],
     reflection_load_n: float,
     ring_reach_gap_m: float,
@@ -173,10 +173,11 @@ def simulate_rough_sphere(
     threads: int = 1,
     min_window_m: float = 0.0,
 ) -> RoughSphereSolution:
-    """Solve the contact-hardening load series of a rough sphere on a window that holds the
-    largest contact and the reflection load's Newton rings, out to the radius where the gap is
-    ``ring_reach_gap_m`` (:func:`ring_reach_gap`), grown and re-solved if not; the window is
-    at least ``min_window_m`` wide (the footprint of the AFM scans that sample it)."""
+    """Solve the load series of a rough sphere under the plasticity ``law`` (SI; None:
+    elastic) on a window that holds the largest contact and the reflection load's Newton
+    rings, out to the radius where the gap is ``ring_reach_gap_m`` (:func:`ring_reach_gap`),
+    grown and re-solved if not; the window is at least ``min_window_m`` wide (the footprint
+    of the AFM scans that sample it)."""
     window = max(
         min_window_m,
         initial_window_m(
@@ -184,7 +185,6 @@ def simulate_rough_sphere(
         ),
     )
     reach_gap = ring_reach_gap_m
-    law = ContactHardening(k_pa_per_m)
     for attempt in range(1, MAX_WINDOW_ATTEMPTS + 1):
         n, dx = solver_grid(window, settings)
         heights, rough = rough_sphere_heights(

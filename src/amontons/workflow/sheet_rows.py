@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from amontons.models import CONTACT_HARDENING, with_parameter
+from amontons.config.errors import ConfigError
+from amontons.models import CONTACT_HARDENING, model_named, with_parameter
 from amontons.workflow.paths import RunPaths
 
 # The sheet values a scene takes from its sphere.
@@ -16,9 +17,12 @@ SCENE_COLUMNS = (
     "loads",
     *(m.parameter.sheet_column for m in with_parameter()),
 )
-# The sheet column of a virtual sphere's true contact-hardening coefficient, MPa/nm (the
-# virtual experiment's truth is contact hardening: docs/workflow.md).
-TRUE_HARDENING_COLUMN = CONTACT_HARDENING.parameter.sheet_column
+# The model the virtual experiment makes a sphere's contact with where its row names none
+# (the reproduction's spheres flow by contact hardening: docs/workflow.md), and the columns
+# that name another and its value.
+DEFAULT_TRUE_MODEL = CONTACT_HARDENING.name
+TRUE_MODEL_COLUMN = "true_model"
+TRUE_VALUE_COLUMN = "true_value"
 
 
 class SheetRows:
@@ -49,6 +53,27 @@ class SheetRows:
         """A numeric sheet value, or None where the cell is empty."""
         value = self.records[sphere].get(column)
         return None if value is None else float(value)
+
+    def true_model(self, sphere: str) -> str:
+        """The model a virtual sphere's contact is made with (:data:`DEFAULT_TRUE_MODEL` where
+        its row names none)."""
+        return self.records[sphere].get(TRUE_MODEL_COLUMN) or DEFAULT_TRUE_MODEL
+
+    def true_value(self, sphere: str) -> float | None:
+        """The true model's parameter (its record's config unit; None for a model without
+        one): the row's ``true_value``, or else the model's prior column."""
+        parameter = model_named(self.true_model(sphere)).parameter
+        if parameter is None:
+            return None
+        value = self.value(sphere, TRUE_VALUE_COLUMN)
+        value = self.value(sphere, parameter.sheet_column) if value is None else value
+        if value is None:
+            raise ConfigError(
+                f"sphere {sphere}: true_model = {self.true_model(sphere)!r} with neither "
+                f"{TRUE_VALUE_COLUMN} nor {parameter.sheet_column} in the sheet; expected the "
+                "value the virtual experiment makes its contact with"
+            )
+        return value
 
     def pixel_nm(self, sphere: str) -> float | None:
         """The fluorescence images' pixel from the sheet, nm; None where the sheet leaves it
