@@ -7,6 +7,7 @@ import re
 import pytest
 import yaml
 
+from amontons import models
 from amontons.config import (
     RESERVED_NAMES,
     ConfigError,
@@ -28,12 +29,31 @@ def _config(repo, name="config.yaml"):
     return read_config(repo / "config" / "config.yaml", *overlays)
 
 
-@pytest.mark.parametrize("name", ["config.yaml", "test.yaml"])
+@pytest.mark.parametrize("name", ["config.yaml", "test.yaml", "chain.yaml"])
 def test_shipped_configs_are_valid(repo, config_schema, sheet_schema, name, monkeypatch):
     monkeypatch.chdir(repo)
     config = _config(repo, name)
     spheres = load_workflow_config(config, config_schema, sheet_schema, name)
     assert {row["material"] for row in spheres.values()} == set(config["materials"])
+
+
+def test_the_chain_lab_makes_each_model_apart_from_its_scans_prior(
+    repo, config_schema, sheet_schema, monkeypatch
+):
+    """config/chain.yaml's virtual lab (docs/study.md §7): two spheres of each model solved on
+    a grid, each plastic truth's value away from the prior its scan is centred on."""
+    monkeypatch.chdir(repo)
+    records = load_workflow_config(
+        _config(repo, "chain.yaml"), config_schema, sheet_schema, "chain.yaml"
+    )
+    truths = [(r.get("true_model"), r.get("true_value")) for r in records.values()]
+    assert sorted(m for m, _ in truths) == sorted(
+        [m.name for m in models.MODELS if m.kind == models.FIELD] * 2
+    )
+    for record in records.values():
+        parameter = models.model_named(record["true_model"]).parameter
+        if parameter is not None:
+            assert record["true_value"] != record[parameter.sheet_column]
 
 
 def test_test_config_is_an_overlay_of_only_the_keys_it_changes(repo):

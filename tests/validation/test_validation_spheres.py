@@ -137,6 +137,10 @@ def test_spheres_a_run_cannot_validate_on_are_left_out_and_named():
     assert runnable_validation_spheres(config, no_prior) == []
     lines = left_out_validation_spheres(config, no_prior)
     assert any("PS's sheet row has no hardness_mpa" in line for line in lines)
+    # a measured sphere whose row leaves its roughness to its AFM map
+    measured = {"PS": _sheet_record("PS", 0.6, 3.7, roughness_rms_nm=None)}
+    assert runnable_validation_spheres(config, measured) == []
+    assert "no roughness_rms_nm" in left_out_validation_spheres(config, measured)[0]
     assert validation_sphere_record(config, selected, "PS_elastic_r2_s7") is selected["PS"]
     assert validation_sphere_record(config, selected, "elastic_r4_s1") is None
 

@@ -16,13 +16,18 @@ def validation_cases(config: Mapping) -> list[str]:
     return case_names(config["validation"])
 
 
+# a sheet sphere's truth is made with its roughness (which a measured sphere's row may leave
+# to its AFM map) and its scans are centred on each plastic model's prior
+NEEDED_COLUMNS = ("roughness_rms_nm", *(m.parameter.sheet_column for m in with_parameter()))
+
+
 def runnable_validation_spheres(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
     """The spheres ``validation.spheres.run`` names that the run can validate on: spheres of
-    the selected materials whose sheet row states each plastic model's prior."""
+    the selected materials whose sheet row states :data:`NEEDED_COLUMNS`."""
     return [
         sphere
         for sphere in config["validation"]["spheres"]["run"]
-        if sphere in selected and not _missing_priors(selected[sphere])
+        if sphere in selected and not _missing_columns(selected[sphere])
     ]
 
 
@@ -36,18 +41,18 @@ def left_out_validation_spheres(config: Mapping, selected: Mapping[str, dict]) -
                 f"validation.spheres.run: {sphere} is not a sphere of the selected materials "
                 f"{list(config['materials'])}; its validation cases are left out"
             )
-        elif missing := _missing_priors(selected[sphere]):
+        elif missing := _missing_columns(selected[sphere]):
             lines.append(
-                f"validation.spheres.run: {sphere}'s sheet row has no {', '.join(missing)}, the "
-                "prior its scans are centred on; its validation cases are left out"
+                f"validation.spheres.run: {sphere}'s sheet row has no {', '.join(missing)} (the "
+                "truth's roughness and the priors its scans are centred on); its validation "
+                "cases are left out"
             )
     return lines
 
 
-def _missing_priors(record: Mapping) -> list[str]:
-    """The prior columns a sheet row leaves empty."""
-    columns = [m.parameter.sheet_column for m in with_parameter()]
-    return [c for c in columns if record.get(c) is None]
+def _missing_columns(record: Mapping) -> list[str]:
+    """The columns of :data:`NEEDED_COLUMNS` a sheet row leaves empty."""
+    return [c for c in NEEDED_COLUMNS if record.get(c) is None]
 
 
 def validation_sphere_cases(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
