@@ -33,6 +33,8 @@ SPHERES = {
     "seeds": 2,
     "first_seed": 7,
     "ratio": 2.0,
+    "comparison_ratios": [4.0],
+    "comparison_models": ["hardening"],
     "window_factor": 1.2,
     "truth_iteration": "preconditioned",
 }
@@ -68,8 +70,15 @@ def _sheet_record(name, diameter_mm, e_star_gpa, **extra):
 
 
 def test_each_run_sphere_has_an_elastic_truth_and_each_plastic_models_on_every_seed():
-    cases = sphere_cases(VALIDATION)
+    everything = sphere_cases(VALIDATION)
+    cases = [c for c in everything if not c.comparison]
     assert len(cases) == 2 * 3 * 2  # spheres × truths × seeds
+    again = [c for c in everything if c.comparison]
+    assert {(c.sphere, c.truth.model, c.ratio) for c in again} == {
+        ("PS", "hardening", 4.0),
+        ("PTFE", "hardening", 4.0),
+    }
+    assert len(again) == 2 * 2  # spheres × seeds
     ptfe = [c for c in cases if c.sphere == "PTFE"]
     assert {(c.truth.model, c.truth.value) for c in ptfe} == {
         ("elastic", None),

@@ -181,7 +181,9 @@ def sphere_truths(sphere: str, values: Mapping) -> list[Truth]:
 def sphere_cases(validation: Mapping, available: Collection[str] | None = None) -> list[Case]:
     """The cases on the materials sheet's spheres: every truth (:func:`sphere_truths`) of each
     sphere ``validation.spheres.run`` names (of those in ``available``, where given) on
-    ``seeds`` seeds from ``first_seed``, at ``ratio``."""
+    ``seeds`` seeds from ``first_seed``, at ``ratio``; and the truths of
+    ``comparison_models`` again at each of ``comparison_ratios`` (reported, not held to the
+    targets: what a truth finer than the default does)."""
     block = validation["spheres"]
     seeds = range(block["first_seed"], block["first_seed"] + block["seeds"])
     ratio = float(block["ratio"])
@@ -196,6 +198,13 @@ def sphere_cases(validation: Mapping, available: Collection[str] | None = None) 
             )
         truths = sphere_truths(sphere, block["values"][sphere])
         cases += [Case(truth, seed, ratio, sphere=sphere) for truth in truths for seed in seeds]
+        cases += [
+            Case(truth, seed, float(again), comparison=True, sphere=sphere)
+            for truth in truths
+            if truth.model in block["comparison_models"]
+            for again in block["comparison_ratios"]
+            for seed in seeds
+        ]
     return cases
 
 
