@@ -8,13 +8,13 @@ from amontons.io.files import write_json
 from amontons.measure.area import OtsuSettings
 from amontons.runlog import run_logged
 from amontons.validation.case import run_case
-from amontons.validation.cases import case_named
+from amontons.validation.cases import Case
 from amontons.validation.study import StudySettings, sheet_priors
 from amontons.validation.truth import Sphere, study_pixel_m
 
 
 def main(
-    case: str,
+    case: dict,
     validation: dict,
     virtual: dict,
     record: dict | None,
@@ -25,7 +25,7 @@ def main(
     out: str,
 ):
     otsu_settings = OtsuSettings.from_config(otsu)
-    the_case = case_named(validation, case)
+    the_case = Case.from_record(case)
     if record is None:
         sphere, priors = Sphere.from_config(validation), validation["priors"]
         iteration = DEFAULT_ITERATION
@@ -50,7 +50,7 @@ if __name__ == "__main__":
     run_logged(
         main,
         sm.log[0],
-        case=sm.wildcards.case,
+        case=sm.params.case,
         validation=sm.params.validation,
         virtual=sm.params.virtual,
         record=sm.params.sphere,

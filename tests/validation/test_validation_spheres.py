@@ -3,6 +3,7 @@ cases it runs, the sphere each is on as the virtual experiment makes it, the pix
 preset solves it at, its priors, and the spheres a run cannot validate on, named. The solves
 run in the small run (tests/workflow/test_validation_run.py)."""
 
+import copy
 from pathlib import Path
 
 import pytest
@@ -12,12 +13,14 @@ from amontons.config import read_config
 from amontons.config.schema import load_schema
 from amontons.config.sheet import read_sample_sheet
 from amontons.contact.options import ITERATIONS
-from amontons.validation.cases import case_named, sphere_case_names, sphere_cases
+from amontons.validation.cases import Case, case_named, sphere_case_names, sphere_cases
 from amontons.validation.study import sheet_priors
 from amontons.validation.truth import Sphere, study_pixel_m
 from amontons.workflow.validation import (
     left_out_validation_spheres,
     runnable_validation_spheres,
+    validation_case_record,
+    validation_case_settings,
     validation_sphere_record,
 )
 
@@ -167,3 +170,22 @@ def test_the_schema_takes_the_validations_models_and_keys_from_the_records():
     for node in (validation["priors"], values):
         assert node["required"] == keys and list(node["properties"]) == keys
     assert validation["spheres"]["properties"]["truth_iteration"]["enum"] == list(ITERATIONS)
+
+
+def test_a_case_job_takes_its_own_record_and_no_key_that_enumerates_the_cases(full_config):
+    """A case's job params are its own record and the settings it is judged with: a seed or
+    a sphere added to the study changes neither for the cases already run (Snakemake reruns
+    a job whose params change)."""
+    config = full_config
+    name = sphere_case_names(config["validation"])[0]
+    before = (validation_case_record(config, name), validation_case_settings(config))
+    more = copy.deepcopy(config)
+    more["validation"]["spheres"]["seeds"] += 3
+    more["validation"]["spheres"]["run"] = [*more["validation"]["spheres"]["run"], "PMMA-1.5mm"]
+    more["validation"]["seeds"] += 1
+    after = (validation_case_record(more, name), validation_case_settings(more))
+    assert after == before
+    assert Case.from_record(before[0]) == case_named(config["validation"], name)
+    settings = before[1]
+    assert "seeds" not in settings and "run" not in settings["spheres"]
+    assert settings["spheres"]["truth_iteration"] == "preconditioned"

@@ -22,7 +22,8 @@ rule validate_case:
         mem_mb=measured_mem_mb("validate_case"),
         runtime=measured_runtime("validate_case"),
     params:
-        validation=config_slice("validation"),
+        case=lambda wildcards: validation_case(wildcards.case),
+        validation=VALIDATION_SETTINGS,
         virtual=config_slice("virtual_experiment"),
         sphere=lambda wildcards: validation_sphere(wildcards.case),
         scans=config_slice("scans"),

@@ -78,6 +78,21 @@ class Truth:
     def parameter(self) -> str | None:
         return PARAMETER_OF.get(self.model)
 
+    def to_record(self) -> dict:
+        """JSON-ready, as :meth:`from_record` reads it."""
+        return {
+            "name": self.name,
+            "model": self.model,
+            "value": self.value,
+            "signal": self.signal,
+            "solver": self.solver,
+            "ratio": self.ratio,
+        }
+
+    @classmethod
+    def from_record(cls, record: Mapping) -> Truth:
+        return cls(**record)
+
     @classmethod
     def from_config(cls, name: str, entry: Mapping) -> Truth:
         model = entry["model"]
@@ -110,6 +125,20 @@ class Case:
     @property
     def name(self) -> str:
         return f"{self.truth.name}_r{self.ratio:g}_s{self.seed}"
+
+    def to_record(self) -> dict:
+        """JSON-ready (a case job's params), as :meth:`from_record` reads it."""
+        return {
+            "truth": self.truth.to_record(),
+            "seed": self.seed,
+            "ratio": self.ratio,
+            "comparison": self.comparison,
+            "sphere": self.sphere,
+        }
+
+    @classmethod
+    def from_record(cls, record: Mapping) -> Case:
+        return cls(**{**record, "truth": Truth.from_record(record["truth"])})
 
 
 def truths_of(validation: Mapping) -> dict[str, Truth]:
@@ -216,3 +245,33 @@ def sphere_case_names(validation: Mapping, available: Collection[str] | None = N
 def sphere_of_case(validation: Mapping, name: str) -> str | None:
     """The sheet sphere case ``name`` is on (None: the study's own small sphere)."""
     return case_named(validation, name).sphere
+
+
+# the keys of ``validation`` (and of its ``spheres``) that only say which cases run: a case
+# job's settings leave them out, so that adding a seed or a truth reruns no case
+ENUMERATING_KEYS = (
+    "seeds",
+    "first_seed",
+    "run_truths",
+    "truths",
+    "comparison_ratios",
+    "comparison_truths",
+)
+SPHERE_ENUMERATING_KEYS = (
+    "run",
+    "values",
+    "seeds",
+    "first_seed",
+    "comparison_ratios",
+    "comparison_models",
+)
+
+
+def case_settings(validation: Mapping) -> dict:
+    """What a case is judged with: ``validation`` without the keys that only enumerate the
+    cases (:data:`ENUMERATING_KEYS`, :data:`SPHERE_ENUMERATING_KEYS`); the case itself is
+    its own record (:meth:`Case.to_record`)."""
+    settings = {k: v for k, v in validation.items() if k not in ENUMERATING_KEYS}
+    spheres = validation["spheres"]
+    settings["spheres"] = {k: v for k, v in spheres.items() if k not in SPHERE_ENUMERATING_KEYS}
+    return settings

@@ -8,7 +8,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from amontons.models import with_parameter
-from amontons.validation.cases import case_names, sphere_case_names, sphere_of_case
+from amontons.validation.cases import (
+    case_named,
+    case_names,
+    case_settings,
+    sphere_case_names,
+    sphere_of_case,
+)
 
 
 def validation_cases(config: Mapping) -> list[str]:
@@ -64,3 +70,14 @@ def validation_sphere_record(config: Mapping, selected: Mapping[str, dict], case
     """The sheet record of the sphere case ``case`` is on, None for the small sphere's."""
     sphere = sphere_of_case(config["validation"], case)
     return None if sphere is None else selected[sphere]
+
+
+def validation_case_record(config: Mapping, case: str) -> dict:
+    """Case ``case`` as its job's params take it (amontons.validation.cases.Case.to_record)."""
+    return case_named(config["validation"], case).to_record()
+
+
+def validation_case_settings(config: Mapping) -> dict:
+    """What every case job is judged with: the validation slice less the keys that only
+    enumerate the cases, so that a seed or a truth added reruns no case."""
+    return case_settings(config["validation"])
