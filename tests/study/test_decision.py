@@ -45,6 +45,25 @@ def test_a_plastic_best_near_its_elastic_limit_names_elastic():
     assert "no flow detected" in decision.why and "from above" in decision.why
 
 
+def test_an_elastic_verdict_says_where_a_scan_bounds_its_parameter_from_above_all_the_same():
+    """The validation's PMMA-4mm 60 MPa truth (docs/study.md §7): the p_Y scan, judged with
+    the error measured at its best value, excludes its elastic end (χ² 30 against 5), while
+    the elastic model judged with its own, larger error lies within the quantile. Elastic is
+    named, and the verdict says that the scan bounds p_Y from above all the same, instead of
+    that the data bound nothing from above."""
+    decision = decide(
+        {"penetration_hardness": 5.0, "hardening": 9.0},
+        {"penetration_hardness": 30.0, "hardening": 12.0},
+        RISE_5,
+        5,
+        elastic_chi2={"penetration_hardness": 8.0, "hardening": 8.0},
+    )
+    assert decision.elastic
+    assert "scan of penetration_hardness bounds its parameter from above" in decision.why
+    assert "the two errors disagree" in decision.why
+    assert "bound no plastic parameter" not in decision.why
+
+
 def test_elastic_is_excluded_by_its_own_chi2_not_by_a_plastic_models_error():
     """The scans' elastic ends judged with a plastic model's smaller error lie far above the
     best (60 and 50), but the elastic model judged with its own error lies within the quantile

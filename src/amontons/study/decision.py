@@ -127,7 +127,7 @@ def decide(
         why = (
             f"no flow detected: no plastic model improves on the elastic model by more than "
             f"the quantile's {rise:.3g} (the largest gain in χ² is {max(flow.values()):.3g}); "
-            "the data bound no plastic parameter from above"
+            + _bounded_above_note(best_chi2, elastic_end_chi2, birge, rise)
         )
     else:
         kept = tuple(sorted((m for m in best_chi2 if delta[m] <= rise), key=lambda m: delta[m]))
@@ -135,6 +135,30 @@ def decide(
     if birge > 1:
         why += f" (χ² scaled by the best model's misfit, Birge ratio² {birge:.3g})"
     return Decision(kept, delta, rise, why + note, flow)
+
+
+def _bounded_above_note(
+    best_chi2: Mapping[str, float],
+    elastic_end_chi2: Mapping[str, float],
+    birge: float,
+    rise: float,
+) -> str:
+    """Where elastic is named: that the data bound no plastic parameter from above, or which
+    scans do so all the same, judged with the error measured at their best value, while the
+    elastic model, judged with its own, is not excluded (the two errors disagree: the scan's
+    bound is not the verdict's)."""
+    bounded = [
+        m
+        for m, end in elastic_end_chi2.items()
+        if _finite(end) and (end - best_chi2[m]) / birge > rise
+    ]
+    if not bounded:
+        return "the data bound no plastic parameter from above"
+    return (
+        f"the scan of {', '.join(bounded)} bounds its parameter from above all the same, "
+        "judged with the error measured at its best value; the elastic model, judged with "
+        "its own, is not excluded: the two errors disagree"
+    )
 
 
 def _plastic_why(
