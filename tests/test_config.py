@@ -47,9 +47,7 @@ def test_the_chain_lab_makes_each_model_apart_from_its_scans_prior(
         _config(repo, "chain.yaml"), config_schema, sheet_schema, "chain.yaml"
     )
     truths = [(r.get("true_model"), r.get("true_value")) for r in records.values()]
-    assert sorted(m for m, _ in truths) == sorted(
-        [m.name for m in models.MODELS if m.kind == models.FIELD] * 2
-    )
+    assert sorted(m for m, _ in truths) == sorted(list(models.field_model_names()) * 2)
     for record in records.values():
         parameter = models.model_named(record["true_model"]).parameter
         if parameter is not None:

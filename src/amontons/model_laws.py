@@ -19,6 +19,8 @@ def law_of(model: str, value: float | None, **options):
     return law_si(model, value * record.parameter.to_si, **options)
 
 
-def law_si(model: str, value_si: float, **options):
-    """The plasticity law of ``model`` at ``value_si``, its parameter in SI (Pa, Pa/m)."""
-    return getattr(laws, model_named(model).law)(value_si, **options)
+def law_si(model: str, value_si: float | None, **options):
+    """The plasticity law of ``model`` at ``value_si``, its parameter in SI (Pa, Pa/m); None
+    for a model without a law (elastic, Greenwood–Tripp)."""
+    law = model_named(model).law
+    return None if law is None else getattr(laws, law)(value_si, **options)

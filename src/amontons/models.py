@@ -171,6 +171,12 @@ def model_named(name: str) -> ContactModel:
     raise UnknownModelError(f"model {name!r}; expected one of {', '.join(model_names())}")
 
 
+def field_model_names() -> tuple[str, ...]:
+    """The names of the models solved on a grid (:data:`FIELD`): those a truth can be made
+    with, by the virtual experiment or the validation study."""
+    return tuple(m.name for m in MODELS if m.kind == FIELD)
+
+
 def with_parameter() -> tuple[ContactModel, ...]:
     """The models that take a parameter (the ones a scan can vary), simplest first."""
     return tuple(m for m in MODELS if m.parameter is not None)

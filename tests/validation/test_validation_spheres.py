@@ -19,7 +19,7 @@ from amontons.validation.truth import Sphere, study_pixel_m
 from amontons.workflow.validation import (
     left_out_validation_spheres,
     runnable_validation_spheres,
-    validation_case_record,
+    validation_case_records,
     validation_case_settings,
     validation_sphere_record,
 )
@@ -153,8 +153,9 @@ def test_spheres_a_run_cannot_validate_on_are_left_out_and_named():
     measured = {"PS": _sheet_record("PS", 0.6, 3.7, roughness_rms_nm=None)}
     assert runnable_validation_spheres(config, measured) == []
     assert "no roughness_rms_nm" in left_out_validation_spheres(config, measured)[0]
-    assert validation_sphere_record(config, selected, "PS_elastic_r2_s7") is selected["PS"]
-    assert validation_sphere_record(config, selected, "elastic_r4_s1") is None
+    records = validation_case_records(config)
+    assert validation_sphere_record(selected, records["PS_elastic_r2_s7"]) is selected["PS"]
+    assert validation_sphere_record(selected, records["elastic_r4_s1"]) is None
 
 
 def test_the_schema_takes_the_validations_models_and_keys_from_the_records():
@@ -163,7 +164,7 @@ def test_the_schema_takes_the_validations_models_and_keys_from_the_records():
     schema = load_schema(REPO / "workflow" / "schemas" / "config.schema.yaml")
     validation = schema["properties"]["validation"]["properties"]
     truth = validation["truths"]["additionalProperties"]["properties"]
-    assert truth["model"]["enum"] == [m.name for m in models.MODELS if m.kind == models.FIELD]
+    assert truth["model"]["enum"] == list(models.field_model_names())
     keys = list(models.parameter_keys())
     assert set(keys) <= set(truth)
     values = validation["spheres"]["properties"]["values"]["additionalProperties"]
@@ -178,12 +179,12 @@ def test_a_case_job_takes_its_own_record_and_no_key_that_enumerates_the_cases(fu
     a job whose params change)."""
     config = full_config
     name = sphere_case_names(config["validation"])[0]
-    before = (validation_case_record(config, name), validation_case_settings(config))
+    before = (validation_case_records(config)[name], validation_case_settings(config))
     more = copy.deepcopy(config)
     more["validation"]["spheres"]["seeds"] += 3
     more["validation"]["spheres"]["run"] = [*more["validation"]["spheres"]["run"], "PMMA-1.5mm"]
     more["validation"]["seeds"] += 1
-    after = (validation_case_record(more, name), validation_case_settings(more))
+    after = (validation_case_records(more)[name], validation_case_settings(more))
     assert after == before
     assert Case.from_record(before[0]) == case_named(config["validation"], name)
     settings = before[1]

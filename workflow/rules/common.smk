@@ -50,7 +50,7 @@ from amontons.workflow.run import WorkflowRun
 from amontons.workflow.optional_inputs import RHEOMETER
 from amontons.workflow.validation import (
     left_out_validation_spheres,
-    validation_case_record,
+    validation_case_records,
     validation_case_settings,
     validation_cases,
     validation_sphere_cases,
@@ -134,8 +134,8 @@ VALIDATION_CASES = validation_cases(config)
 # spheres it names but cannot run on are named in its summary.
 VALIDATION_SPHERE_CASES = validation_sphere_cases(config, SPHERES.rows.records)
 VALIDATION_SPHERES_LEFT_OUT = left_out_validation_spheres(config, SPHERES.rows.records)
-validation_sphere = partial(validation_sphere_record, config, SPHERES.rows.records)
-validation_case = partial(validation_case_record, config)
+VALIDATION_CASE_RECORDS = validation_case_records(config)
+validation_sphere = partial(validation_sphere_record, SPHERES.rows.records)
 VALIDATION_SETTINGS = validation_case_settings(config)
 RING_OPTICS = ring_optics(config)
 AFM_READING = afm_reading(config)

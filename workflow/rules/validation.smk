@@ -22,10 +22,12 @@ rule validate_case:
         mem_mb=measured_mem_mb("validate_case"),
         runtime=measured_runtime("validate_case"),
     params:
-        case=lambda wildcards: validation_case(wildcards.case),
+        case=lambda wildcards: VALIDATION_CASE_RECORDS[wildcards.case],
         validation=VALIDATION_SETTINGS,
         virtual=config_slice("virtual_experiment"),
-        sphere=lambda wildcards: validation_sphere(wildcards.case),
+        sphere=lambda wildcards: validation_sphere(
+            VALIDATION_CASE_RECORDS[wildcards.case]
+        ),
         scans=config_slice("scans"),
         judgement=SCAN_JUDGEMENT,
         preset=config["solver_presets"][config["solver_preset"]],

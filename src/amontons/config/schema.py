@@ -10,7 +10,7 @@ import jsonschema
 import yaml
 
 from amontons.config.errors import ConfigError
-from amontons.models import FIELD, MODELS, model_names, parameter_keys, with_parameter
+from amontons.models import field_model_names, model_names, parameter_keys, with_parameter
 
 
 def load_schema(path: str | Path) -> dict:
@@ -55,7 +55,7 @@ def with_models(schema: dict) -> dict:
         for parameter in parameters:
             properties.setdefault(parameter.sheet_column, _sheet_column_property(parameter))
         if "true_model" in properties:
-            properties["true_model"]["enum"] = [m.name for m in MODELS if m.kind == FIELD]
+            properties["true_model"]["enum"] = list(field_model_names())
     if "validation" in properties:
         _fill_validation(properties["validation"]["properties"], parameters)
     return schema
@@ -66,7 +66,7 @@ def _fill_validation(validation: dict, parameters: list) -> None:
     a grid) and its value's key, the priors' keys and the sheet spheres' values' keys, one
     per parameter, each required."""
     truth = validation["truths"]["additionalProperties"]["properties"]
-    truth["model"]["enum"] = [m.name for m in MODELS if m.kind == FIELD]
+    truth["model"]["enum"] = list(field_model_names())
     for parameter in parameters:
         truth.setdefault(parameter.key, _value_property(parameter, "a truth of its model"))
     values = validation["spheres"]["properties"]["values"]["additionalProperties"]

@@ -78,8 +78,6 @@ class Scene:
     @property
     def plasticity(self) -> PenetrationHardness | ContactHardening | None:
         """The plasticity law, None for an elastic (or Greenwood–Tripp) scene: no plastic loop."""
-        if model_named(self.model).law is None:
-            return None
         return law_si(
             self.model,
             self.parameter_si,

@@ -12,14 +12,14 @@ each plastic model at the value the config gives that sphere."""
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 from amontons import models
 
 # each plastic model's scanned parameter (config ``scans``)
 PARAMETER_OF = {m.name: m.parameter.key for m in models.with_parameter()}
 # the models a truth can be: those solved on a grid (amontons.models.FIELD)
-TRUTH_MODELS = tuple(m.name for m in models.MODELS if m.kind == models.FIELD)
+TRUTH_MODELS = models.field_model_names()
 # how far a truth's areas lie from the other models' against the study's model error: beyond
 # it, below it, or an elastic truth (which every plastic model approaches at its elastic end)
 CLEAR = "clear"
@@ -78,21 +78,6 @@ class Truth:
     def parameter(self) -> str | None:
         return PARAMETER_OF.get(self.model)
 
-    def to_record(self) -> dict:
-        """JSON-ready, as :meth:`from_record` reads it."""
-        return {
-            "name": self.name,
-            "model": self.model,
-            "value": self.value,
-            "signal": self.signal,
-            "solver": self.solver,
-            "ratio": self.ratio,
-        }
-
-    @classmethod
-    def from_record(cls, record: Mapping) -> Truth:
-        return cls(**record)
-
     @classmethod
     def from_config(cls, name: str, entry: Mapping) -> Truth:
         model = entry["model"]
@@ -128,17 +113,11 @@ class Case:
 
     def to_record(self) -> dict:
         """JSON-ready (a case job's params), as :meth:`from_record` reads it."""
-        return {
-            "truth": self.truth.to_record(),
-            "seed": self.seed,
-            "ratio": self.ratio,
-            "comparison": self.comparison,
-            "sphere": self.sphere,
-        }
+        return asdict(self)
 
     @classmethod
     def from_record(cls, record: Mapping) -> Case:
-        return cls(**{**record, "truth": Truth.from_record(record["truth"])})
+        return cls(**{**record, "truth": Truth(**record["truth"])})
 
 
 def truths_of(validation: Mapping) -> dict[str, Truth]:
@@ -176,12 +155,17 @@ def cases_of(validation: Mapping) -> list[Case]:
     return cases
 
 
+def cases_by_name(validation: Mapping) -> dict[str, Case]:
+    """Every case of the study, on the small sphere and the sheet's spheres, by name."""
+    return {case.name: case for case in [*cases_of(validation), *sphere_cases(validation)]}
+
+
 def case_named(validation: Mapping, name: str) -> Case:
     """The case of ``name`` (:attr:`Case.name`), on the small sphere or a sheet sphere."""
-    for case in [*cases_of(validation), *sphere_cases(validation)]:
-        if case.name == name:
-            return case
-    raise ValueError(f"validation case {name!r} is not one of the config's cases")
+    case = cases_by_name(validation).get(name)
+    if case is None:
+        raise ValueError(f"validation case {name!r} is not one of the config's cases")
+    return case
 
 
 def case_names(validation: Mapping) -> list[str]:
@@ -240,11 +224,6 @@ def sphere_cases(validation: Mapping, available: Collection[str] | None = None) 
 def sphere_case_names(validation: Mapping, available: Collection[str] | None = None) -> list[str]:
     """The names of the cases on the sheet's spheres (the jobs' wildcards)."""
     return [case.name for case in sphere_cases(validation, available)]
-
-
-def sphere_of_case(validation: Mapping, name: str) -> str | None:
-    """The sheet sphere case ``name`` is on (None: the study's own small sphere)."""
-    return case_named(validation, name).sphere
 
 
 # the keys of ``validation`` (and of its ``spheres``) that only say which cases run: a case

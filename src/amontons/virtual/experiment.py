@@ -152,11 +152,10 @@ def generate_sphere(
     afm_truth = write_afm_scans(
         out_dir, solution, radius_m, roughness, surface.afm, scan_pixel, afm_rng
     )
-    model_truth = _forward_model_truth(
-        solution, roughness, surface, settings, loads_n, diameter_m, e_star_pa
+    truth.update(_true_model_record(true_model, true_value))
+    truth.update(
+        _forward_model_truth(solution, roughness, surface, settings, loads_n, diameter_m, e_star_pa)
     )
-    model_truth = {**_true_model_record(true_model, true_value), **model_truth}
-    truth.update(model_truth)
     truth["afm"] = afm_truth
     write_json(out_dir / "truth.json", truth)
     return truth

@@ -62,14 +62,15 @@ class SheetRows:
     def true_value(self, sphere: str) -> float | None:
         """The true model's parameter (its record's config unit; None for a model without
         one): the row's ``true_value``, or else the model's prior column."""
-        parameter = model_named(self.true_model(sphere)).parameter
+        model = self.true_model(sphere)
+        parameter = model_named(model).parameter
         if parameter is None:
             return None
         value = self.value(sphere, TRUE_VALUE_COLUMN)
         value = self.value(sphere, parameter.sheet_column) if value is None else value
         if value is None:
             raise ConfigError(
-                f"sphere {sphere}: true_model = {self.true_model(sphere)!r} with neither "
+                f"sphere {sphere}: true_model = {model!r} with neither "
                 f"{TRUE_VALUE_COLUMN} nor {parameter.sheet_column} in the sheet; expected the "
                 "value the virtual experiment makes its contact with"
             )

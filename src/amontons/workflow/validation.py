@@ -9,11 +9,10 @@ from collections.abc import Mapping
 
 from amontons.models import with_parameter
 from amontons.validation.cases import (
-    case_named,
     case_names,
     case_settings,
+    cases_by_name,
     sphere_case_names,
-    sphere_of_case,
 )
 
 
@@ -27,38 +26,36 @@ def validation_cases(config: Mapping) -> list[str]:
 NEEDED_COLUMNS = ("roughness_rms_nm", *(m.parameter.sheet_column for m in with_parameter()))
 
 
+def _why_left_out(config: Mapping, selected: Mapping[str, dict], sphere: str) -> str | None:
+    """Why the run cannot validate on ``sphere`` (None: it can): not a sphere of the selected
+    materials, or a sheet row without :data:`NEEDED_COLUMNS`."""
+    if sphere not in selected:
+        return (
+            f"validation.spheres.run: {sphere} is not a sphere of the selected materials "
+            f"{list(config['materials'])}; its validation cases are left out"
+        )
+    missing = [c for c in NEEDED_COLUMNS if selected[sphere].get(c) is None]
+    if missing:
+        return (
+            f"validation.spheres.run: {sphere}'s sheet row has no {', '.join(missing)} (the "
+            "truth's roughness and the priors its scans are centred on); its validation "
+            "cases are left out"
+        )
+    return None
+
+
 def runnable_validation_spheres(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
-    """The spheres ``validation.spheres.run`` names that the run can validate on: spheres of
-    the selected materials whose sheet row states :data:`NEEDED_COLUMNS`."""
-    return [
-        sphere
-        for sphere in config["validation"]["spheres"]["run"]
-        if sphere in selected and not _missing_columns(selected[sphere])
-    ]
+    """The spheres ``validation.spheres.run`` names that the run can validate on."""
+    run = config["validation"]["spheres"]["run"]
+    return [s for s in run if _why_left_out(config, selected, s) is None]
 
 
 def left_out_validation_spheres(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
     """A line for each sphere ``validation.spheres.run`` names that the run cannot validate
     on, and why (the rest of the study runs without it)."""
-    lines = []
-    for sphere in config["validation"]["spheres"]["run"]:
-        if sphere not in selected:
-            lines.append(
-                f"validation.spheres.run: {sphere} is not a sphere of the selected materials "
-                f"{list(config['materials'])}; its validation cases are left out"
-            )
-        elif missing := _missing_columns(selected[sphere]):
-            lines.append(
-                f"validation.spheres.run: {sphere}'s sheet row has no {', '.join(missing)} (the "
-                "truth's roughness and the priors its scans are centred on); its validation "
-                "cases are left out"
-            )
-    return lines
-
-
-def _missing_columns(record: Mapping) -> list[str]:
-    """The columns of :data:`NEEDED_COLUMNS` a sheet row leaves empty."""
-    return [c for c in NEEDED_COLUMNS if record.get(c) is None]
+    run = config["validation"]["spheres"]["run"]
+    reasons = (_why_left_out(config, selected, s) for s in run)
+    return [why for why in reasons if why is not None]
 
 
 def validation_sphere_cases(config: Mapping, selected: Mapping[str, dict]) -> list[str]:
@@ -66,15 +63,16 @@ def validation_sphere_cases(config: Mapping, selected: Mapping[str, dict]) -> li
     return sphere_case_names(config["validation"], runnable_validation_spheres(config, selected))
 
 
-def validation_sphere_record(config: Mapping, selected: Mapping[str, dict], case: str):
-    """The sheet record of the sphere case ``case`` is on, None for the small sphere's."""
-    sphere = sphere_of_case(config["validation"], case)
-    return None if sphere is None else selected[sphere]
+def validation_case_records(config: Mapping) -> dict[str, dict]:
+    """Every case as its job's params take it (amontons.validation.cases.Case.to_record), by
+    name: built once for the DAG."""
+    return {name: case.to_record() for name, case in cases_by_name(config["validation"]).items()}
 
 
-def validation_case_record(config: Mapping, case: str) -> dict:
-    """Case ``case`` as its job's params take it (amontons.validation.cases.Case.to_record)."""
-    return case_named(config["validation"], case).to_record()
+def validation_sphere_record(selected: Mapping[str, dict], case: Mapping) -> dict | None:
+    """The sheet record of the sphere a case (its record) is on, None for the small
+    sphere's."""
+    return None if case["sphere"] is None else selected[case["sphere"]]
 
 
 def validation_case_settings(config: Mapping) -> dict:
